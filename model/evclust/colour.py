@@ -1,0 +1,40 @@
+"""BT.601 full-range (JPEG) RGB <-> YCbCr, the one colour conversion of the project."""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+
+# Rows: Y, Cb, Cr; last column: offset. Coefficients of ITU-T T.871 (JFIF).
+RGB_TO_YCBCR = np.array(
+    [
+        [0.299, 0.587, 0.114, 0.0],
+        [-0.168736, -0.331264, 0.5, 128.0],
+        [0.5, -0.418688, -0.081312, 128.0],
+    ],
+    dtype=np.float64,
+)
+YCBCR_TO_RGB = np.array(
+    [
+        [1.0, 0.0, 1.402, -1.402 * 128.0],
+        [1.0, -0.344136, -0.714136, (0.344136 + 0.714136) * 128.0],
+        [1.0, 1.772, 0.0, -1.772 * 128.0],
+    ],
+    dtype=np.float64,
+)
+
+
+def rgb_to_ycbcr(rgb: np.ndarray) -> np.ndarray:
+    """(..., 3) RGB in 0..255 -> (..., 3) float YCbCr, unclipped."""
+    rgb = np.asarray(rgb, dtype=np.float64)
+    return rgb @ RGB_TO_YCBCR[:, :3].T + RGB_TO_YCBCR[:, 3]
+
+
+def ycbcr_to_rgb(ycc: np.ndarray) -> np.ndarray:
+    ycc = np.asarray(ycc, dtype=np.float64)
+    return ycc @ YCBCR_TO_RGB[:, :3].T + YCBCR_TO_RGB[:, 3]
+
+
+def frame_to_ycbcr(rgb: np.ndarray) -> np.ndarray:
+    """An (H, W, 3) float32 RGB frame -> (H, W, 3) float32 YCbCr planes; fast path for the simulator."""
+    return cv2.transform(np.ascontiguousarray(rgb, dtype=np.float32), RGB_TO_YCBCR.astype(np.float32))

@@ -1,0 +1,30 @@
+"""The one exception users see: its message is a single line naming the input and the fault."""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import tempfile
+from pathlib import Path
+
+
+class EvclustError(Exception):
+    """Bad input or an impossible request. The CLI prints it as one line and exits non-zero."""
+
+
+@contextlib.contextmanager
+def atomic_output(path: str | os.PathLike, suffix: str | None = None):
+    """Yield a temporary path beside `path`; move it into place only if the block succeeds.
+
+    A failed run therefore never leaves a partial output file behind.
+    """
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix or path.suffix, dir=path.parent)
+    os.close(fd)
+    tmp = Path(tmp)
+    try:
+        yield tmp
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)

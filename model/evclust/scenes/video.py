@@ -1,0 +1,79 @@
+"""Frames from anything OpenCV reads, or from a folder of images (sorted by name)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+from evclust.errors import EvclustError
+
+IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".webp", ".ppm", ".pgm")
+
+
+class VideoSource:
+    def __init__(self, path: Path, fps: float | None = None, max_frames: int | None = None):
+        self.path = Path(path)
+        self.source = str(path)
+        if not self.path.exists():
+            raise EvclustError(f"{self.path}: no such video file or image folder")
+        if self.path.is_dir():
+            self.images = sorted(p for p in self.path.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES)
+            if not self.images:
+                raise EvclustError(f"{self.path}: the folder holds no images ({', '.join(IMAGE_SUFFIXES)})")
+            if fps is None:
+                raise EvclustError(f"{self.path}: a folder of images needs a frame rate (fps in the scene file, or --fps)")
+            first = self._read_image(self.images[0])
+            n_frames = len(self.images)
+        else:
+            self.images = None
+            capture = cv2.VideoCapture(str(self.path))
+            ok, first = capture.read() if capture.isOpened() else (False, None)
+            if not ok:
+                capture.release()
+                raise EvclustError(f"{self.path}: OpenCV cannot read a frame from this file (unreadable or empty video)")
+            fps = fps or capture.get(cv2.CAP_PROP_FPS) or None
+            n_frames = int(capture.get(cv2.CAP_PROP_FRAME_COUNT)) or None
+            capture.release()
+            if not fps:
+                raise EvclustError(f"{self.path}: the video does not declare a frame rate; give fps in a scene file or --fps")
+            first = cv2.cvtColor(first, cv2.COLOR_BGR2RGB)
+        self.height, self.width = first.shape[:2]
+        self.fps = float(fps)
+        self.t_frame_us = 1e6 / self.fps
+        self.n_frames = min(n_frames, max_frames) if (n_frames and max_frames) else (n_frames or max_frames)
+        self.max_frames = max_frames
+
+    def _read_image(self, path: Path) -> np.ndarray:
+        image = cv2.imread(str(path), cv2.IMREAD_COLOR)
+        if image is None:
+            raise EvclustError(f"{path}: OpenCV cannot read this image")
+        return cv2.cvtColor(image, cv2.COLOR_BGR2RGB)
+
+    def _check_size(self, frame: np.ndarray, k: int) -> np.ndarray:
+        if frame.shape[:2] != (self.height, self.width):
+            raise EvclustError(
+                f"{self.path}: frame {k} is {frame.shape[1]}x{frame.shape[0]}, the first was {self.width}x{self.height}"
+            )
+        return frame.astype(np.float32)
+
+    def frames(self):
+        limit = self.max_frames or np.inf
+        if self.images is not None:
+            for k, path in enumerate(self.images):
+                if k >= limit:
+                    return
+                yield self._check_size(self._read_image(path), k)
+            return
+        capture = cv2.VideoCapture(str(self.path))
+        try:
+            k = 0
+            while k < limit:
+                ok, bgr = capture.read()
+                if not ok:
+                    break
+                yield self._check_size(cv2.cvtColor(bgr, cv2.COLOR_BGR2RGB), k)
+                k += 1
+        finally:
+            capture.release()

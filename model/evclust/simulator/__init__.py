@@ -1,0 +1,22 @@
+"""The colour event simulator (SPEC §3): a scene's frames through the sensor model."""
+
+from __future__ import annotations
+
+from evclust.scenes import Scene
+from evclust.simulator.effects import EFFECTS, SensorGeometry, build_effects
+from evclust.simulator.pipeline import Simulation, Simulator
+
+__all__ = ["EFFECTS", "Simulation", "Simulator", "SensorGeometry", "build_effects", "make_simulator", "simulate_scene"]
+
+
+def make_simulator(scene: Scene, seed: int | None = None) -> Simulator:
+    """Build the sensor of `scene`; bad effect names or parameters fail here, before any output."""
+    src = scene.source
+    geometry = SensorGeometry(src.width, src.height, src.t_frame_us)
+    effects = build_effects(scene.spec.effects, geometry, scene.spec.seed if seed is None else seed)
+    return Simulator(scene.spec.sensor, geometry, effects)
+
+
+def simulate_scene(scene: Scene, seed: int | None = None, progress: bool = False) -> Simulation:
+    simulator = make_simulator(scene, seed)
+    return simulator.run(scene.source.frames(), source=scene.source.source, total=scene.source.n_frames, progress=progress)

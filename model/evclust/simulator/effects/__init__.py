@@ -1,0 +1,41 @@
+"""The registry of sensor effects, in pipeline order. A scene names the ones it wants."""
+
+from __future__ import annotations
+
+from pydantic import ValidationError
+
+from evclust.errors import EvclustError
+from evclust.simulator.effects.base import Effect, EffectParams, Interval, SensorGeometry
+from evclust.simulator.effects.mismatch import ThresholdMismatch
+
+# Pipeline order within each stage follows the physical chain: pixel -> readout -> timestamp.
+EFFECTS: dict[str, type[Effect]] = {
+    cls.name: cls
+    for cls in (
+        ThresholdMismatch,
+    )
+}
+
+__all__ = ["EFFECTS", "Effect", "EffectParams", "Interval", "SensorGeometry", "build_effects"]
+
+
+def build_effects(config: dict[str, dict], geometry: SensorGeometry, seed: int) -> list[Effect]:
+    """Construct the effects named in `config` (name -> parameters), and only those, in pipeline order."""
+    unknown = sorted(set(config) - set(EFFECTS))
+    if unknown:
+        raise EvclustError(f"effects: unknown effect '{unknown[0]}' (known: {', '.join(EFFECTS)})")
+    effects = []
+    for name, cls in EFFECTS.items():
+        if name not in config:
+            continue
+        raw = config[name]
+        if not isinstance(raw, dict):
+            raise EvclustError(f"effects.{name}: expected a table of parameters, got {raw!r}")
+        try:
+            params = cls.Params.model_validate(raw)
+        except ValidationError as exc:
+            err = exc.errors()[0]
+            where = ".".join(str(p) for p in err["loc"])
+            raise EvclustError(f"effects.{name}.{where}: {err['msg']}") from None
+        effects.append(cls(params, geometry, seed))
+    return effects
