@@ -35,6 +35,11 @@ def ycbcr_to_rgb(ycc: np.ndarray) -> np.ndarray:
     return ycc @ YCBCR_TO_RGB[:, :3].T + YCBCR_TO_RGB[:, 3]
 
 
+def frame_to_luma(rgb: np.ndarray) -> np.ndarray:
+    """An (H, W, 3) RGB frame -> (H, W) float32 Y; the only plane the change detector needs."""
+    return cv2.transform(np.ascontiguousarray(rgb, dtype=np.float32), RGB_TO_YCBCR[:1, :3].astype(np.float32))
+
+
 def frame_to_ycbcr(rgb: np.ndarray) -> np.ndarray:
     """An (H, W, 3) float32 RGB frame -> (H, W, 3) float32 YCbCr planes; fast path for the simulator."""
     return cv2.transform(np.ascontiguousarray(rgb, dtype=np.float32), RGB_TO_YCBCR.astype(np.float32))

@@ -9,11 +9,11 @@ from typing import Iterable
 import numpy as np
 from tqdm import tqdm
 
-from evclust.colour import frame_to_ycbcr
+from evclust.colour import frame_to_luma
 from evclust.events.format import EVENT_DTYPE, EventMeta
 from evclust.scenes.schema import SensorSpec
 from evclust.simulator.effects import Effect, Interval, SensorGeometry
-from evclust.simulator.kernel import detect_interval
+from evclust.simulator.kernel import detect_interval, time_order
 
 
 @dataclasses.dataclass
@@ -40,12 +40,21 @@ def _stage(effects: list[Effect], stage: str) -> list[Effect]:
     return [e for e in effects if e.stage == stage]
 
 
-def _in_order(ev: np.ndarray) -> bool:
-    if ev.size < 2:
-        return True
-    t = ev["t"]
-    key = ev["y"].astype(np.int64) * 65536 + ev["x"]
-    return bool(np.all((t[1:] > t[:-1]) | ((t[1:] == t[:-1]) & (key[1:] >= key[:-1]))))
+def _join_at_boundary(previous: np.ndarray, current: np.ndarray) -> None:
+    """Re-order, in place, events of two consecutive intervals that fall on the same microsecond.
+
+    Each interval is ordered on its own; only events rounded to the boundary's microsecond can be
+    out of (t, y, x) order across it, so only those are sorted again.
+    """
+    if previous.size == 0 or current.size == 0 or current["t"][0] > previous["t"][-1]:
+        return
+    t = previous["t"][-1]
+    lo = int(np.searchsorted(previous["t"], t))
+    hi = int(np.searchsorted(current["t"], t, side="right"))
+    tied = np.concatenate([previous[lo:], current[:hi]])
+    tied = tied[np.lexsort((tied["x"], tied["y"]))]
+    previous[lo:] = tied[: previous.size - lo]
+    current[:hi] = tied[previous.size - lo :]
 
 
 class Simulator:
@@ -72,56 +81,62 @@ class Simulator:
         n_pixels = geometry.width * geometry.height
         self.buffer = np.empty(max(1 << 16, n_pixels // 2), dtype=EVENT_DTYPE)
 
-    def _observe(self, rgb: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Detector input L (flat float32) and colour planes (H*W, 3) float32 of one frame."""
+    def _observe(self, rgb: np.ndarray, level: np.ndarray) -> np.ndarray:
+        """Fill `level` (flat float32) with the detector input L; return the (H*W, 3) float32 RGB
+        the pixels measure colour from."""
         if self.observer is not None:
-            intensity, ycc = self.observer.observe(rgb)
+            intensity, rgb = self.observer.observe(rgb)
         else:
-            ycc = frame_to_ycbcr(rgb)
-            intensity = ycc[..., 0]
-        intensity = np.ascontiguousarray(intensity, dtype=np.float32).reshape(-1)
+            intensity = frame_to_luma(rgb)
+        intensity = np.asarray(intensity, dtype=np.float32).reshape(-1)
         if self.sensor.detector == "log":
-            level = np.log(intensity + np.float32(self.sensor.log_eps))
+            np.add(intensity, np.float32(self.sensor.log_eps), out=level)
+            np.log(level, out=level)
         else:
-            level = intensity
-        return level, ycc.reshape(-1, 3)
+            level[:] = intensity
+        return np.ascontiguousarray(rgb, dtype=np.float32).reshape(-1, 3)
 
-    def _detect(self, l0, l1, c0, c1, ref, t0_us: float) -> np.ndarray:
+    def _detect(self, l0, l1, rgb0, rgb1, ref, t0_us: float) -> np.ndarray:
         buf = self.buffer
         chunks = []
         pixel = 0
         while pixel < l0.size:
             n, pixel = detect_interval(
-                l0, l1, c0, c1, ref, self.th_on, self.th_off, self.th_stride, self.geometry.width,
+                l0, l1, rgb0, rgb1, ref, self.th_on, self.th_off, self.th_stride, self.geometry.width,
                 t0_us, self.geometry.t_frame_us, pixel,
                 buf["t"], buf["x"], buf["y"], buf["p"], buf["Y"], buf["Cb"], buf["Cr"],
             )  # fmt: skip
-            chunks.append(buf[:n].copy())
-        events = chunks[0] if len(chunks) == 1 else np.concatenate(chunks)
-        return events[np.argsort(events["t"], kind="stable")]
+            if pixel < l0.size or chunks:  # the buffer filled up: keep what it holds, go on
+                chunks.append(buf[:n].copy())
+        events = np.concatenate(chunks) if chunks else buf[:n]
+        return events[time_order(events["t"], int(t0_us))]
 
     def run(self, frames: Iterable[np.ndarray], source: str = "", total: int | None = None, progress: bool = False) -> Simulation:
         start = time.perf_counter()
         g = self.geometry
+        shape = (g.height, g.width, 3)
+        # Two detector-input buffers used in turn: frame k's and frame k-1's.
+        levels = [np.empty(g.width * g.height, np.float32) for _ in range(2)]
         chunks = []
-        ref = l_prev = c_prev = None
+        ref = rgb_prev = None
         k = -1
-        for k, rgb in enumerate(tqdm(frames, total=total, unit="frame", disable=not progress, desc="simulate")):
+        for k, rgb in enumerate(tqdm(frames, total=total, unit="frame", disable=None if progress else True, desc="simulate")):
             if rgb.shape[:2] != (g.height, g.width):
                 raise ValueError(f"frame {k} is {rgb.shape[1]}x{rgb.shape[0]}, the sensor is {g.width}x{g.height}")
-            level, ycc = self._observe(rgb)
+            level, l_prev = levels[k % 2], levels[(k + 1) % 2]
+            colour = self._observe(rgb, level)
             if ref is None:
                 ref = level.astype(np.float64)  # the reference starts at the first frame: no events
             else:
                 t0 = (k - 1) * g.t_frame_us
-                events = self._detect(l_prev, level, c_prev, ycc, ref, t0)
+                events = self._detect(l_prev, level, rgb_prev, colour, ref, t0)
                 for effect in self.interval_effects:
-                    events = effect.interval(events, Interval(k, t0, t0 + g.t_frame_us, c_prev.reshape(g.height, g.width, 3), ycc.reshape(g.height, g.width, 3)))
+                    events = effect.interval(events, Interval(k, t0, t0 + g.t_frame_us, rgb_prev.reshape(shape), colour.reshape(shape)))
+                if chunks:
+                    _join_at_boundary(chunks[-1], events)
                 chunks.append(events)
-            l_prev, c_prev = level, ycc
+            rgb_prev = colour
         events = np.concatenate(chunks) if chunks else np.zeros(0, EVENT_DTYPE)
-        if not _in_order(events):  # equal microseconds on both sides of a frame boundary
-            events = events[np.lexsort((events["x"], events["y"], events["t"]))]
         for effect in self.stream_effects:
             events = effect.stream(events)
         meta = EventMeta(width=g.width, height=g.height, source=source, t_frame_us=g.t_frame_us)

@@ -31,13 +31,13 @@ class SensorGeometry:
 
 @dataclasses.dataclass
 class Interval:
-    """One frame interval as the interval stage sees it: frames k-1 and k, their YCbCr planes."""
+    """One frame interval as the interval stage sees it: frames k-1 and k as the pixels saw them."""
 
     index: int  # k: the interval ends at frame k
     t0_us: float
     t1_us: float
-    ycc0: np.ndarray  # (H, W, 3) float32
-    ycc1: np.ndarray
+    rgb0: np.ndarray  # (H, W, 3) float32 RGB, 0..255
+    rgb1: np.ndarray
 
 
 class Effect:
@@ -53,6 +53,7 @@ class Effect:
 
     # Hooks; each effect implements the one of its stage.
     def observe(self, rgb: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(H, W, 3) RGB -> ((H, W) intensity the change detector sees, (H, W, 3) RGB the TFS measures)."""
         raise NotImplementedError
 
     def thresholds(self, th_on: float, th_off: float) -> tuple[np.ndarray, np.ndarray]:

@@ -1,0 +1,56 @@
+"""evclust simulate SCENE -o events.npz [--truth gt.csv]"""
+
+from __future__ import annotations
+
+import sys
+
+from evclust.errors import EvclustError
+from evclust.events import write_events
+from evclust.scenes import load_scene, write_truth
+from evclust.simulator import make_simulator
+
+
+def add_parser(sub) -> None:
+    p = sub.add_parser(
+        "simulate",
+        help="turn a scene or a video into colour events",
+        description=(
+            "Simulate a colour event camera (DVS change detector + TFS colour measurement) on a scene. "
+            "SCENE is a built-in scene name (see 'evclust scenes'), a TOML scene file, a video file "
+            "OpenCV can read, or a folder of images. Sensor effects are switched on in the scene file."
+        ),
+    )
+    p.add_argument("scene", metavar="SCENE", help="built-in name, scene.toml, video file or image folder")
+    p.add_argument("-o", "--output", required=True, metavar="EVENTS", help="event file to write (.npz, .h5 or .hdf5)")
+    p.add_argument("--truth", metavar="GT.csv", help="also write the ground truth per frame (synthetic scenes, or a video with a CSV beside it)")
+    p.add_argument("--seed", type=int, metavar="N", help="seed of the sensor effects (default: the scene's)")
+    p.add_argument("--frames", type=int, metavar="N", help="simulate only the first N frames")
+    p.add_argument("--fps", type=float, metavar="F", help="frame rate of a video or image folder (default: the video's)")
+    p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(run=run)
+
+
+def run(args) -> int:
+    if args.frames is not None and args.frames < 2:
+        raise EvclustError(f"--frames {args.frames}: at least 2 frames are needed to see a change")
+    if args.fps is not None and args.fps <= 0:
+        raise EvclustError(f"--fps {args.fps}: the frame rate must be positive")
+    scene = load_scene(args.scene, fps=args.fps, max_frames=args.frames)
+    if args.truth and not scene.has_truth:
+        raise EvclustError(f"{args.scene}: no ground truth for this scene (a video needs a CSV of the same name beside it)")
+    simulator = make_simulator(scene, args.seed)
+    result = simulator.run(scene.source.frames(), source=scene.source.source, total=scene.source.n_frames, progress=not args.quiet)
+    if result.frames < 2:
+        raise EvclustError(f"{args.scene}: only {result.frames} frame(s) could be read; at least 2 are needed")
+    write_events(args.output, result.events, result.meta)
+    if args.truth:
+        if scene.truth_path is not None:
+            import shutil
+
+            shutil.copyfile(scene.truth_path, args.truth)
+        else:
+            rows = scene.source.truth()
+            write_truth(args.truth, [r for r in rows if r["frame"] < result.frames])
+    print(result.summary())
+    sys.stdout.flush()
+    return 0
