@@ -31,7 +31,8 @@ def _kind(path: Path) -> str:
 def write_events(path: str | Path, ev: np.ndarray, meta: EventMeta) -> None:
     path = Path(path)
     kind = _kind(path)
-    ev = np.asarray(ev, dtype=EVENT_DTYPE)
+    if ev.dtype != EVENT_DTYPE:
+        raise EvclustError(f"{path}: records of dtype {ev.dtype} are not events ({EVENT_DTYPE})")
     with atomic_output(path) as tmp:
         if kind == "npz":
             with open(tmp, "wb") as f:

@@ -15,7 +15,7 @@ from evclust.scenes.synthetic import TRUTH_COLUMNS, SyntheticSource
 from evclust.scenes.truth import write_truth
 from evclust.scenes.video import IMAGE_SUFFIXES, VideoSource
 
-__all__ = ["Scene", "SceneSpec", "SensorSpec", "load_scene", "builtin_scenes", "write_truth", "TRUTH_COLUMNS"]
+__all__ = ["Scene", "SceneSpec", "SensorSpec", "load_scene", "scene_from_toml", "builtin_scenes", "write_truth", "TRUTH_COLUMNS"]
 
 
 @dataclasses.dataclass
@@ -23,6 +23,7 @@ class Scene:
     spec: SceneSpec
     source: SyntheticSource | VideoSource
     truth_path: Path | None = None  # a video's ground-truth CSV, if it has one
+    label: str = "<scene>"  # how messages name the scene: its file, video or built-in name
 
     @property
     def has_truth(self) -> bool:
@@ -52,6 +53,14 @@ def parse_scene(text: str, name: str) -> SceneSpec:
         raise EvclustError(f"{name}: {_pydantic_message(exc)}") from None
 
 
+def scene_from_toml(text: str, name: str = "<scene>", base_dir: Path = Path(".")) -> Scene:
+    """A synthetic scene from TOML text (a video scene needs a file: use load_scene)."""
+    spec = parse_scene(text, name)
+    if spec.video is not None:
+        raise EvclustError(f"{name}: scene_from_toml takes synthetic scenes only")
+    return Scene(spec, SyntheticSource(spec, base_dir, spec.name or name), label=name)
+
+
 def load_scene(ref: str | Path, fps: float | None = None, max_frames: int | None = None) -> Scene:
     """A built-in name, a TOML scene file, a video file or a folder of images."""
     ref_str = str(ref)
@@ -79,8 +88,8 @@ def load_scene(ref: str | Path, fps: float | None = None, max_frames: int | None
     if spec.video is None:
         if max_frames:
             spec = spec.model_copy(update={"frames": min(spec.frames, max_frames)})
-        return Scene(spec, SyntheticSource(spec, base, spec.name or label))
+        return Scene(spec, SyntheticSource(spec, base, spec.name or label), label=label)
     video = (base / spec.video) if not Path(spec.video).is_absolute() else Path(spec.video)
     source = VideoSource(video, fps=fps or spec.fps, max_frames=max_frames or spec.frames)
     truth = (base / spec.truth) if spec.truth else video.with_suffix(".csv")
-    return Scene(spec, source, truth if truth.is_file() and truth != video else None)
+    return Scene(spec, source, truth if truth.is_file() and truth != video else None, label=label)

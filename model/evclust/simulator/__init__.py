@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from evclust.errors import EvclustError
 from evclust.scenes import Scene
 from evclust.simulator.effects import EFFECTS, SensorGeometry, build_effects
 from evclust.simulator.pipeline import Simulation, Simulator
@@ -13,7 +14,10 @@ def make_simulator(scene: Scene, seed: int | None = None) -> Simulator:
     """Build the sensor of `scene`; bad effect names or parameters fail here, before any output."""
     src = scene.source
     geometry = SensorGeometry(src.width, src.height, src.t_frame_us)
-    effects = build_effects(scene.spec.effects, geometry, scene.spec.seed if seed is None else seed)
+    try:
+        effects = build_effects(scene.spec.effects, geometry, scene.spec.seed if seed is None else seed)
+    except EvclustError as exc:
+        raise EvclustError(f"{scene.label}: {exc}") from None
     return Simulator(scene.spec.sensor, geometry, effects)
 
 

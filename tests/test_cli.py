@@ -1,0 +1,169 @@
+"""The command line: complete help, one clear line for bad input, no partial output, videos."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import cv2
+import numpy as np
+import pytest
+
+from evclust.cli import main
+from evclust.events import read_events
+from evclust.scenes import load_scene
+
+GOOD_SCENE = """
+width = 40
+height = 30
+fps = 30
+frames = 6
+[[objects]]
+id = 1
+label = "red"
+size = [8, 8]
+colour = [210, 40, 40]
+start = [10, 15]
+legs = [{ frames = 5, velocity = [2.0, 0.0] }]
+"""
+
+
+def run_cli(capsys, *argv):
+    code = main(list(argv))
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def assert_one_line_error(code, err, *fragments):
+    assert code == 2
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("evclust: error: "), err
+    assert "Traceback" not in err
+    for fragment in fragments:
+        assert fragment in lines[0]
+
+
+@pytest.mark.parametrize("verb", ["simulate", "show", "scenes"])
+def test_every_verb_has_complete_help(capsys, verb):
+    with pytest.raises(SystemExit) as exit_:
+        main([verb, "--help"])
+    assert exit_.value.code == 0
+    text = capsys.readouterr().out
+    assert text.startswith(f"usage: evclust {verb}") and len(text.splitlines()) > 4
+
+
+def test_top_level_help_lists_the_verbs(capsys):
+    with pytest.raises(SystemExit):
+        main(["--help"])
+    text = capsys.readouterr().out
+    assert all(verb in text for verb in ("simulate", "show", "scenes"))
+
+
+def test_simulate_writes_events_truth_and_a_summary_line(tmp_path, capsys):
+    scene = tmp_path / "s.toml"
+    scene.write_text(GOOD_SCENE)
+    code, out, err = run_cli(capsys, "simulate", str(scene), "-o", str(tmp_path / "e.h5"), "--truth", str(tmp_path / "gt.csv"), "-q")
+    assert code == 0, err
+    ev, meta = read_events(tmp_path / "e.h5")
+    assert ev.size > 0 and (meta.width, meta.height) == (40, 30)
+    assert f"6 frames, {ev.size} events" in out and "events/s of scene time" in out and "wall time" in out
+    assert (tmp_path / "gt.csv").read_text().count("\n") == 1 + 6
+
+
+@pytest.mark.parametrize(
+    "scene_text, fragments",
+    [
+        ("width = 40\nheight = [", ("malformed TOML",)),
+        (GOOD_SCENE + "\n[effects.no_such_effect]\nx = 1\n", ("unknown effect 'no_such_effect'",)),
+        (GOOD_SCENE + "\n[effects.threshold_mismatch]\nsigmaa = 0.1\n", ("effects.threshold_mismatch.sigmaa",)),
+        (GOOD_SCENE + "\n[effects.threshold_mismatch]\nsigma = -1\n", ("effects.threshold_mismatch.sigma", "greater than 0")),
+        (GOOD_SCENE.replace("fps = 30", "fps = 30\nflicker = 2"), ("flicker", "Extra inputs")),
+        (GOOD_SCENE.replace("fps = 30", "fps = -3"), ("fps", "greater than 0")),
+    ],
+)
+def test_bad_scene_files_give_one_line_and_no_output(tmp_path, capsys, scene_text, fragments):
+    scene = tmp_path / "bad.toml"
+    scene.write_text(scene_text)
+    out_path = tmp_path / "out" / "e.npz"
+    code, _, err = run_cli(capsys, "simulate", str(scene), "-o", str(out_path), "--truth", str(tmp_path / "gt.csv"), "-q")
+    assert_one_line_error(code, err, "bad.toml", *fragments)
+    assert not out_path.exists() and not (tmp_path / "gt.csv").exists()
+
+
+def test_unknown_scene_name(tmp_path, capsys):
+    code, _, err = run_cli(capsys, "simulate", "highway", "-o", str(tmp_path / "e.npz"))
+    assert_one_line_error(code, err, "unknown scene 'highway'", "pedestrian")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_unreadable_and_empty_videos(tmp_path, capsys):
+    garbage = tmp_path / "garbage.mp4"
+    garbage.write_bytes(b"\x00\x01 this is not a video" * 100)
+    code, _, err = run_cli(capsys, "simulate", str(garbage), "-o", str(tmp_path / "e.npz"))
+    assert_one_line_error(code, err, "garbage.mp4", "cannot read a frame")
+    empty = tmp_path / "empty.avi"
+    writer = cv2.VideoWriter(str(empty), cv2.VideoWriter_fourcc(*"FFV1"), 25, (32, 24))
+    writer.release()
+    code, _, err = run_cli(capsys, "simulate", str(empty), "-o", str(tmp_path / "e.npz"))
+    assert_one_line_error(code, err, "empty.avi")
+    empty_folder = tmp_path / "frames"
+    empty_folder.mkdir()
+    code, _, err = run_cli(capsys, "simulate", str(empty_folder), "-o", str(tmp_path / "e.npz"), "--fps", "10")
+    assert_one_line_error(code, err, "holds no images")
+    assert not (tmp_path / "e.npz").exists()
+
+
+def test_out_of_range_options_and_truth_without_source(tmp_path, capsys):
+    code, _, err = run_cli(capsys, "simulate", "slow", "-o", str(tmp_path / "e.npz"), "--frames", "1")
+    assert_one_line_error(code, err, "--frames 1")
+    video = tmp_path / "v.avi"
+    _write_video(video, [np.zeros((24, 32, 3), np.uint8)] * 3)
+    code, _, err = run_cli(capsys, "simulate", str(video), "-o", str(tmp_path / "e.npz"), "--truth", str(tmp_path / "gt.csv"))
+    assert_one_line_error(code, err, "no ground truth")
+    assert not (tmp_path / "e.npz").exists()
+
+
+def test_unwritable_output_is_one_line(tmp_path, capsys):
+    blocker = tmp_path / "file"
+    blocker.write_text("")
+    code, _, err = run_cli(capsys, "simulate", "slow", "-o", str(blocker / "e.npz"), "--frames", "3", "-q")
+    assert_one_line_error(code, err)
+
+
+def _write_video(path, frames_rgb, fps=30):
+    h, w = frames_rgb[0].shape[:2]
+    writer = cv2.VideoWriter(str(path), cv2.VideoWriter_fourcc(*"FFV1"), fps, (w, h))
+    for frame in frames_rgb:
+        writer.write(cv2.cvtColor(frame, cv2.COLOR_RGB2BGR))
+    writer.release()
+
+
+def test_a_video_and_the_same_frames_as_images_give_the_same_events(tmp_path, capsys):
+    source = load_scene("crossing").source
+    frames = [np.clip(np.rint(source.render(k)), 0, 255).astype(np.uint8) for k in range(0, 40)]
+    video = tmp_path / "crossing.avi"
+    _write_video(video, frames)
+    # The codec is lossless, so both inputs hold exactly the same frames.
+    capture = cv2.VideoCapture(str(video))
+    decoded = []
+    while (ok_frame := capture.read())[0]:
+        decoded.append(cv2.cvtColor(ok_frame[1], cv2.COLOR_BGR2RGB))
+    assert len(decoded) == len(frames) and all(np.array_equal(a, b) for a, b in zip(decoded, frames))
+    folder = tmp_path / "images"
+    folder.mkdir()
+    for k, frame in enumerate(frames):
+        cv2.imwrite(str(folder / f"frame_{k:04d}.png"), cv2.cvtColor(frame, cv2.COLOR_RGB2BGR))
+    assert main(["simulate", str(video), "-o", str(tmp_path / "v.npz"), "-q"]) == 0
+    assert main(["simulate", str(folder), "-o", str(tmp_path / "i.npz"), "--fps", "30", "-q"]) == 0
+    from_video, meta_video = read_events(tmp_path / "v.npz")
+    from_images, meta_images = read_events(tmp_path / "i.npz")
+    assert from_video.size > 1000
+    assert np.array_equal(from_video, from_images)
+    assert meta_video.t_frame_us == pytest.approx(meta_images.t_frame_us)
+
+
+def test_console_script_reports_bad_input_without_traceback(tmp_path):
+    exe = __import__("shutil").which("evclust") or str(__import__("pathlib").Path(sys.executable).parent / "evclust")
+    result = subprocess.run([exe, "simulate", "nosuch", "-o", str(tmp_path / "e.npz")], capture_output=True, text=True)
+    assert result.returncode == 2
+    assert result.stderr.strip().splitlines() == ["evclust: error: unknown scene 'nosuch': built-in scenes are crossing, grey_on_grey, pedestrian, slow, traffic"]
