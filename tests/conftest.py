@@ -6,12 +6,11 @@ import numpy as np
 import pytest
 
 from evclust.scenes import scene_from_toml
-from evclust.simulator import make_simulator
+from evclust.simulator import simulate_scene
 
 
 def simulate_toml(text: str, seed: int | None = None):
-    scene = scene_from_toml(text)
-    return make_simulator(scene, seed).run(scene.source.frames(), source="test")
+    return simulate_scene(scene_from_toml(text, "test"), seed=seed)
 
 
 def pixel_events(events: np.ndarray, x: int, y: int) -> np.ndarray:

@@ -74,7 +74,7 @@ def test_simulate_writes_events_truth_and_a_summary_line(tmp_path, capsys):
     "scene_text, fragments",
     [
         ("width = 40\nheight = [", ("malformed TOML",)),
-        (GOOD_SCENE + "\n[effects.no_such_effect]\nx = 1\n", ("unknown effect 'no_such_effect'",)),
+        (GOOD_SCENE + "\n[effects.no_such_effect]\nx = 1\n", ("effects.no_such_effect", "unknown effect")),
         (GOOD_SCENE + "\n[effects.threshold_mismatch]\nsigmaa = 0.1\n", ("effects.threshold_mismatch.sigmaa",)),
         (GOOD_SCENE + "\n[effects.threshold_mismatch]\nsigma = -1\n", ("effects.threshold_mismatch.sigma", "greater than 0")),
         (GOOD_SCENE.replace("fps = 30", "fps = 30\nflicker = 2"), ("flicker", "Extra inputs")),

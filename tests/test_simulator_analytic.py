@@ -23,7 +23,7 @@ FPS = 100
 T_US = 1e6 / FPS
 
 
-def edge_scene(velocity: float, detector: str, th_on: float, th_off: float, frames: int, bg=50, obj=200, width=40):
+def edge_scene(velocity: float, detector: str, th_on: float, th_off: float, frames: int, bg=50, obj=200, width=40, substeps=1):
     """A wide grey rectangle whose right edge sits on the boundary x = 2.5 at frame 0."""
     right = 2.5
     return f"""
@@ -31,6 +31,7 @@ width = 16
 height = 8
 fps = {FPS}
 frames = {frames}
+substeps = {substeps}
 [sensor]
 detector = "{detector}"
 threshold_on = {th_on}
@@ -147,3 +148,23 @@ def test_metadata_carries_sensor_size_source_and_frame_period():
     assert (sim.meta.width, sim.meta.height) == (16, 8)
     assert sim.meta.t_frame_us == pytest.approx(T_US)
     assert sim.frames == 4
+
+
+def test_substeps_put_a_fast_edge_at_the_right_time():
+    # At 4 px/frame the edge sweeps pixel x in the quarter frame starting at (x-3)·T/4, where a
+    # linear detector sees Y rise linearly. With 4 sub-steps per frame the sensor samples every
+    # quarter frame, so its interpolation is exact; sampling whole frames spreads the same rise
+    # over the full frame.
+    bg, obj, theta, v = 50, 200, 20.0, 4.0
+    n_expected = math.floor((obj - bg) / theta)
+    sweep_us = T_US / v
+    errors = {}
+    for substeps in (1, 4):
+        sim = simulate_toml(edge_scene(v, "linear", theta, theta, frames=4, bg=bg, obj=obj, substeps=substeps))
+        assert sim.frames == 4 and sim.meta.t_frame_us == pytest.approx(T_US)
+        got = pixel_events(sim.events, 5, 4)
+        assert got.size == n_expected
+        expected = 2 * sweep_us + sweep_us * theta * np.arange(1, n_expected + 1) / (obj - bg)
+        errors[substeps] = np.max(np.abs(got["t"].astype(float) - expected))
+    assert errors[4] <= 1.0
+    assert errors[1] > sweep_us  # whole-frame sampling is off by more than the sweep itself

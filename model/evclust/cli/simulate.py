@@ -7,7 +7,7 @@ import sys
 from evclust.errors import EvclustError
 from evclust.events import write_events
 from evclust.scenes import load_scene, write_truth
-from evclust.simulator import make_simulator
+from evclust.simulator import simulate_scene
 
 
 def add_parser(sub) -> None:
@@ -38,8 +38,7 @@ def run(args) -> int:
     scene = load_scene(args.scene, fps=args.fps, max_frames=args.frames)
     if args.truth and not scene.has_truth:
         raise EvclustError(f"{args.scene}: no ground truth for this scene (a video needs a CSV of the same name beside it)")
-    simulator = make_simulator(scene, args.seed)
-    result = simulator.run(scene.source.frames(), source=scene.source.source, total=scene.source.n_frames, progress=not args.quiet)
+    result = simulate_scene(scene, seed=args.seed, progress=not args.quiet)
     if result.frames < 2:
         raise EvclustError(f"{args.scene}: only {result.frames} frame(s) could be read; at least 2 are needed")
     write_events(args.output, result.events, result.meta)

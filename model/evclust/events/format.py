@@ -48,6 +48,16 @@ def empty_events(n: int = 0) -> np.ndarray:
 
 
 def sort_events(ev: np.ndarray) -> np.ndarray:
-    """Order by time, ties by y then x (SPEC §2). Stable, so equal keys keep their order."""
-    order = np.lexsort((ev["x"], ev["y"], ev["t"]))
-    return ev[order]
+    """Order by time, ties by y then x (SPEC §2), keeping the order of equal keys.
+
+    Up to 2^32 µs (71 minutes) the three keys pack into one uint64, and one stable sort of it is
+    several times faster than a three-key lexsort, above all on the nearly sorted streams that
+    effects produce.
+    """
+    if ev.size < 2:
+        return ev
+    t = ev["t"]
+    if int(t.max()) < 1 << 32:
+        key = (t << np.uint64(32)) | (ev["y"].astype(np.uint64) << np.uint64(16)) | ev["x"].astype(np.uint64)
+        return ev[np.argsort(key, kind="stable")]
+    return ev[np.lexsort((ev["x"], ev["y"], t))]

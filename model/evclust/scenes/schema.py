@@ -85,6 +85,9 @@ class SceneSpec(Strict):
     height: Annotated[int, Field(gt=0, le=65535)] | None = None
     fps: Annotated[float, Field(gt=0, le=1e6)] | None = None
     frames: Annotated[int, Field(gt=1)] | None = None
+    # Synthetic scenes can be sampled between frames: the sensor then sees `substeps` renders per
+    # frame, so an edge faster than 1 px/frame crosses each pixel at the right time.
+    substeps: Annotated[int, Field(ge=1, le=64)] = 1
     background: BackgroundSpec = BackgroundSpec()
     objects: list[ObjectSpec] = []
     # video scenes: anything OpenCV reads, or a folder of images
@@ -104,4 +107,6 @@ class SceneSpec(Strict):
                 raise ValueError("object ids must be unique")
         elif self.objects:
             raise ValueError("a video scene cannot also have objects")
+        elif self.substeps != 1:
+            raise ValueError("substeps applies to synthetic scenes only: a video has only its frames")
         return self

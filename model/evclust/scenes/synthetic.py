@@ -134,10 +134,14 @@ class SyntheticSource:
         self.fps = float(spec.fps)
         self.n_frames = int(spec.frames)
         self.t_frame_us = 1e6 / self.fps
+        self.substeps = int(spec.substeps)
+        self.t_sample_us = self.t_frame_us / self.substeps
+        self.n_samples = (self.n_frames - 1) * self.substeps + 1
         self.background = make_background(spec.background, self.width, self.height, spec.seed, base_dir)
         self.objects = [RigidObject(o) for o in spec.objects]
 
-    def render(self, k: int) -> np.ndarray:
+    def render(self, k: float) -> np.ndarray:
+        """The view at frame k; k may be fractional (a sub-step between frames)."""
         frame = self.background.copy()
         for obj in self.objects:
             state = obj.state(k)
@@ -151,8 +155,9 @@ class SyntheticSource:
         return frame
 
     def frames(self):
-        for k in range(self.n_frames):
-            yield self.render(k)
+        """The views the sensor samples: every frame, and `substeps - 1` views between frames."""
+        for j in range(self.n_samples):
+            yield self.render(j / self.substeps)
 
     def truth(self) -> list[dict]:
         rows = []

@@ -43,6 +43,9 @@ class VideoSource:
         self.fps = float(fps)
         self.t_frame_us = 1e6 / self.fps
         self.n_frames = min(n_frames, max_frames) if (n_frames and max_frames) else (n_frames or max_frames)
+        self.substeps = 1  # the sensor samples exactly the video's frames
+        self.t_sample_us = self.t_frame_us
+        self.n_samples = self.n_frames
         self.max_frames = max_frames
 
     def _read_image(self, path: Path) -> np.ndarray:

@@ -13,7 +13,7 @@ __all__ = ["EFFECTS", "Simulation", "Simulator", "SensorGeometry", "build_effect
 def make_simulator(scene: Scene, seed: int | None = None) -> Simulator:
     """Build the sensor of `scene`; bad effect names or parameters fail here, before any output."""
     src = scene.source
-    geometry = SensorGeometry(src.width, src.height, src.t_frame_us)
+    geometry = SensorGeometry(src.width, src.height, src.t_sample_us)
     try:
         effects = build_effects(scene.spec.effects, geometry, scene.spec.seed if seed is None else seed)
     except EvclustError as exc:
@@ -23,4 +23,5 @@ def make_simulator(scene: Scene, seed: int | None = None) -> Simulator:
 
 def simulate_scene(scene: Scene, seed: int | None = None, progress: bool = False) -> Simulation:
     simulator = make_simulator(scene, seed)
-    return simulator.run(scene.source.frames(), source=scene.source.source, total=scene.source.n_frames, progress=progress)
+    src = scene.source
+    return simulator.run(src.frames(), source=src.source, total=src.n_samples, progress=progress, frame_period_us=src.t_frame_us)

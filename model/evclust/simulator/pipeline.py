@@ -20,12 +20,20 @@ from evclust.simulator.kernel import detect_interval, time_order
 class Simulation:
     events: np.ndarray
     meta: EventMeta
-    frames: int
+    samples: int  # views the sensor saw: frames, or frames and the sub-steps between them
+    sample_period_us: float
     wall_s: float
 
     @property
     def scene_s(self) -> float:
-        return max(self.frames - 1, 0) * (self.meta.t_frame_us or 0.0) / 1e6
+        return max(self.samples - 1, 0) * self.sample_period_us / 1e6
+
+    @property
+    def frames(self) -> int:
+        """Scene frames covered (the sub-steps between frames are not counted)."""
+        if self.samples == 0:
+            return 0
+        return int(round(self.scene_s * 1e6 / (self.meta.t_frame_us or self.sample_period_us))) + 1
 
     def summary(self) -> str:
         n = len(self.events)
@@ -111,7 +119,17 @@ class Simulator:
         events = np.concatenate(chunks) if chunks else buf[:n]
         return events[time_order(events["t"], int(t0_us))]
 
-    def run(self, frames: Iterable[np.ndarray], source: str = "", total: int | None = None, progress: bool = False) -> Simulation:
+    def run(
+        self,
+        frames: Iterable[np.ndarray],
+        source: str = "",
+        total: int | None = None,
+        progress: bool = False,
+        frame_period_us: float | None = None,
+    ) -> Simulation:
+        """Simulate the sensor over `frames`, sampled every geometry.t_frame_us. `frame_period_us`
+        is the scene's frame period recorded in the metadata (velocities are per frame); by
+        default the sampling period."""
         start = time.perf_counter()
         g = self.geometry
         shape = (g.height, g.width, 3)
@@ -139,5 +157,5 @@ class Simulator:
         events = np.concatenate(chunks) if chunks else np.zeros(0, EVENT_DTYPE)
         for effect in self.stream_effects:
             events = effect.stream(events)
-        meta = EventMeta(width=g.width, height=g.height, source=source, t_frame_us=g.t_frame_us)
-        return Simulation(events, meta, k + 1, time.perf_counter() - start)
+        meta = EventMeta(width=g.width, height=g.height, source=source, t_frame_us=frame_period_us or g.t_frame_us)
+        return Simulation(events, meta, k + 1, g.t_frame_us, time.perf_counter() - start)
