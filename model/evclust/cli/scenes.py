@@ -24,5 +24,5 @@ def run(args) -> int:
     for name, cls in EFFECTS.items():
         fields = ", ".join(f"{k}={v.default!r}" for k, v in cls.Params.model_fields.items())
         doc = (cls.__doc__ or "").strip().splitlines()[0] if cls.__doc__ else ""
-        print(f"  {name:<20} {fields}  {doc}")
+        print(f"  {name:<23} {fields}  {doc}")
     return 0

@@ -9,31 +9,44 @@ order (time, then y, then x).
 
 from __future__ import annotations
 
+import sys
+
 import numba
 import numpy as np
 
 from evclust.colour import RGB_TO_YCBCR
+from evclust.events.format import EVENT_DTYPE
 
 _M = RGB_TO_YCBCR  # YCbCr = M[:, :3] · RGB + M[:, 3]; linear, so interpolating RGB interpolates YCbCr
 
+# The kernel writes each event as the two little-endian uint64 words of its 16-byte record:
+# word 0 = t; word 1 = x | y << 16 | p << 32 | Y << 40 | Cb << 48 | Cr << 56.
+assert sys.byteorder == "little"
+assert [EVENT_DTYPE.fields[f][1] for f in EVENT_DTYPE.names] == [0, 8, 10, 12, 13, 14, 15]
+_ON_BITS = np.uint64(1) << np.uint64(32)
+_OFF_BITS = np.uint64(0xFF) << np.uint64(32)  # int8 -1
+
 
 @numba.njit(cache=True, nogil=True, inline="always")
-def _channel(row, r, g, b):
-    v = _M[row, 0] * r + _M[row, 1] * g + _M[row, 2] * b + _M[row, 3]
-    return np.uint8(min(max(v, 0.0), 255.0) + 0.5)
+def _ycbcr(row, rgb, i):
+    return _M[row, 0] * rgb[i, 0] + _M[row, 1] * rgb[i, 1] + _M[row, 2] * rgb[i, 2] + _M[row, 3]
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _byte(v):
+    return np.uint64(np.int64(min(max(v, 0.0), 255.0) + 0.5))
 
 
 @numba.njit(cache=True, nogil=True, boundscheck=False)
-def detect_interval(
-    l0, l1, rgb0, rgb1, ref, th_on, th_off, th_stride, width, t0_us, dt_us, first_pixel,
-    out_t, out_x, out_y, out_p, out_lum, out_cb, out_cr,
-):  # fmt: skip
-    """Emit the events of pixels first_pixel.. into the out_* buffers.
+def detect_interval(l0, l1, rgb0, rgb1, ref, th_on, th_off, th_stride, width, t0_us, dt_us, first_pixel, words, keys):
+    """Emit the events of pixels first_pixel.. as packed records into `words` (2 per event), and
+    their sort keys ((t - floor(t0)) << 32 | emission index) into `keys`.
 
     Returns (events written, next pixel to visit). The next pixel is l0.size when the interval is
     done; otherwise the buffers are full, and the caller empties them and calls again from there.
     """
-    capacity = out_t.size
+    capacity = keys.size
+    t_base = np.uint64(np.floor(t0_us))
     n = 0
     for i in range(first_pixel, l0.size):
         r = ref[i]
@@ -41,16 +54,16 @@ def detect_interval(
         th_up = th_on[i * th_stride]
         th_down = th_off[i * th_stride]
         if target - r >= th_up:
-            count = int((target - r) / th_up)
             step = th_up
-            polarity = 1
+            polarity_bits = _ON_BITS
         elif r - target >= th_down:
-            count = int((r - target) / th_down)
             step = -th_down
-            polarity = -1
+            polarity_bits = _OFF_BITS
         else:
             continue
-        # Make the residual pass the very test this pixel faces next, so a static pixel stays silent.
+        # Count crossings until the residual fails the very test this pixel faces next, so a
+        # static pixel stays silent. Counts are small: stepping beats dividing.
+        count = 1
         while abs(target - (r + count * step)) >= abs(step):
             count += 1
         if n + count > capacity:
@@ -60,29 +73,38 @@ def detect_interval(
         if span == 0.0:  # only float rounding can get here: the crossing is at the frame itself
             span = step
             start = target - step
+        inv_span = 1.0 / span
         y = i // width
-        x = i - y * width
+        address = np.uint64(i - y * width) | (np.uint64(y) << np.uint64(16)) | polarity_bits
+        # YCbCr is linear in RGB: convert the pixel's two frames once, interpolate per event.
+        lum0, cb0, cr0 = _ycbcr(0, rgb0, i), _ycbcr(1, rgb0, i), _ycbcr(2, rgb0, i)
+        d_lum, d_cb, d_cr = _ycbcr(0, rgb1, i) - lum0, _ycbcr(1, rgb1, i) - cb0, _ycbcr(2, rgb1, i) - cr0
         for j in range(1, count + 1):
-            frac = min(max((r + j * step - start) / span, 0.0), 1.0)
-            red = rgb0[i, 0] + frac * (rgb1[i, 0] - rgb0[i, 0])
-            green = rgb0[i, 1] + frac * (rgb1[i, 1] - rgb0[i, 1])
-            blue = rgb0[i, 2] + frac * (rgb1[i, 2] - rgb0[i, 2])
-            out_t[n] = np.uint64(t0_us + frac * dt_us + 0.5)
-            out_x[n] = x
-            out_y[n] = y
-            out_p[n] = polarity
-            out_lum[n] = _channel(0, red, green, blue)
-            out_cb[n] = _channel(1, red, green, blue)
-            out_cr[n] = _channel(2, red, green, blue)
+            frac = min(max((r + j * step - start) * inv_span, 0.0), 1.0)
+            t = np.uint64(np.int64(t0_us + frac * dt_us + 0.5))
+            words[2 * n] = t
+            words[2 * n + 1] = (
+                address
+                | (_byte(lum0 + frac * d_lum) << np.uint64(40))
+                | (_byte(cb0 + frac * d_cb) << np.uint64(48))
+                | (_byte(cr0 + frac * d_cr) << np.uint64(56))
+            )
+            keys[n] = ((t - t_base) << np.uint64(32)) | np.uint64(n)
             n += 1
         ref[i] = r + count * step
     return n, l0.size
 
 
-def time_order(t: np.ndarray, t0: int) -> np.ndarray:
-    """Indices that order one interval's events by time, ties by emission order (= y, then x).
+class EventBuffer:
+    """Room for the events of one call of detect_interval, and their sort keys."""
 
-    One packed uint64 key per event and an unstable SIMD sort: faster than a stable argsort.
-    """
-    key = ((t - np.uint64(t0)) << np.uint64(32)) | np.arange(t.size, dtype=np.uint64)
-    return (np.sort(key) & np.uint64(0xFFFFFFFF)).astype(np.intp)
+    def __init__(self, capacity: int):
+        self.words = np.empty(2 * capacity, np.uint64)
+        self.keys = np.empty(capacity, np.uint64)
+
+    def time_ordered(self, n: int) -> np.ndarray:
+        """A copy of the first n events ordered by time, ties by emission (= y, then x) order.
+
+        The keys are unique, so a plain (SIMD) sort of them gives the permutation."""
+        order = np.sort(self.keys[:n]) & np.uint64(0xFFFFFFFF)
+        return self.words.view(EVENT_DTYPE)[order.astype(np.intp)]

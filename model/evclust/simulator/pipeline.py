@@ -10,10 +10,10 @@ import numpy as np
 from tqdm import tqdm
 
 from evclust.colour import frame_to_luma
-from evclust.events.format import EVENT_DTYPE, EventMeta
+from evclust.events.format import EventMeta, concat_events, sort_events
 from evclust.scenes.schema import SensorSpec
 from evclust.simulator.effects import Effect, Interval, SensorGeometry
-from evclust.simulator.kernel import detect_interval, time_order
+from evclust.simulator.kernel import EventBuffer, detect_interval
 
 
 @dataclasses.dataclass
@@ -59,7 +59,7 @@ def _join_at_boundary(previous: np.ndarray, current: np.ndarray) -> None:
     t = previous["t"][-1]
     lo = int(np.searchsorted(previous["t"], t))
     hi = int(np.searchsorted(current["t"], t, side="right"))
-    tied = np.concatenate([previous[lo:], current[:hi]])
+    tied = concat_events([previous[lo:], current[:hi]])
     tied = tied[np.lexsort((tied["x"], tied["y"]))]
     previous[lo:] = tied[: previous.size - lo]
     current[:hi] = tied[previous.size - lo :]
@@ -87,7 +87,7 @@ class Simulator:
             self.th_off = np.array([sensor.threshold_off], dtype=np.float64)
             self.th_stride = 0
         n_pixels = geometry.width * geometry.height
-        self.buffer = np.empty(max(1 << 16, n_pixels // 2), dtype=EVENT_DTYPE)
+        self.buffer = EventBuffer(max(1 << 16, n_pixels // 2))
 
     def _observe(self, rgb: np.ndarray, level: np.ndarray) -> np.ndarray:
         """Fill `level` (flat float32) with the detector input L; return the (H*W, 3) float32 RGB
@@ -105,19 +105,23 @@ class Simulator:
         return np.ascontiguousarray(rgb, dtype=np.float32).reshape(-1, 3)
 
     def _detect(self, l0, l1, rgb0, rgb1, ref, t0_us: float) -> np.ndarray:
+        """The events of one frame interval, ordered by (t, y, x)."""
         buf = self.buffer
         chunks = []
         pixel = 0
         while pixel < l0.size:
             n, pixel = detect_interval(
                 l0, l1, rgb0, rgb1, ref, self.th_on, self.th_off, self.th_stride, self.geometry.width,
-                t0_us, self.geometry.t_frame_us, pixel,
-                buf["t"], buf["x"], buf["y"], buf["p"], buf["Y"], buf["Cb"], buf["Cr"],
+                t0_us, self.geometry.t_frame_us, pixel, buf.words, buf.keys,
             )  # fmt: skip
-            if pixel < l0.size or chunks:  # the buffer filled up: keep what it holds, go on
-                chunks.append(buf[:n].copy())
-        events = np.concatenate(chunks) if chunks else buf[:n]
-        return events[time_order(events["t"], int(t0_us))]
+            if n == 0 and pixel < l0.size:  # one pixel crosses more levels than the buffer holds
+                self.buffer = buf = EventBuffer(2 * buf.keys.size)
+                continue
+            chunks.append(buf.time_ordered(n))
+        if len(chunks) == 1:
+            return chunks[0]
+        # The buffer filled up: each chunk is in order on its own, their union is not.
+        return sort_events(concat_events(chunks))
 
     def run(
         self,
@@ -154,7 +158,7 @@ class Simulator:
                     _join_at_boundary(chunks[-1], events)
                 chunks.append(events)
             rgb_prev = colour
-        events = np.concatenate(chunks) if chunks else np.zeros(0, EVENT_DTYPE)
+        events = concat_events(chunks)
         for effect in self.stream_effects:
             events = effect.stream(events)
         meta = EventMeta(width=g.width, height=g.height, source=source, t_frame_us=frame_period_us or g.t_frame_us)

@@ -6,13 +6,29 @@ from pydantic import ValidationError
 
 from evclust.errors import EvclustError
 from evclust.simulator.effects.base import Effect, EffectParams, Interval, SensorGeometry
+from evclust.simulator.effects.background import BackgroundActivity
+from evclust.simulator.effects.bayer import Bayer
+from evclust.simulator.effects.hot_pixels import HotPixels
 from evclust.simulator.effects.mismatch import ThresholdMismatch
+from evclust.simulator.effects.readout import ReadoutLimit
+from evclust.simulator.effects.refractory import Refractory
+from evclust.simulator.effects.tdc import TdcQuantisation
+from evclust.simulator.effects.tfs import TfsLatency
+from evclust.simulator.effects.timestamp import TimestampQuantisation
 
-# Pipeline order within each stage follows the physical chain: pixel -> readout -> timestamp.
+# Pipeline order follows the physical chain: pixel -> intensity measurement -> timestamp -> readout.
 EFFECTS: dict[str, type[Effect]] = {
     cls.name: cls
     for cls in (
+        Bayer,
         ThresholdMismatch,
+        BackgroundActivity,
+        HotPixels,
+        Refractory,
+        TdcQuantisation,
+        TfsLatency,
+        TimestampQuantisation,
+        ReadoutLimit,
     )
 }
 
@@ -23,7 +39,7 @@ def build_effects(config: dict[str, dict], geometry: SensorGeometry, seed: int) 
     """Construct the effects named in `config` (name -> parameters), and only those, in pipeline order."""
     unknown = sorted(set(config) - set(EFFECTS))
     if unknown:
-        raise EvclustError(f"effects: unknown effect '{unknown[0]}' (known: {', '.join(EFFECTS)})")
+        raise EvclustError(f"effects.{unknown[0]}: unknown effect (known: {', '.join(EFFECTS)})")
     effects = []
     for name, cls in EFFECTS.items():
         if name not in config:

@@ -17,6 +17,9 @@ from typing import ClassVar
 import numpy as np
 from pydantic import BaseModel, ConfigDict
 
+from evclust.colour import rgb_to_ycbcr
+from evclust.events.format import EVENT_DTYPE, concat_events, sort_events
+
 
 class EffectParams(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True)
@@ -64,3 +67,57 @@ class Effect:
 
     def stream(self, events: np.ndarray) -> np.ndarray:
         raise NotImplementedError
+
+
+# ---------------------------------------------------------------------------------------------
+# Helpers shared by several effects.
+
+def round_us(t: np.ndarray) -> np.ndarray:
+    """Float µs -> uint64 µs, rounding half up as the change detector does."""
+    return np.floor(np.asarray(t, dtype=np.float64) + 0.5).astype(np.uint64)
+
+
+def to_ycbcr_u8(rgb: np.ndarray) -> np.ndarray:
+    """(N, 3) RGB 0..255 -> (N, 3) uint8 YCbCr (BT.601 full range), clipped and rounded as the kernel does."""
+    return np.floor(np.clip(rgb_to_ycbcr(rgb), 0.0, 255.0) + 0.5).astype(np.uint8)
+
+
+def poisson_events(
+    rng: np.random.Generator, pixels: np.ndarray | int, rate_hz: float, on_fraction: float, interval: Interval
+) -> np.ndarray:
+    """Independent Poisson trains of `rate_hz` at each pixel over one frame interval.
+
+    `pixels`: flat indices (y·W + x) of the pixels that fire, or an int n for all pixels 0..n-1.
+    The total count is Poisson(rate·pixels·Δt); each event picks its pixel uniformly and its time
+    uniformly in [t0, t1], which is the same process. An event is ON with probability
+    `on_fraction` and carries the pixel's colour linearly interpolated to its time, as a change
+    event would. Returned sorted by (t, y, x).
+    """
+    n_pixels = pixels if isinstance(pixels, (int, np.integer)) else len(pixels)
+    span_us = interval.t1_us - interval.t0_us
+    n = int(rng.poisson(rate_hz * n_pixels * span_us * 1e-6))
+    which = rng.integers(0, n_pixels, n)
+    flat = which if isinstance(pixels, (int, np.integer)) else np.asarray(pixels)[which]
+    frac = rng.random(n)
+    on = rng.random(n) < on_fraction
+    width = interval.rgb0.shape[1]
+    y, x = np.divmod(flat, width)
+    c0 = interval.rgb0[y, x].astype(np.float64)
+    rgb = c0 + frac[:, None] * (interval.rgb1[y, x] - c0)
+    ev = np.empty(n, dtype=EVENT_DTYPE)
+    ev["t"] = round_us(interval.t0_us + frac * span_us)
+    ev["x"] = x
+    ev["y"] = y
+    ev["p"] = np.where(on, 1, -1)
+    ycc = to_ycbcr_u8(rgb)
+    ev["Y"], ev["Cb"], ev["Cr"] = ycc[:, 0], ycc[:, 1], ycc[:, 2]
+    return sort_events(ev)
+
+
+def add_events(events: np.ndarray, extra: np.ndarray) -> np.ndarray:
+    """Two sorted streams -> one sorted stream."""
+    if extra.size == 0:
+        return events
+    if events.size == 0:
+        return extra
+    return sort_events(concat_events([events, extra]))

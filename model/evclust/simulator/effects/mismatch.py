@@ -11,6 +11,8 @@ from evclust.simulator.effects.base import Effect, EffectParams
 
 
 class ThresholdMismatch(Effect):
+    """Per-pixel ON/OFF thresholds scattered around the nominal ones with relative spread sigma."""
+
     name = "threshold_mismatch"
     stage = "thresholds"
 
