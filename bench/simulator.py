@@ -50,7 +50,7 @@ from evclust.events.format import EVENT_DTYPE  # noqa: E402
 from evclust.scenes import Scene, load_scene  # noqa: E402
 from evclust.scenes.synthetic import SyntheticSource  # noqa: E402
 from evclust.scenes.video import VideoSource  # noqa: E402
-from evclust.simulator import EFFECTS, make_simulator  # noqa: E402
+from evclust.simulator import EFFECTS, make_simulator, simulate_scene  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 VIDEO = ROOT / "build" / "bench" / "pan_disks.avi"
@@ -153,7 +153,7 @@ def ensure_video() -> str:
 def baseline_simulate(frames: list[np.ndarray], scene: Scene) -> np.ndarray:
     sensor = scene.spec.sensor
     width = scene.source.width
-    dt = scene.source.t_frame_us
+    dt = scene.source.t_sample_us  # the period of the frames the sensor sees (sub-steps included)
     th_on, th_off = float(sensor.threshold_on), float(sensor.threshold_off)
     luma = RGB_TO_YCBCR[0, :3].astype(np.float32)
     to_ycc, offset = RGB_TO_YCBCR[:, :3].T, RGB_TO_YCBCR[:, 3]
@@ -278,7 +278,7 @@ def run_case(name: str, load: Callable[[], Scene], frames: list[np.ndarray], noi
 
     def end_to_end() -> int:
         s = make()
-        return len(make_simulator(s).run(s.source.frames(), source=s.source.source, total=s.source.n_frames).events)
+        return len(simulate_scene(s).events)
 
     kind = "noisy" if noisy else "ideal"
     case = Case(name, noisy, src.width, src.height, len(frames), timed(f"{name} {kind}: simulator", simulate, repeat),

@@ -14,10 +14,7 @@ import sys
 import numba
 import numpy as np
 
-from evclust.colour import RGB_TO_YCBCR
 from evclust.events.format import EVENT_DTYPE
-
-_M = RGB_TO_YCBCR  # YCbCr = M[:, :3] · RGB + M[:, 3]; linear, so interpolating RGB interpolates YCbCr
 
 # The kernel writes each event as the two little-endian uint64 words of its 16-byte record:
 # word 0 = t; word 1 = x | y << 16 | p << 32 | Y << 40 | Cb << 48 | Cr << 56.
@@ -28,8 +25,8 @@ _OFF_BITS = np.uint64(0xFF) << np.uint64(32)  # int8 -1
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
-def _ycbcr(row, rgb, i):
-    return _M[row, 0] * rgb[i, 0] + _M[row, 1] * rgb[i, 1] + _M[row, 2] * rgb[i, 2] + _M[row, 3]
+def _ycbcr(m, row, rgb, i):
+    return m[row, 0] * rgb[i, 0] + m[row, 1] * rgb[i, 1] + m[row, 2] * rgb[i, 2] + m[row, 3]
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
@@ -38,12 +35,13 @@ def _byte(v):
 
 
 @numba.njit(cache=True, nogil=True, boundscheck=False)
-def detect_interval(l0, l1, rgb0, rgb1, ref, th_on, th_off, th_stride, width, t0_us, dt_us, first_pixel, words, keys):
+def detect_interval(l0, l1, rgb0, rgb1, ref, th_on, th_off, th_stride, width, t0_us, dt_us, first_pixel, words, keys, m):
     """Emit the events of pixels first_pixel.. as packed records into `words` (2 per event), and
     their sort keys ((t - floor(t0)) << 32 | emission index) into `keys`.
 
     Returns (events written, next pixel to visit). The next pixel is l0.size when the interval is
     done; otherwise the buffers are full, and the caller empties them and calls again from there.
+    `m` is the RGB -> YCbCr matrix (an argument, not a global: numba's disk cache freezes globals).
     """
     capacity = keys.size
     t_base = np.uint64(np.floor(t0_us))
@@ -77,8 +75,8 @@ def detect_interval(l0, l1, rgb0, rgb1, ref, th_on, th_off, th_stride, width, t0
         y = i // width
         address = np.uint64(i - y * width) | (np.uint64(y) << np.uint64(16)) | polarity_bits
         # YCbCr is linear in RGB: convert the pixel's two frames once, interpolate per event.
-        lum0, cb0, cr0 = _ycbcr(0, rgb0, i), _ycbcr(1, rgb0, i), _ycbcr(2, rgb0, i)
-        d_lum, d_cb, d_cr = _ycbcr(0, rgb1, i) - lum0, _ycbcr(1, rgb1, i) - cb0, _ycbcr(2, rgb1, i) - cr0
+        lum0, cb0, cr0 = _ycbcr(m, 0, rgb0, i), _ycbcr(m, 1, rgb0, i), _ycbcr(m, 2, rgb0, i)
+        d_lum, d_cb, d_cr = _ycbcr(m, 0, rgb1, i) - lum0, _ycbcr(m, 1, rgb1, i) - cb0, _ycbcr(m, 2, rgb1, i) - cr0
         for j in range(1, count + 1):
             frac = min(max((r + j * step - start) * inv_span, 0.0), 1.0)
             t = np.uint64(np.int64(t0_us + frac * dt_us + 0.5))

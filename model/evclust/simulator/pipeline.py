@@ -9,7 +9,7 @@ from typing import Iterable
 import numpy as np
 from tqdm import tqdm
 
-from evclust.colour import frame_to_luma
+from evclust.colour import RGB_TO_YCBCR, frame_to_luma
 from evclust.events.format import EventMeta, concat_events, sort_events
 from evclust.scenes.schema import SensorSpec
 from evclust.simulator.effects import Effect, Interval, SensorGeometry
@@ -112,7 +112,7 @@ class Simulator:
         while pixel < l0.size:
             n, pixel = detect_interval(
                 l0, l1, rgb0, rgb1, ref, self.th_on, self.th_off, self.th_stride, self.geometry.width,
-                t0_us, self.geometry.t_frame_us, pixel, buf.words, buf.keys,
+                t0_us, self.geometry.t_frame_us, pixel, buf.words, buf.keys, RGB_TO_YCBCR,
             )  # fmt: skip
             if n == 0 and pixel < l0.size:  # one pixel crosses more levels than the buffer holds
                 self.buffer = buf = EventBuffer(2 * buf.keys.size)

@@ -18,9 +18,6 @@ from pydantic import Field, ValidationInfo, field_validator
 from evclust.colour import RGB_TO_YCBCR, YCBCR_TO_RGB
 from evclust.simulator.effects.base import Effect, EffectParams
 
-_TO_YCC = RGB_TO_YCBCR  # the project's BT.601 matrices (evclust.colour), applied per event below
-_TO_RGB = YCBCR_TO_RGB
-
 
 # integration_time_us lives here, beside the compiled code that calls it: numba's on-disk cache
 # only notices edits to the calling function's own file. TFS latency imports it from here.
@@ -50,18 +47,28 @@ def tdc_read(intensity, k_us, t_max_us, bits):
 
 
 @numba.njit(cache=True, nogil=True, boundscheck=False)
-def _requantise(lum, cb, cr, k_us, t_max_us, bits):
-    """In place: YCbCr -> RGB, each channel through the TDC, -> YCbCr (rounded as the change detector does)."""
-    rgb = np.empty(3)
+def _requantise(lum, cb, cr, to_rgb, to_ycc, k_us, t_max_us, bits):
+    """In place: YCbCr -> RGB, each channel through the TDC, -> YCbCr (rounded as the change detector does).
+
+    The BT.601 matrices come in as arguments: numba's disk cache would freeze a module global."""
     for i in range(lum.size):
-        for c in range(3):
-            v = _TO_RGB[c, 0] * lum[i] + _TO_RGB[c, 1] * cb[i] + _TO_RGB[c, 2] * cr[i] + _TO_RGB[c, 3]
-            rgb[c] = tdc_read(min(max(v, 0.0), 255.0), k_us, t_max_us, bits)
-        out = np.empty(3, np.uint8)
-        for c in range(3):
-            v = _TO_YCC[c, 0] * rgb[0] + _TO_YCC[c, 1] * rgb[1] + _TO_YCC[c, 2] * rgb[2] + _TO_YCC[c, 3]
-            out[c] = np.uint8(min(max(v, 0.0), 255.0) + 0.5)
-        lum[i], cb[i], cr[i] = out[0], out[1], out[2]
+        r = _read_channel(to_rgb, 0, lum[i], cb[i], cr[i], k_us, t_max_us, bits)
+        g = _read_channel(to_rgb, 1, lum[i], cb[i], cr[i], k_us, t_max_us, bits)
+        b = _read_channel(to_rgb, 2, lum[i], cb[i], cr[i], k_us, t_max_us, bits)
+        lum[i] = _byte(to_ycc[0, 0] * r + to_ycc[0, 1] * g + to_ycc[0, 2] * b + to_ycc[0, 3])
+        cb[i] = _byte(to_ycc[1, 0] * r + to_ycc[1, 1] * g + to_ycc[1, 2] * b + to_ycc[1, 3])
+        cr[i] = _byte(to_ycc[2, 0] * r + to_ycc[2, 1] * g + to_ycc[2, 2] * b + to_ycc[2, 3])
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _read_channel(to_rgb, c, lum, cb, cr, k_us, t_max_us, bits):
+    v = to_rgb[c, 0] * lum + to_rgb[c, 1] * cb + to_rgb[c, 2] * cr + to_rgb[c, 3]
+    return tdc_read(min(max(v, 0.0), 255.0), k_us, t_max_us, bits)
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _byte(v):
+    return np.uint8(min(max(v, 0.0), 255.0) + 0.5)
 
 
 class TdcQuantisation(Effect):
@@ -98,6 +105,6 @@ class TdcQuantisation(Effect):
         if out.size:
             lum, cb, cr = (np.ascontiguousarray(out[f]) for f in ("Y", "Cb", "Cr"))
             p = self.params
-            _requantise(lum, cb, cr, float(p.k_us), float(p.t_max_us), int(p.bits))
+            _requantise(lum, cb, cr, YCBCR_TO_RGB, RGB_TO_YCBCR, float(p.k_us), float(p.t_max_us), int(p.bits))
             out["Y"], out["Cb"], out["Cr"] = lum, cb, cr
         return out
