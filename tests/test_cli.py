@@ -167,3 +167,17 @@ def test_console_script_reports_bad_input_without_traceback(tmp_path):
     result = subprocess.run([exe, "simulate", "nosuch", "-o", str(tmp_path / "e.npz")], capture_output=True, text=True)
     assert result.returncode == 2
     assert result.stderr.strip().splitlines() == ["evclust: error: unknown scene 'nosuch': built-in scenes are crossing, grey_on_grey, pedestrian, slow, traffic"]
+
+
+def test_a_video_with_a_truth_csv_beside_it_passes_the_truth_through(tmp_path, capsys):
+    video = tmp_path / "clip.avi"
+    frames = [np.full((24, 32, 3), v, np.uint8) for v in (40, 40, 200)]
+    _write_video(video, frames)
+    truth = "frame,t_us,id,cx,cy,w,h,vx,vy,Y,Cb,Cr,label,fully_visible\n0,0,1,5,5,2,2,0,0,40,128,128,grey,1\n"
+    (tmp_path / "clip.csv").write_text(truth)
+    code, out, err = run_cli(capsys, "simulate", str(video), "-o", str(tmp_path / "e.npz"), "--truth", str(tmp_path / "gt.csv"), "-q")
+    assert code == 0, err
+    assert (tmp_path / "gt.csv").read_text() == truth
+    events, _ = read_events(tmp_path / "e.npz")
+    # A full-frame step from grey 40 to 200: ln(201/41) = 1.59 crosses θ = 0.2 seven times per pixel.
+    assert events.size == 7 * 24 * 32 and np.all(events["p"] == 1)

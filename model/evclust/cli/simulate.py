@@ -2,9 +2,10 @@
 
 from __future__ import annotations
 
+import shutil
 import sys
 
-from evclust.errors import EvclustError
+from evclust.errors import EvclustError, atomic_output
 from evclust.events import write_events
 from evclust.scenes import load_scene, write_truth
 from evclust.simulator import simulate_scene
@@ -44,9 +45,8 @@ def run(args) -> int:
     write_events(args.output, result.events, result.meta)
     if args.truth:
         if scene.truth_path is not None:
-            import shutil
-
-            shutil.copyfile(scene.truth_path, args.truth)
+            with atomic_output(args.truth) as tmp:
+                shutil.copyfile(scene.truth_path, tmp)
         else:
             rows = scene.source.truth()
             write_truth(args.truth, [r for r in rows if r["frame"] < result.frames])
