@@ -1,0 +1,127 @@
+"""Track record dtype, its metadata, and the CSV file."""
+
+from __future__ import annotations
+
+import csv
+import dataclasses
+import enum
+import io
+import json
+from pathlib import Path
+
+import numpy as np
+
+from evclust.errors import EvclustError, atomic_output
+
+TRACK_DTYPE = np.dtype(
+    [
+        ("t_us", np.uint64),  # time of the filter step (the event that triggered it)
+        ("step", np.uint32),  # filter step index, from 0
+        ("slot", np.uint16),  # cluster table slot
+        ("id", np.uint32),  # unique, increasing cluster id
+        ("x", np.float64),  # centre, px (pixel-index coordinates)
+        ("y", np.float64),
+        ("rx", np.float64),  # half-size, px
+        ("ry", np.float64),
+        ("activity", np.float64),  # decayed event count
+        ("vx_mcm", np.float64),  # mean-centre-motion velocity, px/frame
+        ("vy_mcm", np.float64),
+        ("vx_int", np.float64),  # regular-interval velocity, px/frame
+        ("vy_int", np.float64),
+        ("Y", np.float64),  # object colour after background correction, 0..255
+        ("Cb", np.float64),
+        ("Cr", np.float64),
+        ("class", np.int16),  # palette index of the histogram's argmax (non-background); -1: none
+        ("flags", np.uint16),  # TrackFlags
+    ]
+)
+TRACK_FIELDS = TRACK_DTYPE.names
+_INTEGER_FIELDS = {"t_us", "step", "slot", "id", "class", "flags"}
+MAGIC = "# evclust-tracks "
+
+
+class TrackFlags(enum.IntFlag):
+    NEW = 1  # first record of this id
+    BORDER = 2  # centre within exit_margin of a border
+    MOVING_MCM = 4  # |V_mcm| >= v_min
+    MOVING_INT = 8  # |V_int| >= v_min
+
+
+@dataclasses.dataclass(frozen=True)
+class TrackMeta:
+    """What a track file needs beside its rows."""
+
+    width: int
+    height: int
+    t_frame_us: float
+    source: str = ""  # the event file's source (scene name or video)
+    model: str = "float"  # float | fixed | rtl
+    palette: tuple[str, ...] = ()  # palette entry names, by class index
+    palette_ycbcr: tuple[tuple[float, float, float], ...] = ()  # the entries' colours
+    palette_background: tuple[str, ...] = ()  # entries that are background, never a class
+    luma_weight: float = 1.0  # weight of |ΔY| in the palette's L1 distance
+    seek_margin: float = 0.0  # S: the seek region is the box grown by S on every side, px
+    exit_margin: float = 0.0  # M: the border band where exit prediction acts, px
+    has_colour: bool = True
+
+    def to_json(self) -> str:
+        return json.dumps(dataclasses.asdict(self), sort_keys=True)
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "TrackMeta":
+        known = {f.name for f in dataclasses.fields(cls)}
+        d = {k: v for k, v in d.items() if k in known}
+        for key in ("palette", "palette_background"):
+            if key in d:
+                d[key] = tuple(d[key])
+        if "palette_ycbcr" in d:
+            d["palette_ycbcr"] = tuple(tuple(float(c) for c in e) for e in d["palette_ycbcr"])
+        return cls(**d)
+
+
+def _format(value, integer: bool) -> str:
+    return str(int(value)) if integer else f"{float(value):.6g}"
+
+
+def write_tracks(path: str | Path, tracks: np.ndarray, meta: TrackMeta) -> None:
+    tracks = np.asarray(tracks)
+    if tracks.dtype != TRACK_DTYPE:
+        raise EvclustError(f"{path}: records of dtype {tracks.dtype} are not tracks")
+    with atomic_output(path) as tmp:
+        with open(tmp, "w", newline="") as f:
+            f.write(MAGIC + meta.to_json() + "\n")
+            f.write(",".join(TRACK_FIELDS) + "\n")
+            integer = [name in _INTEGER_FIELDS for name in TRACK_FIELDS]
+            columns = [tracks[name].tolist() for name in TRACK_FIELDS]
+            f.writelines(",".join(_format(v, i) for v, i in zip(row, integer)) + "\n" for row in zip(*columns))
+
+
+def read_tracks(path: str | Path) -> tuple[np.ndarray, TrackMeta]:
+    path = Path(path)
+    if not path.is_file():
+        raise EvclustError(f"{path}: no such track file")
+    text = path.read_text()
+    first, _, rest = text.partition("\n")
+    if not first.startswith(MAGIC):
+        raise EvclustError(f"{path}: not an evclust track file (its first line must start with '{MAGIC.strip()}')")
+    try:
+        meta = TrackMeta.from_dict(json.loads(first[len(MAGIC):]))
+    except (json.JSONDecodeError, TypeError) as exc:
+        raise EvclustError(f"{path}: line 1: unreadable metadata ({exc})") from None
+    reader = csv.reader(io.StringIO(rest))
+    header = next(reader, None)
+    if header is None:
+        raise EvclustError(f"{path}: no header line")
+    missing = [name for name in TRACK_FIELDS if name not in header]
+    if missing:
+        raise EvclustError(f"{path}: missing column(s) {', '.join(missing)}")
+    index = [header.index(name) for name in TRACK_FIELDS]
+    rows = []
+    for line_no, row in enumerate(reader, start=3):
+        if not row:
+            continue
+        try:
+            rows.append(tuple(float(row[i]) if name not in _INTEGER_FIELDS else int(row[i]) for i, name in zip(index, TRACK_FIELDS)))
+        except (ValueError, IndexError):
+            raise EvclustError(f"{path}: line {line_no}: not a track record: {','.join(row)[:80]}") from None
+    return np.array(rows, dtype=TRACK_DTYPE), meta
