@@ -16,12 +16,20 @@ $(STAMP): pyproject.toml
 	$(PY) -m pip install --quiet -e '.[test]'
 	touch $(STAMP)
 
-# Simulate a built-in scene, print a summary, draw its events to build/.
+# The main job on a built-in scene: simulate it, track it, score the tracks against the ground
+# truth, and draw the results into build/.
+DEMO := $(BUILD)/traffic
 demo: $(STAMP)
 	mkdir -p $(BUILD)
-	$(VENV)/bin/evclust simulate traffic -o $(BUILD)/traffic.npz --truth $(BUILD)/traffic_truth.csv
-	$(VENV)/bin/evclust show $(BUILD)/traffic.npz -o $(BUILD)/traffic_events.png
-	@echo "picture: $(BUILD)/traffic_events.png"
+	$(VENV)/bin/evclust simulate traffic -o $(DEMO).npz --truth $(DEMO)_truth.csv
+	$(VENV)/bin/evclust track $(DEMO).npz -o $(DEMO)_tracks.csv
+	$(VENV)/bin/evclust score $(DEMO)_tracks.csv --truth $(DEMO)_truth.csv --json $(DEMO)_scores.json
+	$(VENV)/bin/evclust show $(DEMO).npz -o $(DEMO)_events.png
+	$(VENV)/bin/evclust render $(DEMO).npz $(DEMO)_tracks.csv -o $(DEMO)_tracks.png
+	$(VENV)/bin/evclust render $(DEMO).npz $(DEMO)_tracks.csv -o $(DEMO)_tracks.mp4 -q
+	$(VENV)/bin/evclust plot $(DEMO)_tracks.csv --truth $(DEMO)_truth.csv -o $(DEMO)_velocity.png
+	$(VENV)/bin/evclust plot $(DEMO)_tracks.csv --truth $(DEMO)_truth.csv -o $(DEMO)_colour.png --kind colour
+	@echo "pictures: $(DEMO)_events.png $(DEMO)_tracks.png $(DEMO)_tracks.mp4 $(DEMO)_velocity.png $(DEMO)_colour.png"
 
 test: $(STAMP)
 	$(PY) -m pytest -q

@@ -43,7 +43,7 @@ def assert_one_line_error(code, err, *fragments):
         assert fragment in lines[0]
 
 
-@pytest.mark.parametrize("verb", ["simulate", "show", "scenes"])
+@pytest.mark.parametrize("verb", ["simulate", "track", "score", "render", "plot", "show", "scenes"])
 def test_every_verb_has_complete_help(capsys, verb):
     with pytest.raises(SystemExit) as exit_:
         main([verb, "--help"])

@@ -6,10 +6,11 @@ import argparse
 import sys
 
 from evclust import __version__
-from evclust.cli import simulate, show, scenes
+from evclust.cli import simulate, show, scenes, score, render, plot
+from evclust.cli import track
 from evclust.errors import EvclustError
 
-VERBS = (simulate, show, scenes)
+VERBS = (simulate, track, score, show, render, plot, scenes)
 
 
 def build_parser() -> argparse.ArgumentParser:

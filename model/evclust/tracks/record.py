@@ -100,7 +100,10 @@ def read_tracks(path: str | Path) -> tuple[np.ndarray, TrackMeta]:
     path = Path(path)
     if not path.is_file():
         raise EvclustError(f"{path}: no such track file")
-    text = path.read_text()
+    try:
+        text = path.read_text()
+    except UnicodeDecodeError as exc:
+        raise EvclustError(f"{path}: not a text track file ({exc.reason} at byte {exc.start})") from None
     first, _, rest = text.partition("\n")
     if not first.startswith(MAGIC):
         raise EvclustError(f"{path}: not an evclust track file (its first line must start with '{MAGIC.strip()}')")

@@ -1,0 +1,274 @@
+"""The floating-point reference clusterer: SPEC §4, event by event, compiled.
+
+Read beside the paper: eq. (1) mean shift, written X += β(f(e) - X) with β = 1 - α; eq. (4)
+regular-interval velocity; eq. (5) mean centre motion; eqs. (10)-(11) colour with background
+correction; §7.2.2 palette histogram; §6.3 velocity noise filter and exit prediction.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+from evclust.clusterer.layout import (
+    ACT, BG_CB, BG_CR, BG_Y, CCB, CCR, CREATED, CY, DROPPED, EVENTS, EVER_REPORTED, EVICTED, EXITED,
+    EXPIRED, FLAG_BORDER, FLAG_MOVING_INT, FLAG_MOVING_MCM, FLAG_NEW, GAMMA, ID, NEXT_ID, NOISE, PPX, PPY, PX,
+    PY, RECORD_COLUMNS, REPORTED, RX, RY, SINCE_FILTER, STEP, T_FILTER, T_LAST, VALID, VIX, VIY, VMX,
+    VMY,
+)  # fmt: skip
+
+# The parameter vector the compiled loop reads (built by `param_vector`).
+(
+    K_SEEK, K_R_INIT, K_R_MIN, K_R_MAX, K_GAIN, B_POS, B_SIZE, K_T_HALF, K_A_MIN, K_A_VALID, K_EVERY,
+    B_VM, K_GAMMA, K_GAMMA_ACTIVITY, B_VI, K_TAU, K_T_FRAME, B_LUM, B_CHRO, B_BG, K_P, K_BG_FIXED,
+    K_LUMA_W, K_H_MAX, K_V_MIN, K_EXIT_M, K_V_EXIT, K_COS_EXIT, K_WIDTH, K_HEIGHT, K_COLOUR,
+) = range(31)  # fmt: skip
+N_PARAMS = 31
+LN2 = math.log(2.0)
+
+
+def param_vector(p, width: int, height: int, t_frame_us: float, has_colour: bool) -> np.ndarray:
+    v = np.zeros(N_PARAMS)
+    v[K_SEEK], v[K_R_INIT], v[K_R_MIN], v[K_R_MAX], v[K_GAIN] = p.seek_margin, p.r_init, p.r_min, p.r_max, p.size_gain
+    v[B_POS], v[B_SIZE] = 1 - p.alpha_pos, 1 - p.alpha_size
+    v[K_T_HALF], v[K_A_MIN], v[K_A_VALID], v[K_EVERY] = p.t_half_us, p.a_min, p.a_valid, p.filter_every
+    v[B_VM], v[K_GAMMA], v[K_GAMMA_ACTIVITY] = 1 - p.alpha_vel_mcm, p.gamma, p.gamma_mode == "activity"
+    v[B_VI], v[K_TAU], v[K_T_FRAME] = 1 - p.alpha_vel_int, p.tau_us, t_frame_us
+    v[B_LUM], v[B_CHRO], v[B_BG], v[K_P] = 1 - p.alpha_lum, 1 - p.alpha_chro, 1 - p.alpha_bg, p.p_correction
+    v[K_BG_FIXED], v[K_LUMA_W], v[K_H_MAX] = p.background is not None, p.luma_weight, (1 << p.hist_bits) - 1
+    v[K_V_MIN], v[K_EXIT_M], v[K_V_EXIT] = p.v_min, p.exit_margin, p.v_exit
+    v[K_COS_EXIT] = math.cos(math.radians(p.theta_exit_deg))
+    v[K_WIDTH], v[K_HEIGHT], v[K_COLOUR] = width, height, has_colour
+    return v
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _decayed(activity, dt_us, t_half_us):
+    """A · 2^(-Δt / T_half)."""
+    return activity * math.exp2(-dt_us / t_half_us)
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _gamma(activity, k):
+    """γ of eq. (5): the paper's global constant, or the cluster's events per frame, A·ln2·T_frame/T_half.
+    Refreshed at filter steps only: per event, A's steps inside a burst of simultaneous events
+    would correlate with where those events pull the centre and bias the estimate."""
+    if k[K_GAMMA_ACTIVITY] != 0.0:
+        return activity * LN2 * k[K_T_FRAME] / k[K_T_HALF]
+    return k[K_GAMMA]
+
+
+@numba.njit(cache=True, nogil=True)
+def _nearest_palette(y, cb, cr, palette, luma_w):
+    """§7.2.2: the palette entry nearest to a colour, L1 with the luminance weighted."""
+    best, best_d = 0, np.inf
+    for k in range(palette.shape[0]):
+        d = luma_w * abs(y - palette[k, 0]) + abs(cb - palette[k, 1]) + abs(cr - palette[k, 2])
+        if d < best_d:
+            best, best_d = k, d
+    return best
+
+
+@numba.njit(cache=True, nogil=True)
+def _seek(S, x, y, seek):
+    """Step 1: the valid cluster whose box grown by S holds the event, nearest in L1; ties: lower slot."""
+    best, best_d = -1, np.inf
+    for s in range(S.shape[0]):
+        if S[s, VALID] == 0.0:
+            continue
+        dx = abs(x - S[s, PX])
+        dy = abs(y - S[s, PY])
+        if dx <= S[s, RX] + seek and dy <= S[s, RY] + seek:
+            d = dx + dy
+            if d < best_d:
+                best, best_d = s, d
+    return best
+
+
+@numba.njit(cache=True, nogil=True)
+def _slot_for_new(S, G, t, k):
+    """Step 2: a free slot; if none, the least active slot if its activity is below A_valid."""
+    for s in range(S.shape[0]):
+        if S[s, VALID] == 0.0:
+            return s
+    weakest, weakest_a = -1, np.inf
+    for s in range(S.shape[0]):
+        a = _decayed(S[s, ACT], t - S[s, T_LAST], k[K_T_HALF])
+        if a < weakest_a:
+            weakest, weakest_a = s, a
+    if weakest_a < k[K_A_VALID]:
+        G[EVICTED] += 1
+        return weakest
+    return -1
+
+
+@numba.njit(cache=True, nogil=True)
+def _create(S, H, G, s, t, x, y, lum, cb, cr, k):
+    S[s, :] = 0.0
+    S[s, VALID] = 1.0
+    S[s, ID] = G[NEXT_ID]
+    G[NEXT_ID] += 1
+    S[s, PX], S[s, PY] = x, y
+    S[s, PPX], S[s, PPY] = x, y
+    S[s, RX], S[s, RY] = k[K_R_INIT], k[K_R_INIT]
+    S[s, ACT] = 1.0
+    S[s, GAMMA] = _gamma(1.0, k)
+    S[s, T_LAST] = t
+    S[s, CY], S[s, CCB], S[s, CCR] = lum, cb, cr
+    H[s, :] = 0
+    G[CREATED] += 1
+
+
+@numba.njit(cache=True, nogil=True)
+def _update(S, H, s, t, x, y, lum, cb, cr, k, palette):
+    """Step 3: mean-shift update of the chosen cluster."""
+    a = _decayed(S[s, ACT], t - S[s, T_LAST], k[K_T_HALF]) + 1.0
+    S[s, ACT] = a
+    px, py = S[s, PX], S[s, PY]
+    # Eq. (1) on the centre: P_new = P + β_P (e - P).
+    px_new = px + k[B_POS] * (x - px)
+    py_new = py + k[B_POS] * (y - py)
+    # Size: R += β_R (g_R |e - P| - R), clamped.
+    rx = S[s, RX] + k[B_SIZE] * (k[K_GAIN] * abs(x - px) - S[s, RX])
+    ry = S[s, RY] + k[B_SIZE] * (k[K_GAIN] * abs(y - py) - S[s, RY])
+    S[s, RX] = min(max(rx, k[K_R_MIN]), k[K_R_MAX])
+    S[s, RY] = min(max(ry, k[K_R_MIN]), k[K_R_MAX])
+    # Eq. (5), MCM: V += β_vm (γ (P_new - P) - V).
+    gamma = S[s, GAMMA]
+    S[s, VMX] += k[B_VM] * (gamma * (px_new - px) - S[s, VMX])
+    S[s, VMY] += k[B_VM] * (gamma * (py_new - py) - S[s, VMY])
+    S[s, PX], S[s, PY] = px_new, py_new
+    if k[K_COLOUR] != 0.0:
+        # Eq. (10): colour mean shift, luminance and chrominance with their own β.
+        S[s, CY] += k[B_LUM] * (lum - S[s, CY])
+        S[s, CCB] += k[B_CHRO] * (cb - S[s, CCB])
+        S[s, CCR] += k[B_CHRO] * (cr - S[s, CCR])
+        # §7.2.2: count the event's palette class; halve all counters when one saturates.
+        c = _nearest_palette(lum, cb, cr, palette, k[K_LUMA_W])
+        H[s, c] += 1
+        if H[s, c] >= k[K_H_MAX]:
+            for j in range(H.shape[1]):
+                H[s, j] >>= 1
+    S[s, T_LAST] = t
+
+
+@numba.njit(cache=True, nogil=True)
+def _exiting(S, s, k):
+    """§6.3, Fig. 8: near a border, fast enough, heading out within θ_exit of the border normal."""
+    px, py, vx, vy = S[s, PX], S[s, PY], S[s, VMX], S[s, VMY]
+    speed = math.hypot(vx, vy)
+    if speed < k[K_V_EXIT] or speed == 0.0:
+        return False
+    m = k[K_EXIT_M]
+    limit = speed * k[K_COS_EXIT]
+    # Outward normals: left (-1, 0), right (1, 0), top (0, -1), bottom (0, 1); y grows downwards.
+    return (
+        (px < m and -vx >= limit)
+        or (px > k[K_WIDTH] - 1.0 - m and vx >= limit)
+        or (py < m and -vy >= limit)
+        or (py > k[K_HEIGHT] - 1.0 - m and vy >= limit)
+    )
+
+
+@numba.njit(cache=True, nogil=True)
+def _filter_step(S, H, G, t, k, palette, background_mask, out, n_out):
+    """Every N_f events: decay, free, interval velocity, noise and exit decisions, records."""
+    interval_due = math.floor(t / k[K_TAU]) > math.floor(G[T_FILTER] / k[K_TAU])
+    v_min = k[K_V_MIN]
+    m = k[K_EXIT_M]
+    for s in range(S.shape[0]):
+        if S[s, VALID] == 0.0:
+            continue
+        S[s, ACT] = _decayed(S[s, ACT], t - S[s, T_LAST], k[K_T_HALF])
+        S[s, T_LAST] = t
+        if S[s, ACT] < k[K_A_MIN]:
+            S[s, VALID] = 0.0
+            G[EXPIRED] += 1
+            continue
+        S[s, GAMMA] = _gamma(S[s, ACT], k)
+        if interval_due:
+            # Eq. (4): V_RI += β_vi ((P - P_prev) · T_frame / τ - V_RI); P_prev = P.
+            scale = k[K_T_FRAME] / k[K_TAU]
+            S[s, VIX] += k[B_VI] * ((S[s, PX] - S[s, PPX]) * scale - S[s, VIX])
+            S[s, VIY] += k[B_VI] * ((S[s, PY] - S[s, PPY]) * scale - S[s, VIY])
+            S[s, PPX], S[s, PPY] = S[s, PX], S[s, PY]
+        if _exiting(S, s, k):
+            S[s, VALID] = 0.0
+            G[EXITED] += 1
+            continue
+        moving_mcm = math.hypot(S[s, VMX], S[s, VMY]) >= v_min
+        moving_int = math.hypot(S[s, VIX], S[s, VIY]) >= v_min
+        reported = S[s, ACT] >= k[K_A_VALID] and (moving_mcm or moving_int)
+        if S[s, ACT] >= k[K_A_VALID] and not reported:
+            G[NOISE] += 1
+        S[s, REPORTED] = 1.0 if reported else 0.0
+        if not reported:
+            continue
+        row = out[n_out]
+        row[0], row[1], row[2], row[3] = t, G[STEP], s, S[s, ID]
+        row[4], row[5], row[6], row[7], row[8] = S[s, PX], S[s, PY], S[s, RX], S[s, RY], S[s, ACT]
+        row[9], row[10], row[11], row[12] = S[s, VMX], S[s, VMY], S[s, VIX], S[s, VIY]
+        cls = -1
+        row[13], row[14], row[15] = 0.0, 0.0, 0.0  # no colour without TFS data
+        if k[K_COLOUR] != 0.0:
+            # Eq. (11): C_obj = (C - BG) / p + BG, clamped to the byte range.
+            row[13] = min(max((S[s, CY] - G[BG_Y]) / k[K_P] + G[BG_Y], 0.0), 255.0)
+            row[14] = min(max((S[s, CCB] - G[BG_CB]) / k[K_P] + G[BG_CB], 0.0), 255.0)
+            row[15] = min(max((S[s, CCR] - G[BG_CR]) / k[K_P] + G[BG_CR], 0.0), 255.0)
+            best = 0
+            for j in range(H.shape[1]):
+                if not background_mask[j] and H[s, j] > best:
+                    best, cls = H[s, j], j
+        row[16] = cls
+        flags = 0
+        if S[s, EVER_REPORTED] == 0.0:
+            flags |= FLAG_NEW
+        if S[s, PX] < m or S[s, PX] > k[K_WIDTH] - 1 - m or S[s, PY] < m or S[s, PY] > k[K_HEIGHT] - 1 - m:
+            flags |= FLAG_BORDER
+        if moving_mcm:
+            flags |= FLAG_MOVING_MCM
+        if moving_int:
+            flags |= FLAG_MOVING_INT
+        row[17] = flags
+        S[s, EVER_REPORTED] = 1.0
+        n_out += 1
+    G[STEP] += 1
+    G[T_FILTER] = t
+    return n_out
+
+
+@numba.njit(cache=True, nogil=True)
+def run_events(S, H, G, k, palette, background_mask, t_us, xs, ys, lums, cbs, crs, out):
+    """Feed events through the table; write track records into `out`; return how many."""
+    n_out = 0
+    every = int(k[K_EVERY])
+    for i in range(t_us.size):
+        t = float(t_us[i])
+        x, y = float(xs[i]), float(ys[i])
+        lum, cb, cr = float(lums[i]), float(cbs[i]), float(crs[i])
+        if G[EVENTS] == 0:
+            G[T_FILTER] = t  # the filter-step clock starts at the first event
+        G[EVENTS] += 1
+        s = _seek(S, x, y, k[K_SEEK])
+        updated_reported = False
+        if s < 0:
+            s = _slot_for_new(S, G, t, k)
+            if s >= 0:
+                _create(S, H, G, s, t, x, y, lum, cb, cr, k)
+            else:
+                G[DROPPED] += 1
+        else:
+            _update(S, H, s, t, x, y, lum, cb, cr, k, palette)
+            updated_reported = S[s, REPORTED] != 0.0
+        # Step 4: events that do not update a reported cluster track the background colour.
+        if k[K_COLOUR] != 0.0 and k[K_BG_FIXED] == 0.0 and not updated_reported:
+            G[BG_Y] += k[B_BG] * (lum - G[BG_Y])
+            G[BG_CB] += k[B_BG] * (cb - G[BG_CB])
+            G[BG_CR] += k[B_BG] * (cr - G[BG_CR])
+        G[SINCE_FILTER] += 1
+        if G[SINCE_FILTER] >= every:
+            G[SINCE_FILTER] = 0
+            n_out = _filter_step(S, H, G, t, k, palette, background_mask, out, n_out)
+    return n_out

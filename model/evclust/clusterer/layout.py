@@ -1,0 +1,28 @@
+"""The cluster-state layout shared by the float and fixed models (and the RTL's table).
+
+One row per slot, one column per field; the float model stores float64, the fixed model integers
+in their formats. The palette histogram H[K] is a separate (N, K) array. Globals (counters, the
+background colour, the filter-step clock) are one small vector.
+"""
+
+from __future__ import annotations
+
+# Slot columns.
+VALID, ID, PX, PY, RX, RY, ACT, T_LAST, VMX, VMY, VIX, VIY, PPX, PPY, CY, CCB, CCR, REPORTED, EVER_REPORTED, GAMMA = range(20)
+SLOT_COLUMNS = (
+    "valid", "id", "px", "py", "rx", "ry", "activity", "t_last", "vmx", "vmy", "vix", "viy",
+    "p_prev_x", "p_prev_y", "Y", "Cb", "Cr", "reported", "ever_reported", "gamma",
+)  # fmt: skip
+
+# Global columns.
+NEXT_ID, BG_Y, BG_CB, BG_CR, SINCE_FILTER, STEP, T_FILTER, EVENTS, CREATED, EVICTED, DROPPED, EXPIRED, EXITED, NOISE = range(14)
+GLOBAL_COLUMNS = (
+    "next_id", "bg_Y", "bg_Cb", "bg_Cr", "since_filter", "step", "t_filter", "events",
+    "created", "evicted", "dropped", "expired", "exited", "noise",
+)  # fmt: skip
+
+# Track-record columns as the models write them (the order of evclust.tracks.TRACK_DTYPE).
+RECORD_COLUMNS = 18
+
+# Flags of a record (evclust.tracks.TrackFlags).
+FLAG_NEW, FLAG_BORDER, FLAG_MOVING_MCM, FLAG_MOVING_INT = 1, 2, 4, 8

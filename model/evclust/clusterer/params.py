@@ -1,0 +1,153 @@
+"""The clusterer's parameters: one `[clusterer]` TOML table, the same names in float, fixed and RTL.
+
+Units: px for positions and sizes, µs for times, px/frame for velocities, 0..255 for colours.
+Every α is the mean-shift memory of eq. (1); the hardware form uses β = 1 - α.
+"""
+
+from __future__ import annotations
+
+import tomllib
+from importlib import resources
+from pathlib import Path
+from typing import Annotated, Literal
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+
+from evclust.colour import rgb_to_ycbcr
+from evclust.errors import EvclustError
+
+Alpha = Annotated[float, Field(ge=0.0, lt=1.0)]
+Positive = Annotated[float, Field(gt=0.0)]
+NonNegative = Annotated[float, Field(ge=0.0)]
+Byte = Annotated[float, Field(ge=0.0, le=255.0)]
+
+
+class PaletteEntry(BaseModel):
+    """A colour class: a name (matched against ground-truth labels) and its RGB colour."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+    name: Annotated[str, Field(min_length=1)]
+    rgb: tuple[Byte, Byte, Byte]
+
+
+DEFAULT_PALETTE = (
+    PaletteEntry(name="black", rgb=(30, 30, 30)),
+    PaletteEntry(name="grey", rgb=(128, 128, 128)),
+    PaletteEntry(name="white", rgb=(235, 235, 235)),
+    PaletteEntry(name="red", rgb=(200, 30, 30)),
+    PaletteEntry(name="green", rgb=(40, 170, 60)),
+    PaletteEntry(name="blue", rgb=(30, 60, 180)),
+    PaletteEntry(name="yellow", rgb=(230, 200, 40)),
+)
+
+
+class ClustererParams(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    # The cluster table and the seek region (§5.2).
+    n_clusters: Annotated[int, Field(ge=1, le=1024)] = 16  # N slots
+    seek_margin: NonNegative = 12.0  # S, px: a cluster catches events within its box grown by S
+    r_init: Positive = 10.0  # half-size of a new cluster, px
+    r_min: Positive = 2.0  # half-size clamp, px
+    r_max: Positive = 80.0
+    size_gain: Positive = 1.5  # g_R: R tracks g_R · |e - P|
+    alpha_pos: Alpha = 0.98  # centre
+    alpha_size: Alpha = 0.99  # half-size
+    # Activity: an event count decaying with half-life T_half.
+    t_half_us: Positive = 20000.0
+    a_min: NonNegative = 1.0  # below: the slot is freed at a filter step
+    a_valid: NonNegative = 20.0  # at or above (and not noise): the cluster is reported
+    filter_every: Annotated[int, Field(ge=1, le=1 << 20)] = 64  # N_f events between filter steps
+    # Velocity (§6.2): mean centre motion, every event, and regular interval, every τ.
+    alpha_vel_mcm: Alpha = 0.9999  # close to 1, as in the paper: one event says little about motion
+    gamma: Positive = 60.0  # events per frame, the paper's global scale factor of eq. (5)
+    gamma_mode: Literal["global", "activity"] = "activity"  # activity: γ_i = A_i·ln2·T_frame/T_half
+    alpha_vel_int: Alpha = 0.7
+    tau_us: Positive = 100000.0
+    t_frame_us: Positive | None = None  # frame period; default: the event file's
+    # Colour (§7.2).
+    alpha_lum: Alpha = 0.99
+    alpha_chro: Alpha = 0.99
+    alpha_bg: Alpha = 0.999
+    p_correction: Annotated[float, Field(gt=0.0, le=1.0)] = 1.0  # p of eq. (11)
+    background: tuple[Byte, Byte, Byte] | None = None  # fixed background YCbCr; default: estimated
+    palette: Annotated[tuple[PaletteEntry, ...], Field(min_length=1, max_length=64)] = DEFAULT_PALETTE
+    palette_background: tuple[str, ...] = ()  # palette names that are background, never a class
+    luma_weight: NonNegative = 1.0  # palette distance: w_Y·|ΔY| + |ΔCb| + |ΔCr|
+    hist_bits: Annotated[int, Field(ge=2, le=16)] = 8  # saturating histogram counters
+    # Decisions from velocity (§6.3).
+    v_min: NonNegative = 0.3  # px/frame: a cluster whose MCM and interval speeds are both below is noise
+    exit_margin: NonNegative = 10.0  # M, px: the border band where exit prediction acts
+    v_exit: NonNegative = 1.0  # px/frame: minimum speed to predict an exit
+    theta_exit_deg: Annotated[float, Field(gt=0.0, le=90.0)] = 45.0  # max angle to the border normal
+
+    @model_validator(mode="after")
+    def _consistent(self):
+        if not self.r_min <= self.r_init <= self.r_max:
+            raise ValueError(f"need r_min <= r_init <= r_max, got {self.r_min}, {self.r_init}, {self.r_max}")
+        names = [e.name for e in self.palette]
+        if len(set(names)) != len(names):
+            raise ValueError("palette names must be unique")
+        unknown = [n for n in self.palette_background if n not in names]
+        if unknown:
+            raise ValueError(f"palette_background names {', '.join(unknown)} are not in the palette")
+        if len(self.palette_background) == len(names):
+            raise ValueError("every palette entry is background: no class is left")
+        return self
+
+    @property
+    def palette_names(self) -> tuple[str, ...]:
+        return tuple(e.name for e in self.palette)
+
+    def palette_ycbcr(self) -> np.ndarray:
+        """(K, 3) float64 YCbCr of the palette entries (BT.601 full range)."""
+        return rgb_to_ycbcr(np.array([e.rgb for e in self.palette], dtype=np.float64))
+
+    def background_mask(self) -> np.ndarray:
+        return np.array([e.name in self.palette_background for e in self.palette], dtype=np.bool_)
+
+
+def _message(exc: ValidationError) -> str:
+    err = exc.errors()[0]
+    where = ".".join(str(p) for p in err["loc"])
+    more = f" (and {exc.error_count() - 1} more)" if exc.error_count() > 1 else ""
+    return f"clusterer.{where}: {err['msg']}{more}" if where else f"clusterer: {err['msg']}{more}"
+
+
+def parse_params(text: str, name: str) -> ClustererParams:
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise EvclustError(f"{name}: malformed TOML: {exc}") from None
+    unknown = sorted(set(data) - {"clusterer"})
+    if unknown:
+        raise EvclustError(f"{name}: unknown table or key '{unknown[0]}' (parameters go in a [clusterer] table)")
+    try:
+        return ClustererParams.model_validate(data.get("clusterer", {}))
+    except ValidationError as exc:
+        raise EvclustError(f"{name}: {_message(exc)}") from None
+
+
+def preset_names() -> list[str]:
+    folder = resources.files("evclust.clusterer") / "presets"
+    return sorted(p.name[: -len(".toml")] for p in folder.iterdir() if p.name.endswith(".toml"))
+
+
+def load_params(ref: str | Path | None, source: str = "") -> tuple[ClustererParams, str]:
+    """A TOML file, a preset name, or None: the preset of the events' source scene if there is
+    one, else the defaults. Returns the parameters and where they came from."""
+    if ref is None:
+        if source in preset_names():
+            ref = source
+        else:
+            return ClustererParams(), "defaults"
+    path = Path(str(ref))
+    if path.suffix.lower() == ".toml":
+        if not path.is_file():
+            raise EvclustError(f"{path}: no such parameter file")
+        return parse_params(path.read_text(), str(path)), str(path)
+    if str(ref) in preset_names():
+        text = (resources.files("evclust.clusterer") / "presets" / f"{ref}.toml").read_text()
+        return parse_params(text, f"preset '{ref}'"), f"preset '{ref}'"
+    raise EvclustError(f"unknown parameter set '{ref}': give a .toml file or a preset ({', '.join(preset_names())})")

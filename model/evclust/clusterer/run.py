@@ -1,0 +1,120 @@
+"""Driving a clusterer model over an event stream: chunks, progress, records, statistics."""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+
+import numpy as np
+from tqdm import tqdm
+
+from evclust.clusterer import float_model
+from evclust.clusterer.layout import (
+    BG_CB, BG_CR, BG_Y, CREATED, DROPPED, EVENTS, EVICTED, EXITED, EXPIRED, GLOBAL_COLUMNS, NOISE,
+    RECORD_COLUMNS, SLOT_COLUMNS, STEP,
+)  # fmt: skip
+from evclust.clusterer.params import ClustererParams
+from evclust.errors import EvclustError
+from evclust.events import EventMeta
+from evclust.tracks import TRACK_DTYPE, TrackMeta
+
+CHUNK = 1 << 18  # events per compiled call: the progress bar's granularity
+
+
+@dataclasses.dataclass
+class TrackRun:
+    tracks: np.ndarray
+    meta: TrackMeta
+    stats: dict
+    wall_s: float
+
+    def summary(self) -> str:
+        s = self.stats
+        rate = s["events"] / self.wall_s if self.wall_s > 0 else float("inf")
+        return (
+            f"{s['events']} events, {s['steps']} filter steps, {len(self.tracks)} track records, "
+            f"{s['created']} clusters created ({s['evicted']} by eviction), {s['dropped']} events dropped, "
+            f"wall time {self.wall_s:.2f} s, {rate / 1e6:.2f} Mevents/s"
+        )
+
+
+class FloatClusterer:
+    """The float64 reference model: state in the shared layout, the loop compiled."""
+
+    model = "float"
+
+    def __init__(self, params: ClustererParams, width: int, height: int, t_frame_us: float, has_colour: bool = True):
+        self.params = params
+        self.k = float_model.param_vector(params, width, height, t_frame_us, has_colour)
+        self.palette = params.palette_ycbcr()
+        self.background_mask = params.background_mask()
+        self.slots = np.zeros((params.n_clusters, len(SLOT_COLUMNS)))
+        self.hist = np.zeros((params.n_clusters, len(params.palette)), dtype=np.int64)
+        self.globals = np.zeros(len(GLOBAL_COLUMNS))
+        bg = params.background if params.background is not None else (128.0, 128.0, 128.0)
+        self.globals[[BG_Y, BG_CB, BG_CR]] = bg
+
+    def feed(self, events: np.ndarray) -> np.ndarray:
+        """Process events; return the (n, RECORD_COLUMNS) float64 records of the filter steps they completed."""
+        every = self.params.filter_every
+        out = np.empty(((events.size // every + 1) * self.params.n_clusters, RECORD_COLUMNS))
+        n = float_model.run_events(
+            self.slots, self.hist, self.globals, self.k, self.palette, self.background_mask,
+            events["t"], events["x"], events["y"], events["Y"], events["Cb"], events["Cr"], out,
+        )  # fmt: skip
+        return out[:n]
+
+    def stats(self) -> dict:
+        g = self.globals
+        return {
+            "events": int(g[EVENTS]), "steps": int(g[STEP]), "created": int(g[CREATED]), "evicted": int(g[EVICTED]),
+            "dropped": int(g[DROPPED]), "expired": int(g[EXPIRED]), "exited": int(g[EXITED]), "noise_decisions": int(g[NOISE]),
+        }  # fmt: skip
+
+
+MODELS = {"float": FloatClusterer}
+
+
+def records_to_tracks(rows: np.ndarray) -> np.ndarray:
+    tracks = np.zeros(len(rows), TRACK_DTYPE)
+    for j, name in enumerate(TRACK_DTYPE.names):
+        column = rows[:, j]
+        tracks[name] = np.rint(column) if np.issubdtype(TRACK_DTYPE[name], np.integer) else column
+    return tracks
+
+
+def track_events(
+    events: np.ndarray, meta: EventMeta, params: ClustererParams, model: str = "float", progress: bool = False
+) -> TrackRun:
+    """Run a clusterer model over a whole stream."""
+    if model not in MODELS:
+        raise EvclustError(f"unknown model '{model}' (available: {', '.join(MODELS)})")
+    t_frame_us = params.t_frame_us or meta.t_frame_us
+    if not t_frame_us:
+        raise EvclustError(f"{meta.source or 'events'}: no frame period: set clusterer.t_frame_us (velocities are in px/frame)")
+    has_colour = bool(meta.has_colour)
+    clusterer = MODELS[model](params, meta.width, meta.height, float(t_frame_us), has_colour)
+    start = time.perf_counter()
+    pieces = []
+    with tqdm(total=events.size, unit="ev", unit_scale=True, disable=None if progress else True, desc=f"track ({model})") as bar:
+        for lo in range(0, events.size, CHUNK):
+            chunk = events[lo : lo + CHUNK]
+            pieces.append(clusterer.feed(chunk))
+            bar.update(chunk.size)
+    wall = time.perf_counter() - start
+    rows = np.concatenate(pieces) if pieces else np.zeros((0, RECORD_COLUMNS))
+    track_meta = TrackMeta(
+        width=meta.width,
+        height=meta.height,
+        t_frame_us=float(t_frame_us),
+        source=meta.source,
+        model=model,
+        palette=params.palette_names,
+        palette_ycbcr=tuple(tuple(float(c) for c in e) for e in params.palette_ycbcr()),
+        palette_background=tuple(params.palette_background),
+        luma_weight=params.luma_weight,
+        seek_margin=params.seek_margin,
+        exit_margin=params.exit_margin,
+        has_colour=has_colour,
+    )
+    return TrackRun(records_to_tracks(rows), track_meta, clusterer.stats(), wall)

@@ -1,0 +1,250 @@
+"""Match track records to ground-truth objects at each filter step (docs/METRICS.md).
+
+At each filter step (each distinct `(step, t_us)` of the track file):
+- the objects present are the ground-truth rows of frame `k = floor(t_us / t_frame_us)`;
+- an object's centre is interpolated linearly in time between its rows of frames k and k+1
+  (frame k's centre alone when the object has no row in frame k+1);
+- its velocity, colour, label and visibility are frame k's (the forward convention of
+  docs/DESIGN.md: frame k's velocity is the motion from k to k+1);
+- the step's track records and those objects are paired by the Hungarian algorithm
+  (scipy.optimize.linear_sum_assignment) on the Euclidean centre distance, pairs farther apart
+  than the gate being forbidden; a pair is kept when its distance is <= gate_px.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+from scipy.optimize import linear_sum_assignment
+
+from evclust.errors import EvclustError
+from evclust.scenes.truth import LABEL_CHARS, truth_array
+from evclust.tracks import TRACK_FIELDS, TrackMeta
+
+DEFAULT_GATE_PX = 30.0
+
+MATCH_DTYPE = np.dtype(
+    [
+        ("step", np.uint32),  # filter step index
+        ("t_us", np.uint64),  # time of the filter step
+        ("frame", np.int64),  # ground-truth frame k = floor(t_us / t_frame_us)
+        ("gt_id", np.int64),  # ground-truth object id
+        ("track_id", np.uint32),  # the track record's cluster id
+        ("slot", np.uint16),  # the track record's slot
+        ("x", np.float64),  # estimated centre, px
+        ("y", np.float64),
+        ("gt_x", np.float64),  # true centre at t_us (interpolated), px
+        ("gt_y", np.float64),
+        ("vx_mcm", np.float64),  # estimated velocities, px/frame
+        ("vy_mcm", np.float64),
+        ("vx_int", np.float64),
+        ("vy_int", np.float64),
+        ("gt_vx", np.float64),  # true velocity of frame k, px/frame
+        ("gt_vy", np.float64),
+        ("Y", np.float64),  # estimated object colour
+        ("Cb", np.float64),
+        ("Cr", np.float64),
+        ("gt_Y", np.float64),  # true object colour of frame k
+        ("gt_Cb", np.float64),
+        ("gt_Cr", np.float64),
+        ("class_palette", np.int32),  # the record's class field: palette index, -1 none
+        ("class_direct", np.int32),  # nearest non-background palette entry to (Y, Cb, Cr); -1 none
+        ("gt_label", f"U{LABEL_CHARS}"),
+        ("fully_visible", np.bool_),  # frame k's fully_visible
+    ]
+)
+
+
+@dataclasses.dataclass(frozen=True)
+class MatchCounts:
+    """What the matches alone cannot tell: the sizes of the populations they were drawn from."""
+
+    n_steps: int  # distinct (step, t_us) in the tracks
+    n_steps_missing: int  # step numbers 0..max absent from the tracks (no reported cluster then)
+    n_track_records: int  # track records that count for precision
+    n_gt_evaluations: int  # (filter step, object present) pairs that count for recall
+    n_excluded_records: int  # records matched to an object left out by fully_visible_only
+
+
+def _check_inputs(tracks, meta: TrackMeta, gate_px: float) -> np.ndarray:
+    if not isinstance(meta, TrackMeta):
+        raise EvclustError(f"track metadata must be a TrackMeta, not {type(meta).__name__}")
+    t_frame = float(meta.t_frame_us)
+    if not (math.isfinite(t_frame) and t_frame > 0):
+        raise EvclustError(f"track metadata: t_frame_us must be a positive number, not {meta.t_frame_us}")
+    gate = float(gate_px)
+    if not (math.isfinite(gate) and gate > 0):
+        raise EvclustError(f"gate must be a positive number of pixels, not {gate_px}")
+    tracks = np.asarray(tracks)
+    names = tracks.dtype.names or ()
+    missing = [name for name in TRACK_FIELDS if name not in names]
+    if missing:
+        raise EvclustError(f"tracks: missing field(s) {', '.join(missing)}")
+    if len(meta.palette_ycbcr) and len(meta.palette_ycbcr) != len(meta.palette):
+        raise EvclustError(
+            f"track metadata: palette has {len(meta.palette)} names but {len(meta.palette_ycbcr)} colours"
+        )
+    return tracks.reshape(-1)
+
+
+def nearest_palette_class(ycbcr: np.ndarray, meta: TrackMeta) -> np.ndarray:
+    """Index of the nearest non-background palette entry to each (Y, Cb, Cr) row, under the
+    L1 distance luma_weight·|ΔY| + |ΔCb| + |ΔCr|; ties go to the lower index; -1 when the track
+    file has no colour or no non-background entry."""
+    ycbcr = np.asarray(ycbcr, dtype=np.float64).reshape(-1, 3)
+    out = np.full(len(ycbcr), -1, dtype=np.int32)
+    if not meta.has_colour or not meta.palette_ycbcr or len(ycbcr) == 0:
+        return out
+    background = set(meta.palette_background)
+    usable = np.array([i for i, name in enumerate(meta.palette) if name not in background], dtype=np.int64)
+    if usable.size == 0:
+        return out
+    entries = np.asarray(meta.palette_ycbcr, dtype=np.float64)[usable]  # (K, 3)
+    weights = np.array([float(meta.luma_weight), 1.0, 1.0])
+    distance = (np.abs(ycbcr[:, None, :] - entries[None, :, :]) * weights).sum(axis=2)  # (N, K)
+    out[:] = usable[np.argmin(distance, axis=1)]  # argmin returns the first minimum: lower index
+    return out
+
+
+def _assign(cost: np.ndarray, gate: float) -> tuple[np.ndarray, np.ndarray]:
+    """Hungarian assignment with pairs beyond the gate forbidden.
+
+    Out-of-gate pairs get a cost larger than any sum of in-gate costs, so the solver first
+    maximises the number of in-gate pairs and then minimises their total distance; the
+    out-of-gate pairs it is still forced to make are dropped. (Solving on the raw distances
+    and dropping afterwards can trade a close pair for two pairs one of which is then dropped.)
+    """
+    allowed = cost <= gate
+    if not allowed.any():
+        return np.empty(0, np.int64), np.empty(0, np.int64)
+    big = gate * (min(cost.shape) + 1) + 1.0
+    rows, cols = linear_sum_assignment(np.where(allowed, cost, big))
+    keep = allowed[rows, cols]
+    return rows[keep], cols[keep]
+
+
+def match_with_counts(
+    tracks: np.ndarray,
+    meta: TrackMeta,
+    truth,
+    gate_px: float = DEFAULT_GATE_PX,
+    fully_visible_only: bool = False,
+) -> tuple[np.ndarray, MatchCounts]:
+    """`match` plus the counts recall and precision need."""
+    tracks = _check_inputs(tracks, meta, gate_px)
+    truth = truth_array(truth)
+    gate = float(gate_px)
+    t_frame = float(meta.t_frame_us)
+
+    # Index the ground truth by frame, and by (frame, id) for the next frame's centre.
+    by_frame: dict[int, np.ndarray] = {}
+    if truth.size:
+        order = np.argsort(truth["frame"], kind="stable")
+        frames = truth["frame"][order]
+        starts = np.flatnonzero(np.r_[True, frames[1:] != frames[:-1]])
+        for a, b in zip(starts, np.r_[starts[1:], frames.size]):
+            by_frame[int(frames[a])] = order[a:b]
+    where: dict[tuple[int, int], int] = {}
+    for i, (frame, obj) in enumerate(zip(truth["frame"].tolist(), truth["id"].tolist())):
+        if (frame, obj) in where:
+            raise EvclustError(f"ground truth: object {obj} has two rows for frame {frame}")
+        where[(frame, obj)] = i
+
+    # Group the records by filter step, in time order.
+    order = np.lexsort((tracks["step"], tracks["t_us"]))
+    t_all = tracks["t_us"][order]
+    s_all = tracks["step"][order]
+    if order.size:
+        changes = np.flatnonzero((t_all[1:] != t_all[:-1]) | (s_all[1:] != s_all[:-1])) + 1
+        bounds = np.r_[0, changes, order.size]
+    else:
+        bounds = np.zeros(1, np.int64)
+
+    rec_index: list[np.ndarray] = []  # matched track record (index into tracks)
+    gt_index: list[np.ndarray] = []  # matched truth row (frame k)
+    frame_of: list[np.ndarray] = []
+    gt_xy: list[np.ndarray] = []
+    n_gt = 0
+    n_excluded = 0
+    empty = np.empty(0, np.int64)
+    for a, b in zip(bounds[:-1], bounds[1:]):
+        records = order[a:b]
+        t = float(t_all[a])
+        k = math.floor(t / t_frame)
+        frac = t / t_frame - k
+        objs = by_frame.get(k, empty)
+        if fully_visible_only:
+            n_gt += int(truth["fully_visible"][objs].sum())
+        else:
+            n_gt += objs.size
+        if objs.size == 0:
+            continue
+        centre = np.stack([truth["cx"][objs], truth["cy"][objs]], axis=1)
+        for j, row in enumerate(objs.tolist()):
+            nxt = where.get((k + 1, int(truth["id"][row])))
+            if nxt is not None:
+                centre[j, 0] += frac * (truth["cx"][nxt] - centre[j, 0])
+                centre[j, 1] += frac * (truth["cy"][nxt] - centre[j, 1])
+        est = np.stack([tracks["x"][records], tracks["y"][records]], axis=1).astype(np.float64)
+        cost = np.hypot(est[:, None, 0] - centre[None, :, 0], est[:, None, 1] - centre[None, :, 1])
+        r, c = _assign(cost, gate)
+        if fully_visible_only:
+            visible = truth["fully_visible"][objs[c]]
+            n_excluded += int((~visible).sum())
+            r, c = r[visible], c[visible]
+        rec_index.append(records[r])
+        gt_index.append(objs[c])
+        frame_of.append(np.full(r.size, k, np.int64))
+        gt_xy.append(centre[c])
+
+    rec = np.concatenate(rec_index) if rec_index else empty
+    gti = np.concatenate(gt_index) if gt_index else empty
+    out = np.zeros(rec.size, dtype=MATCH_DTYPE)
+    out["step"] = tracks["step"][rec]
+    out["t_us"] = tracks["t_us"][rec]
+    out["frame"] = np.concatenate(frame_of) if frame_of else empty
+    out["gt_id"] = truth["id"][gti]
+    out["track_id"] = tracks["id"][rec]
+    out["slot"] = tracks["slot"][rec]
+    for name in ("x", "y", "vx_mcm", "vy_mcm", "vx_int", "vy_int", "Y", "Cb", "Cr"):
+        out[name] = tracks[name][rec]
+    if gt_xy:
+        xy = np.concatenate(gt_xy)
+        out["gt_x"], out["gt_y"] = xy[:, 0], xy[:, 1]
+    out["gt_vx"], out["gt_vy"] = truth["vx"][gti], truth["vy"][gti]
+    out["gt_Y"], out["gt_Cb"], out["gt_Cr"] = truth["Y"][gti], truth["Cb"][gti], truth["Cr"][gti]
+    out["class_palette"] = tracks["class"][rec]
+    out["class_direct"] = nearest_palette_class(np.stack([out["Y"], out["Cb"], out["Cr"]], axis=1), meta)
+    out["gt_label"] = truth["label"][gti]
+    out["fully_visible"] = truth["fully_visible"][gti]
+
+    steps = np.unique(tracks["step"]) if tracks.size else np.empty(0, np.uint32)
+    counts = MatchCounts(
+        n_steps=int(bounds.size - 1),
+        n_steps_missing=int(steps[-1]) + 1 - steps.size if steps.size else 0,
+        n_track_records=int(tracks.size) - n_excluded,
+        n_gt_evaluations=int(n_gt),
+        n_excluded_records=n_excluded,
+    )
+    return out, counts
+
+
+def match(
+    tracks: np.ndarray,
+    meta: TrackMeta,
+    truth,
+    gate_px: float = DEFAULT_GATE_PX,
+    fully_visible_only: bool = False,
+) -> np.ndarray:
+    """One MATCH_DTYPE row per matched (track record, ground-truth object) pair, in time order.
+
+    tracks: TRACK_DTYPE records (`evclust.tracks.read_tracks`); meta: their TrackMeta (gives
+    t_frame_us, the palette and luma_weight); truth: TRUTH_DTYPE rows (`read_truth`) or dicts
+    keyed by TRUTH_COLUMNS. gate_px: pairs farther apart than this are not matched.
+    fully_visible_only: drop pairs whose object is not fully inside the sensor in frame k
+    (objects are still matched against all objects present, so a cluster on a half-visible
+    object is not forced onto a fully visible one).
+    """
+    return match_with_counts(tracks, meta, truth, gate_px, fully_visible_only)[0]
