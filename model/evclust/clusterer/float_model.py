@@ -13,20 +13,23 @@ import numba
 import numpy as np
 
 from evclust.clusterer.layout import (
-    ACT, BG_CB, BG_CR, BG_Y, CCB, CCR, CREATED, CY, DROPPED, EVENTS, EVER_REPORTED, EVICTED, EXITED,
-    EXPIRED, FLAG_BORDER, FLAG_MOVING_INT, FLAG_MOVING_MCM, FLAG_NEW, GAMMA, ID, NEXT_ID, NOISE, PPX, PPY, PX,
-    PY, RECORD_COLUMNS, REPORTED, RX, RY, SINCE_FILTER, STEP, T_FILTER, T_LAST, VALID, VIX, VIY, VMX,
+    ACT, BG_CB, BG_CR, BG_Y, CCB, CCR, CREATED, CY, DROPPED, EV_COUNT, EVENTS, EVER_REPORTED, EVICTED, EXITED,
+    EXPIRED, FLAG_BORDER, FLAG_MOVING_INT, FLAG_MOVING_MCM, FLAG_NEW, GAMMA, ID, MCM_NORM, NEXT_ID, NOISE, PPX, PPY, PX,
+    PY, RECORD_COLUMNS, REPORTED, RX, RY, SINCE_FILTER, STEP, T_FILTER, T_LAST, VALID, VI_COUNT, VIX, VIY, VMX,
     VMY,
 )  # fmt: skip
 
 # The parameter vector the compiled loop reads (built by `param_vector`).
 (
     K_SEEK, K_R_INIT, K_R_MIN, K_R_MAX, K_GAIN, B_POS, B_SIZE, K_T_HALF, K_A_MIN, K_A_VALID, K_EVERY,
-    B_VM, K_GAMMA, K_GAMMA_ACTIVITY, B_VI, K_TAU, K_T_FRAME, B_LUM, B_CHRO, B_BG, K_P, K_BG_FIXED,
+    B_VM, K_GAMMA, K_GAMMA_MODE, B_VI, K_TAU, K_T_FRAME, B_LUM, B_CHRO, B_BG, K_P, K_BG_FIXED,
     K_LUMA_W, K_H_MAX, K_V_MIN, K_EXIT_M, K_V_EXIT, K_COS_EXIT, K_WIDTH, K_HEIGHT, K_COLOUR,
-) = range(31)  # fmt: skip
-N_PARAMS = 31
+    K_WARM_START, K_MCM_CORRECT,
+) = range(33)  # fmt: skip
+N_PARAMS = 33
 LN2 = math.log(2.0)
+GAMMA_MODES = ("global", "activity", "count")
+GAMMA_GLOBAL, GAMMA_ACTIVITY, GAMMA_COUNT = range(3)
 
 
 def param_vector(p, width: int, height: int, t_frame_us: float, has_colour: bool) -> np.ndarray:
@@ -34,13 +37,14 @@ def param_vector(p, width: int, height: int, t_frame_us: float, has_colour: bool
     v[K_SEEK], v[K_R_INIT], v[K_R_MIN], v[K_R_MAX], v[K_GAIN] = p.seek_margin, p.r_init, p.r_min, p.r_max, p.size_gain
     v[B_POS], v[B_SIZE] = 1 - p.alpha_pos, 1 - p.alpha_size
     v[K_T_HALF], v[K_A_MIN], v[K_A_VALID], v[K_EVERY] = p.t_half_us, p.a_min, p.a_valid, p.filter_every
-    v[B_VM], v[K_GAMMA], v[K_GAMMA_ACTIVITY] = 1 - p.alpha_vel_mcm, p.gamma, p.gamma_mode == "activity"
+    v[B_VM], v[K_GAMMA], v[K_GAMMA_MODE] = 1 - p.alpha_vel_mcm, p.gamma, GAMMA_MODES.index(p.gamma_mode)
     v[B_VI], v[K_TAU], v[K_T_FRAME] = 1 - p.alpha_vel_int, p.tau_us, t_frame_us
     v[B_LUM], v[B_CHRO], v[B_BG], v[K_P] = 1 - p.alpha_lum, 1 - p.alpha_chro, 1 - p.alpha_bg, p.p_correction
     v[K_BG_FIXED], v[K_LUMA_W], v[K_H_MAX] = p.background is not None, p.luma_weight, (1 << p.hist_bits) - 1
     v[K_V_MIN], v[K_EXIT_M], v[K_V_EXIT] = p.v_min, p.exit_margin, p.v_exit
     v[K_COS_EXIT] = math.cos(math.radians(p.theta_exit_deg))
     v[K_WIDTH], v[K_HEIGHT], v[K_COLOUR] = width, height, has_colour
+    v[K_WARM_START], v[K_MCM_CORRECT] = p.velocity_warm_start, p.mcm_bias_correction
     return v
 
 
@@ -52,12 +56,13 @@ def _decayed(activity, dt_us, t_half_us):
 
 @numba.njit(cache=True, nogil=True, inline="always")
 def _gamma(activity, k):
-    """γ of eq. (5): the paper's global constant, or the cluster's events per frame, A·ln2·T_frame/T_half.
+    """γ of eq. (5) from the activity: the paper's global constant, or the cluster's events per
+    frame, A·ln2·T_frame/T_half (also the count mode's guess until its first full interval).
     Refreshed at filter steps only: per event, A's steps inside a burst of simultaneous events
     would correlate with where those events pull the centre and bias the estimate."""
-    if k[K_GAMMA_ACTIVITY] != 0.0:
-        return activity * LN2 * k[K_T_FRAME] / k[K_T_HALF]
-    return k[K_GAMMA]
+    if k[K_GAMMA_MODE] == GAMMA_GLOBAL:
+        return k[K_GAMMA]
+    return activity * LN2 * k[K_T_FRAME] / k[K_T_HALF]
 
 
 @numba.njit(cache=True, nogil=True)
@@ -139,6 +144,8 @@ def _update(S, H, s, t, x, y, lum, cb, cr, k, palette):
     gamma = S[s, GAMMA]
     S[s, VMX] += k[B_VM] * (gamma * (px_new - px) - S[s, VMX])
     S[s, VMY] += k[B_VM] * (gamma * (py_new - py) - S[s, VMY])
+    # The same filter on a constant 1 gives 1 - α^n: the weight V has gathered since V = 0.
+    S[s, MCM_NORM] += k[B_VM] * (1.0 - S[s, MCM_NORM])
     S[s, PX], S[s, PY] = px_new, py_new
     if k[K_COLOUR] != 0.0:
         # Eq. (10): colour mean shift, luminance and chrominance with their own β.
@@ -151,13 +158,23 @@ def _update(S, H, s, t, x, y, lum, cb, cr, k, palette):
         if H[s, c] >= k[K_H_MAX]:
             for j in range(H.shape[1]):
                 H[s, j] >>= 1
+    S[s, EV_COUNT] += 1.0
     S[s, T_LAST] = t
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _mcm_velocity(S, s, k):
+    """V_MCM as reported: optionally divided by 1 - α^n, which removes the pull of V's zero start."""
+    if k[K_MCM_CORRECT] != 0.0 and S[s, MCM_NORM] > 0.0:
+        return S[s, VMX] / S[s, MCM_NORM], S[s, VMY] / S[s, MCM_NORM]
+    return S[s, VMX], S[s, VMY]
 
 
 @numba.njit(cache=True, nogil=True)
 def _exiting(S, s, k):
     """§6.3, Fig. 8: near a border, fast enough, heading out within θ_exit of the border normal."""
-    px, py, vx, vy = S[s, PX], S[s, PY], S[s, VMX], S[s, VMY]
+    px, py = S[s, PX], S[s, PY]
+    vx, vy = _mcm_velocity(S, s, k)
     speed = math.hypot(vx, vy)
     if speed < k[K_V_EXIT] or speed == 0.0:
         return False
@@ -187,18 +204,31 @@ def _filter_step(S, H, G, t, k, palette, background_mask, out, n_out):
             S[s, VALID] = 0.0
             G[EXPIRED] += 1
             continue
-        S[s, GAMMA] = _gamma(S[s, ACT], k)
+        if k[K_GAMMA_MODE] != GAMMA_COUNT or S[s, VI_COUNT] == 0.0:
+            S[s, GAMMA] = _gamma(S[s, ACT], k)
         if interval_due:
+            if k[K_GAMMA_MODE] == GAMMA_COUNT and S[s, VI_COUNT] >= 1.0:
+                S[s, GAMMA] = S[s, EV_COUNT] * k[K_T_FRAME] / k[K_TAU]  # events per frame over the last τ
+            S[s, EV_COUNT] = 0.0
             # Eq. (4): V_RI += β_vi ((P - P_prev) · T_frame / τ - V_RI); P_prev = P.
             scale = k[K_T_FRAME] / k[K_TAU]
-            S[s, VIX] += k[B_VI] * ((S[s, PX] - S[s, PPX]) * scale - S[s, VIX])
-            S[s, VIY] += k[B_VI] * ((S[s, PY] - S[s, PPY]) * scale - S[s, VIY])
+            mx = (S[s, PX] - S[s, PPX]) * scale
+            my = (S[s, PY] - S[s, PPY]) * scale
+            if k[K_WARM_START] == 0.0 or S[s, VI_COUNT] >= 2.0:
+                S[s, VIX] += k[B_VI] * (mx - S[s, VIX])
+                S[s, VIY] += k[B_VI] * (my - S[s, VIY])
+            elif S[s, VI_COUNT] == 1.0:  # the first full interval: take it as it is
+                S[s, VIX], S[s, VIY] = mx, my
+            # (VI_COUNT 0: the cluster was born inside this interval; its displacement is partial.)
+            S[s, VI_COUNT] = min(S[s, VI_COUNT] + 1.0, 2.0)
             S[s, PPX], S[s, PPY] = S[s, PX], S[s, PY]
         if _exiting(S, s, k):
             S[s, VALID] = 0.0
             G[EXITED] += 1
             continue
+        # The noise decision weighs evidence: the uncorrected V is small until many events agree.
         moving_mcm = math.hypot(S[s, VMX], S[s, VMY]) >= v_min
+        vmx, vmy = _mcm_velocity(S, s, k)
         moving_int = math.hypot(S[s, VIX], S[s, VIY]) >= v_min
         reported = S[s, ACT] >= k[K_A_VALID] and (moving_mcm or moving_int)
         if S[s, ACT] >= k[K_A_VALID] and not reported:
@@ -209,7 +239,7 @@ def _filter_step(S, H, G, t, k, palette, background_mask, out, n_out):
         row = out[n_out]
         row[0], row[1], row[2], row[3] = t, G[STEP], s, S[s, ID]
         row[4], row[5], row[6], row[7], row[8] = S[s, PX], S[s, PY], S[s, RX], S[s, RY], S[s, ACT]
-        row[9], row[10], row[11], row[12] = S[s, VMX], S[s, VMY], S[s, VIX], S[s, VIY]
+        row[9], row[10], row[11], row[12] = vmx, vmy, S[s, VIX], S[s, VIY]
         cls = -1
         row[13], row[14], row[15] = 0.0, 0.0, 0.0  # no colour without TFS data
         if k[K_COLOUR] != 0.0:

@@ -8,10 +8,14 @@ background colour, the filter-step clock) are one small vector.
 from __future__ import annotations
 
 # Slot columns.
-VALID, ID, PX, PY, RX, RY, ACT, T_LAST, VMX, VMY, VIX, VIY, PPX, PPY, CY, CCB, CCR, REPORTED, EVER_REPORTED, GAMMA = range(20)
+(
+    VALID, ID, PX, PY, RX, RY, ACT, T_LAST, VMX, VMY, VIX, VIY, PPX, PPY, CY, CCB, CCR, REPORTED,
+    EVER_REPORTED, GAMMA, VI_COUNT, MCM_NORM, EV_COUNT,
+) = range(23)  # fmt: skip
 SLOT_COLUMNS = (
     "valid", "id", "px", "py", "rx", "ry", "activity", "t_last", "vmx", "vmy", "vix", "viy",
     "p_prev_x", "p_prev_y", "Y", "Cb", "Cr", "reported", "ever_reported", "gamma",
+    "interval_updates", "mcm_norm", "events_in_interval",
 )  # fmt: skip
 
 # Global columns.

@@ -62,9 +62,16 @@ class ClustererParams(BaseModel):
     # Velocity (§6.2): mean centre motion, every event, and regular interval, every τ.
     alpha_vel_mcm: Alpha = 0.9999  # close to 1, as in the paper: one event says little about motion
     gamma: Positive = 60.0  # events per frame, the paper's global scale factor of eq. (5)
-    gamma_mode: Literal["global", "activity"] = "activity"  # activity: γ_i = A_i·ln2·T_frame/T_half
+    # global: the paper's γ. activity: γ_i = A_i·ln2·T_frame/T_half, refreshed at filter steps.
+    # count (beyond the paper): γ_i = the cluster's events in the last τ · T_frame/τ, which does not
+    # follow the bursts inside a frame (activity with a short T_half does, and biases V_MCM).
+    gamma_mode: Literal["global", "activity", "count"] = "count"
     alpha_vel_int: Alpha = 0.7
     tau_us: Positive = 100000.0
+    # Beyond the paper: both filters otherwise start at V = 0 and need ~1/β samples to forget it,
+    # often longer than an object stays in view.
+    velocity_warm_start: bool = True  # interval: skip the partial first τ, seed V_RI with the first full one
+    mcm_bias_correction: bool = True  # MCM: report V / (1 - α^n), n = events since creation
     t_frame_us: Positive | None = None  # frame period; default: the event file's
     # Colour (§7.2).
     alpha_lum: Alpha = 0.99
