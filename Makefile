@@ -6,7 +6,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 BUILD  := build
 
-.PHONY: setup demo test bench clean
+.PHONY: setup demo test bench results clean
 
 setup: $(STAMP)
 
@@ -36,6 +36,11 @@ test: $(STAMP)
 
 bench: $(STAMP)
 	$(PY) bench/simulator.py --write docs/BENCHMARKS.md
+	$(PY) bench/clusterer.py --write docs/BENCHMARKS.md
+
+# Task accuracy on the built-in scenes: docs/RESULTS.md and its figures.
+results: $(STAMP)
+	$(PY) -m evclust.report.results --write docs/RESULTS.md
 
 clean:
 	rm -rf $(BUILD) .pytest_cache

@@ -20,17 +20,11 @@ Mpixel-frames/s = W*H*frames / wall / 1e6; Mev/s = events / wall / 1e6.
 
 from __future__ import annotations
 
-import os
-
-# One core: every thread pool is set to one thread before numpy / numba / OpenCV load.
-for _var in ("NUMBA_NUM_THREADS", "OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
-    os.environ[_var] = "1"
+import common  # noqa: F401  (first: pins every thread pool to one core)
 
 import argparse
 import dataclasses
 import datetime
-import platform
-import re
 import statistics
 import sys
 import time
@@ -38,11 +32,7 @@ from pathlib import Path
 from typing import Callable
 
 import cv2
-
-cv2.setNumThreads(1)
-
-import numba  # noqa: E402
-import numpy as np  # noqa: E402
+import numpy as np
 from tqdm import tqdm  # noqa: E402
 
 from evclust.colour import RGB_TO_YCBCR  # noqa: E402
@@ -318,25 +308,6 @@ def effect_costs(name: str, load: Callable[[], Scene], frames: list[np.ndarray],
 # Report.
 
 
-def machine() -> list[str]:
-    info = Path("/proc/cpuinfo").read_text() if Path("/proc/cpuinfo").exists() else ""
-    model = re.search(r"^model name\s*:\s*(.+)$", info, re.M)
-    mhz = re.search(r"^cpu MHz\s*:\s*(.+)$", info, re.M)
-    cache = re.search(r"^cache size\s*:\s*(.+)$", info, re.M)
-    flags = re.search(r"^flags\s*:\s*(.+)$", info, re.M)
-    simd = [f for f in ("avx2", "avx512f", "fma") if flags and f in flags.group(1).split()]
-    mem = re.search(r"^MemTotal:\s*(\d+) kB", Path("/proc/meminfo").read_text(), re.M) if Path("/proc/meminfo").exists() else None
-    cpu = model.group(1).strip() if model else (platform.processor() or "unknown CPU")
-    extra = ", ".join(x for x in (f"{float(mhz.group(1)):.0f} MHz" if mhz else "", f"cache {cache.group(1)}" if cache else "", "/".join(simd)) if x)
-    load = ", ".join(f"{v:.2f}" for v in os.getloadavg())
-    return [
-        f"- CPU: {cpu} ({extra}); {os.cpu_count()} logical cores; memory {int(mem.group(1)) / 2**20:.1f} GiB" if mem else f"- CPU: {cpu}",
-        f"- OS: {platform.platform()}; load average at start {load}",
-        f"- Python {platform.python_version()}, numpy {np.__version__}, numba {numba.__version__}, OpenCV {cv2.__version__}",
-        f"- One core: NUMBA_NUM_THREADS=OMP_NUM_THREADS=OPENBLAS_NUM_THREADS=MKL_NUM_THREADS=1, cv2.setNumThreads(1); numba threads {numba.config.NUMBA_NUM_THREADS}, OpenCV threads {cv2.getNumThreads()}",
-    ]
-
-
 def rate_cells(px: float, events: int, t: Timing) -> str:
     return (f"{t.median:.3f} | {t.best:.3f} | {px / t.median / 1e6:.1f} | {px / t.best / 1e6:.1f} | "
             f"{events / t.median / 1e6:.2f} | {events / t.best / 1e6:.2f}")  # fmt: skip
@@ -392,7 +363,7 @@ def report(cases: list[Case], costs: list[EffectCost], video_note: str, repeat: 
         "",
         "Machine:",
         "",
-        *machine(),
+        *common.machine(),
         "",
         "Method: one warm-up run, then "
         f"{repeat} timed runs of each; wall time by `time.perf_counter`. Mpx-frames/s = W·H·frames / wall / 10⁶, "
@@ -470,21 +441,6 @@ def report(cases: list[Case], costs: list[EffectCost], video_note: str, repeat: 
     return "\n".join(lines) + "\n"
 
 
-def write_section(path: Path, section: str) -> None:
-    if path.exists():
-        text = path.read_text()
-        if START in text and END in text:
-            head, rest = text.split(START, 1)
-            tail = rest.split(END, 1)[1].lstrip("\n")
-            text = head + section + ("\n" + tail if tail else "")
-        else:
-            text = text.rstrip("\n") + "\n\n" + section
-    else:
-        text = "# Benchmarks\n\nMeasured by `make bench`; each section is rewritten by the script that owns it.\n\n" + section
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(text)
-
-
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--write", metavar="FILE.md", help="replace the simulator section of this Markdown file")
@@ -518,7 +474,7 @@ def main(argv: list[str] | None = None) -> int:
     text = report(cases, costs, video_note, args.repeat, effects, missing)
     print(text, end="")
     if args.write:
-        write_section(Path(args.write), text)
+        common.write_section(Path(args.write), text, START, END)
         print(f"bench: wrote {args.write}", file=sys.stderr)
     return 0
 

@@ -24,9 +24,9 @@ from evclust.clusterer.layout import (
     K_SEEK, K_R_INIT, K_R_MIN, K_R_MAX, K_GAIN, B_POS, B_SIZE, K_T_HALF, K_A_MIN, K_A_VALID, K_EVERY,
     B_VM, K_GAMMA, K_GAMMA_MODE, B_VI, K_TAU, K_T_FRAME, B_LUM, B_CHRO, B_BG, K_P, K_BG_FIXED,
     K_LUMA_W, K_H_MAX, K_V_MIN, K_EXIT_M, K_V_EXIT, K_COS_EXIT, K_WIDTH, K_HEIGHT, K_COLOUR,
-    K_WARM_START, K_MCM_CORRECT,
-) = range(33)  # fmt: skip
-N_PARAMS = 33
+    K_WARM_START, K_MCM_CORRECT, K_VOTE_CONTRAST, K_ASSIGN_MIXING, K_MIX_TOL,
+) = range(36)  # fmt: skip
+N_PARAMS = 36
 LN2 = math.log(2.0)
 GAMMA_MODES = ("global", "activity", "count")
 GAMMA_GLOBAL, GAMMA_ACTIVITY, GAMMA_COUNT = range(3)
@@ -45,6 +45,8 @@ def param_vector(p, width: int, height: int, t_frame_us: float, has_colour: bool
     v[K_COS_EXIT] = math.cos(math.radians(p.theta_exit_deg))
     v[K_WIDTH], v[K_HEIGHT], v[K_COLOUR] = width, height, has_colour
     v[K_WARM_START], v[K_MCM_CORRECT] = p.velocity_warm_start, p.mcm_bias_correction
+    v[K_VOTE_CONTRAST] = p.palette_vote == "contrast"
+    v[K_ASSIGN_MIXING], v[K_MIX_TOL] = p.palette_assign == "mixing", p.mixing_tolerance
     return v
 
 
@@ -74,6 +76,30 @@ def _nearest_palette(y, cb, cr, palette, luma_w):
         if d < best_d:
             best, best_d = k, d
     return best
+
+
+@numba.njit(cache=True, nogil=True)
+def _mixing_palette(y, cb, cr, bg_y, bg_cb, bg_cr, palette, background_mask, luma_w, tolerance):
+    """§7.2.1 + §7.2.2: the nearest entry among those whose segment from the background colour
+    passes within `tolerance` of the event (an edge event mixes background and object); the
+    plain nearest entry when no segment does."""
+    best, best_d = -1, np.inf
+    plain, plain_d = 0, np.inf
+    uy, ucb, ucr = y - bg_y, cb - bg_cb, cr - bg_cr
+    for k in range(palette.shape[0]):
+        d_end = luma_w * abs(y - palette[k, 0]) + abs(cb - palette[k, 1]) + abs(cr - palette[k, 2])
+        if d_end < plain_d:
+            plain, plain_d = k, d_end
+        if background_mask[k]:
+            d_line = d_end  # background entries stand for themselves
+        else:
+            wy, wcb, wcr = palette[k, 0] - bg_y, palette[k, 1] - bg_cb, palette[k, 2] - bg_cr
+            ww = wy * wy + wcb * wcb + wcr * wcr
+            q = 0.0 if ww == 0.0 else min(max((uy * wy + ucb * wcb + ucr * wcr) / ww, 0.0), 1.0)
+            d_line = luma_w * abs(uy - q * wy) + abs(ucb - q * wcb) + abs(ucr - q * wcr)
+        if d_line <= tolerance and d_end < best_d:
+            best, best_d = k, d_end
+    return best if best >= 0 else plain
 
 
 @numba.njit(cache=True, nogil=True)
@@ -127,7 +153,7 @@ def _create(S, H, G, s, t, x, y, lum, cb, cr, k):
 
 
 @numba.njit(cache=True, nogil=True)
-def _update(S, H, s, t, x, y, lum, cb, cr, k, palette):
+def _update(S, H, G, s, t, x, y, lum, cb, cr, k, palette, background_mask):
     """Step 3: mean-shift update of the chosen cluster."""
     a = _decayed(S[s, ACT], t - S[s, T_LAST], k[K_T_HALF]) + 1.0
     S[s, ACT] = a
@@ -153,8 +179,14 @@ def _update(S, H, s, t, x, y, lum, cb, cr, k, palette):
         S[s, CCB] += k[B_CHRO] * (cb - S[s, CCB])
         S[s, CCR] += k[B_CHRO] * (cr - S[s, CCR])
         # §7.2.2: count the event's palette class; halve all counters when one saturates.
-        c = _nearest_palette(lum, cb, cr, palette, k[K_LUMA_W])
-        H[s, c] += 1
+        if k[K_ASSIGN_MIXING] != 0.0:
+            c = _mixing_palette(lum, cb, cr, G[BG_Y], G[BG_CB], G[BG_CR], palette, background_mask, k[K_LUMA_W], k[K_MIX_TOL])
+        else:
+            c = _nearest_palette(lum, cb, cr, palette, k[K_LUMA_W])
+        vote = 1
+        if k[K_VOTE_CONTRAST] != 0.0:
+            vote = int(abs(lum - G[BG_Y]) + abs(cb - G[BG_CB]) + abs(cr - G[BG_CR]) + 0.5)
+        H[s, c] = min(H[s, c] + vote, k[K_H_MAX])
         if H[s, c] >= k[K_H_MAX]:
             for j in range(H.shape[1]):
                 H[s, j] >>= 1
@@ -290,7 +322,7 @@ def run_events(S, H, G, k, palette, background_mask, t_us, xs, ys, lums, cbs, cr
             else:
                 G[DROPPED] += 1
         else:
-            _update(S, H, s, t, x, y, lum, cb, cr, k, palette)
+            _update(S, H, G, s, t, x, y, lum, cb, cr, k, palette, background_mask)
             updated_reported = S[s, REPORTED] != 0.0
         # Step 4: events that do not update a reported cluster track the background colour.
         if k[K_COLOUR] != 0.0 and k[K_BG_FIXED] == 0.0 and not updated_reported:

@@ -82,7 +82,15 @@ class ClustererParams(BaseModel):
     palette: Annotated[tuple[PaletteEntry, ...], Field(min_length=1, max_length=64)] = DEFAULT_PALETTE
     palette_background: tuple[str, ...] = ()  # palette names that are background, never a class
     luma_weight: NonNegative = 1.0  # palette distance: w_Y·|ΔY| + |ΔCb| + |ΔCr|
-    hist_bits: Annotated[int, Field(ge=2, le=16)] = 8  # saturating histogram counters
+    hist_bits: Annotated[int, Field(ge=2, le=24)] = 16  # saturating histogram counters
+    # count: each event adds 1 (§7.2.2). contrast (beyond the paper): each event adds its L1 distance
+    # from the background colour, so edge events that are mostly background weigh little.
+    palette_vote: Literal["count", "contrast"] = "contrast"
+    # nearest: the event's class is the nearest entry (§7.2.2). mixing (beyond the paper): an edge
+    # event is a mixture q·object + (1-q)·background (§7.2.1); its class is the nearest entry among
+    # those whose background-to-entry segment passes within mixing_tolerance of it.
+    palette_assign: Literal["nearest", "mixing"] = "mixing"
+    mixing_tolerance: NonNegative = 12.0  # L1 (luma weighted) distance to a mixing segment
     # Decisions from velocity (§6.3).
     v_min: NonNegative = 0.3  # px/frame: a cluster whose MCM and interval speeds are both below is noise
     exit_margin: NonNegative = 10.0  # M, px: the border band where exit prediction acts

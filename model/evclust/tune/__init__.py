@@ -19,9 +19,9 @@ from evclust.metrics import score
 # (name, low, high, scale) of each searched parameter. α parameters are searched as β = 1 - α on a
 # log scale: what matters is the memory 1/β, which spans decades.
 SEARCH_SPACE = (
-    ("seek_margin", 2.0, 30.0, "linear"),
-    ("r_init", 3.0, 30.0, "linear"),
-    ("size_gain", 1.0, 3.0, "linear"),
+    ("seek_margin", 2.0, 60.0, "linear"),
+    ("r_init", 3.0, 40.0, "linear"),
+    ("size_gain", 1.0, 4.0, "linear"),
     ("beta_pos", 3e-4, 3e-2, "log"),
     ("beta_size", 1e-3, 5e-2, "log"),
     ("t_half_us", 5e3, 3e5, "log"),
@@ -37,7 +37,7 @@ SEARCH_SPACE = (
     ("exit_margin", 0.0, 20.0, "linear"),
     ("v_exit", 0.5, 6.0, "linear"),
 )
-CATEGORICAL = (("gamma_mode", ("global", "activity")),)
+CATEGORICAL = (("gamma_mode", ("global", "activity", "count")), ("palette_vote", ("count", "contrast")))
 
 
 def params_from_trial(values: dict, base: ClustererParams, t_frame_us: float) -> ClustererParams:
@@ -64,11 +64,12 @@ def objective_value(s) -> float:
             v = v.get(k) if isinstance(v, dict) else None
         return worst if v is None or (isinstance(v, float) and math.isnan(v)) else float(v)
 
-    velocity = min(get("mcm", "nrmse", worst=5.0), get("interval", "nrmse", worst=5.0))
-    angle = min(get("mcm", "angular_deg", worst=90.0), get("interval", "angular_deg", worst=90.0)) / 90.0
+    # Both velocity methods count: a search that may sacrifice one of them will.
+    velocity = (get("mcm", "nrmse", worst=5.0) + get("interval", "nrmse", worst=5.0)) / 2
+    angle = (get("mcm", "angular_deg", worst=90.0) + get("interval", "angular_deg", worst=90.0)) / 2 / 90.0
     position = get("position_rmse_px", worst=50.0) / 20.0
     colour = get("luminance", "nrmse", worst=1.0) + get("chrominance", "nrmse", worst=1.0)
-    classes = 1.0 - get("class_palette_accuracy", worst=0.0)
+    classes = 2.0 * (1.0 - get("class_palette_accuracy", worst=0.0))
     tracking = (1.0 - get("recall", worst=0.0)) + 0.5 * (1.0 - get("precision", worst=0.0))
     return velocity + angle + position + colour + classes + tracking
 
@@ -119,7 +120,8 @@ def trial_values(p: ClustererParams, t_frame_us: float) -> dict:
         else:
             v = getattr(p, name)
         values[name] = min(max(v, low), high)
-    values["gamma_mode"] = p.gamma_mode
+    for name, _ in CATEGORICAL:
+        values[name] = getattr(p, name)
     return values
 
 

@@ -1,0 +1,79 @@
+"""Clusterer speed: events per second of each model on the built-in scenes' events, one core.
+
+Writes its section of docs/BENCHMARKS.md. Target (issue 3): the float model at >= 5 Mevents/s
+with N = 16 on `traffic` events.
+"""
+
+from __future__ import annotations
+
+import common  # noqa: F401  (first: pins every thread pool to one core)
+
+import argparse
+import datetime
+import statistics
+import time
+from pathlib import Path
+
+from evclust.clusterer import load_params, track_events
+from evclust.clusterer.run import MODELS
+from evclust.scenes import load_scene
+from evclust.simulator import simulate_scene
+
+START, END = "<!-- bench:clusterer:start -->", "<!-- bench:clusterer:end -->"
+SCENES = ("traffic", "pedestrian")
+REPEAT = 5
+
+
+def measure(events, meta, params, model: str) -> tuple[float, float, int]:
+    track_events(events[:10_000], meta, params, model=model)  # compile outside the timing
+    walls = []
+    for _ in range(REPEAT):
+        start = time.perf_counter()
+        run = track_events(events, meta, params, model=model)
+        walls.append(time.perf_counter() - start)
+    return statistics.median(walls), min(walls), len(run.tracks)
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--write", metavar="BENCHMARKS.md", help="rewrite this file's clusterer section")
+    args = parser.parse_args()
+    rows = []
+    for name in SCENES:
+        sim = simulate_scene(load_scene(name))
+        params, origin = load_params(name)
+        for model in MODELS:
+            median, best, records = measure(sim.events, sim.meta, params, model)
+            rows.append((name, model, params.n_clusters, sim.events.size, records, median, best))
+    lines = [
+        START,
+        "## Clusterer speed",
+        "",
+        f"Command: `make bench` (= `.venv/bin/python bench/clusterer.py --write docs/BENCHMARKS.md`), "
+        f"run {datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC.",
+        "",
+        "Machine:",
+        "",
+        *common.machine(),
+        "",
+        f"Method: each scene simulated with its built-in sensor, tracked with its preset parameters; "
+        f"{REPEAT} timed runs of the whole stream (`track_events`: the compiled loop, chunking and record "
+        "conversion; file I/O not included) after one warm-up. Mevents/s = events / wall / 10⁶.",
+        "",
+        "| scene | model | N | events | track records | median wall s | best wall s | Mevents/s (median) |",
+        "|---|---|---:|---:|---:|---:|---:|---:|",
+    ]
+    for name, model, n, events, records, median, best in rows:
+        lines.append(f"| {name} | {model} | {n} | {events:,} | {records:,} | {median:.3f} | {best:.3f} | {events / median / 1e6:.2f} |")
+    traffic_float = next(r for r in rows if r[0] == "traffic" and r[1] == "float")
+    rate = traffic_float[3] / traffic_float[5] / 1e6
+    lines += ["", f"Target: float model ≥ 5 Mevents/s with N = 16 on `traffic`: {rate:.2f} Mevents/s, **{'PASS' if rate >= 5 else 'FAIL'}**.", END]
+    text = "\n".join(lines) + "\n"
+    print(text)
+    if args.write:
+        common.write_section(Path(args.write), text, START, END)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

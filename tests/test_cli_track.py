@@ -1,0 +1,85 @@
+"""track and tune from the command line: outputs, reproducibility and bad input."""
+
+from __future__ import annotations
+
+import h5py
+import numpy as np
+import pytest
+
+from evclust.cli import main
+from evclust.events import read_events
+from evclust.tracks import read_tracks
+
+from test_cli import assert_one_line_error, run_cli
+
+
+@pytest.fixture(scope="module")
+def crossing_events(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("crossing")
+    assert main(["simulate", "crossing", "-o", str(folder / "e.npz"), "--truth", str(folder / "gt.csv"), "-q"]) == 0
+    return folder
+
+
+def test_track_writes_records_and_a_summary(crossing_events, capsys):
+    out = crossing_events / "tracks.csv"
+    code, stdout, err = run_cli(capsys, "track", str(crossing_events / "e.npz"), "-o", str(out), "-q")
+    assert code == 0, err
+    tracks, meta = read_tracks(out)
+    events, _ = read_events(crossing_events / "e.npz")
+    assert tracks.size > 0 and meta.model == "float" and meta.width == 160
+    assert f"{events.size} events" in stdout and "Mevents/s" in stdout and "parameters from defaults" in stdout
+    # Records come in filter-step order, inside the sensor.
+    assert np.all(np.diff(tracks["step"].astype(np.int64)) >= 0)
+    assert np.all((tracks["x"] >= 0) & (tracks["x"] < 160) & (tracks["y"] >= 0) & (tracks["y"] < 120))
+
+
+@pytest.mark.parametrize(
+    "text, fragments",
+    [
+        ("[clusterer]\nalpha_pos = 1.5\n", ("clusterer.alpha_pos", "less than 1")),
+        ("[clusterer]\nsize_gian = 2\n", ("size_gian", "Extra inputs")),
+        ("[clusterer]\npalette = []\n", ("clusterer.palette",)),
+        ("[clusterer]\nr_max = -3\n", ("clusterer.r_max", "greater than 0")),
+    ],
+)
+def test_track_refuses_bad_parameter_files(crossing_events, capsys, text, fragments):
+    params = crossing_events / "bad.toml"
+    params.write_text(text)
+    out = crossing_events / "never.csv"
+    code, _, err = run_cli(capsys, "track", str(crossing_events / "e.npz"), "-o", str(out), "--params", str(params), "-q")
+    assert_one_line_error(code, err, "bad.toml", *fragments)
+    assert not out.exists()
+
+
+def test_track_runs_dvs_only_files_with_colour_off(crossing_events, capsys):
+    events, meta = read_events(crossing_events / "e.npz")
+    dvs = crossing_events / "dvs.h5"
+    with h5py.File(dvs, "w") as f:
+        for name in ("t", "x", "y", "p"):
+            f.create_dataset(f"events/{name}", data=events[name])
+        f.attrs["width"], f.attrs["height"], f.attrs["t_frame_us"] = meta.width, meta.height, meta.t_frame_us
+    code, _, err = run_cli(capsys, "track", str(dvs), "-o", str(crossing_events / "dvs.csv"), "-q")
+    assert code == 0, err
+    tracks, tmeta = read_tracks(crossing_events / "dvs.csv")
+    assert not tmeta.has_colour and tracks.size > 0 and np.all(tracks["class"] == -1)
+
+
+def test_tune_is_reproducible_under_a_seed(tmp_path, capsys):
+    outputs = []
+    for name in ("a.toml", "b.toml"):
+        code, _, err = run_cli(capsys, "tune", "crossing", "--trials", "4", "--seed", "7", "--segment", "0.5", "-o", str(tmp_path / name), "-q")
+        assert code == 0, err
+        outputs.append((tmp_path / name).read_text())
+    assert outputs[0] == outputs[1]
+    # And the result is a parameter file `track` accepts.
+    assert "[clusterer]" in outputs[0] and "# Tuned by: evclust tune crossing" in outputs[0]
+
+
+@pytest.mark.parametrize(
+    "args, fragment",
+    [(["--trials", "0"], "--trials 0"), (["--segment", "1.5"], "--segment 1.5"), (["--params", "nosuch"], "unknown parameter set 'nosuch'")],
+)
+def test_tune_refuses_bad_options(tmp_path, capsys, args, fragment):
+    code, _, err = run_cli(capsys, "tune", "crossing", "-o", str(tmp_path / "x.toml"), "-q", *args)
+    assert_one_line_error(code, err, fragment)
+    assert not (tmp_path / "x.toml").exists()
