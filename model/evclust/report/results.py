@@ -6,6 +6,8 @@ from __future__ import annotations
 import dataclasses
 from pathlib import Path
 
+import numpy as np
+
 from evclust.clusterer import load_params, track_events
 from evclust.errors import atomic_output
 from evclust.metrics import match, score
@@ -44,6 +46,34 @@ class SceneResult:
     all_objects: dict
     fully_visible: dict
     stats: dict
+    steady: dict  # velocity NRMSE where the true velocity has not changed for a second
+    per_label: dict  # palette accuracy per ground-truth label: (correct, evaluations)
+
+
+def steady_velocity(matches, truth, frames_back: int) -> dict:
+    """Velocity NRMSE of each method over matches whose object kept its velocity for the last
+    `frames_back` frames: the error left once the filters have had time to follow a change."""
+    by_key = {(int(r["id"]), int(r["frame"])): (float(r["vx"]), float(r["vy"])) for r in truth}
+    keep = np.array([
+        by_key.get((int(m["gt_id"]), int(m["frame"]) - frames_back)) == (float(m["gt_vx"]), float(m["gt_vy"]))
+        for m in matches
+    ], dtype=bool)  # fmt: skip
+    out = {"evaluations": int(keep.sum()), "of": int(matches.size)}
+    sel = matches[keep]
+    speed = np.hypot(sel["gt_vx"], sel["gt_vy"])
+    for method in ("mcm", "int"):
+        err = np.hypot(sel[f"vx_{method}"] - sel["gt_vx"], sel[f"vy_{method}"] - sel["gt_vy"])
+        out[method] = float(np.sqrt(np.mean(err**2)) / np.mean(speed)) if sel.size and speed.mean() > 0 else None
+    return out
+
+
+def label_accuracy(matches, palette) -> dict:
+    out = {}
+    for label in np.unique(matches["gt_label"]):
+        sel = matches[matches["gt_label"] == label]
+        correct = sum(1 for c in sel["class_palette"] if 0 <= c < len(palette) and palette[c] == label)
+        out[str(label)] = (correct, int(sel.size))
+    return out
 
 
 def scene_results(name: str, figures: Path | None = None) -> SceneResult:
@@ -52,8 +82,8 @@ def scene_results(name: str, figures: Path | None = None) -> SceneResult:
     truth = truth_array(scene.source.truth())
     params, origin = load_params(None, sim.meta.source)
     run = track_events(sim.events, sim.meta, params)
+    matches = match(run.tracks, run.meta, truth)
     if figures is not None:
-        matches = match(run.tracks, run.meta, truth)
         figures.mkdir(parents=True, exist_ok=True)
         plot_velocity(matches, figures / f"results_{name}_velocity.png", truth=truth, axis="time", t_frame_us=run.meta.t_frame_us, title=name)
         plot_colour(matches, figures / f"results_{name}_colour.png", truth=truth, axis="time", t_frame_us=run.meta.t_frame_us, palette=run.meta.palette, title=name)
@@ -62,6 +92,8 @@ def scene_results(name: str, figures: Path | None = None) -> SceneResult:
         score(run.tracks, run.meta, truth).to_dict(),
         score(run.tracks, run.meta, truth, fully_visible_only=True).to_dict(),
         run.stats,
+        steady_velocity(matches, truth, frames_back=int(round(1e6 / run.meta.t_frame_us))),
+        label_accuracy(matches, run.meta.palette),
     )  # fmt: skip
 
 
@@ -103,6 +135,13 @@ def scene_table(r: SceneResult) -> list[str]:
         row("recall / precision", lambda d: (d["recall"], d["precision"]), lambda v: f"{_pct(v[0])} / {_pct(v[1])}", "not reported"),
         row("identity switches", lambda d: d["id_switches"], str, "not reported"),
         "",
+        f"Velocity NRMSE in steady state (the object has kept its velocity for the last second; "
+        f"{r.steady['evaluations']:,} of {r.steady['of']:,} evaluations): MCM {_pct(r.steady['mcm'])}, "
+        f"interval {_pct(r.steady['int'])}.",
+        "",
+        "Palette classification per ground-truth label: "
+        + ", ".join(f"{label} {_pct(c / n)} ({n:,})" for label, (c, n) in r.per_label.items()) + ".",
+        "",
     ]
     return lines
 
@@ -121,7 +160,9 @@ def target_table(results: list[SceneResult]) -> list[str]:
     return lines
 
 
-def write_results(path: Path, scenes=("pedestrian", "traffic"), figures: Path | None = None, preamble: str = "") -> list[SceneResult]:
+def write_results(
+    path: Path, scenes=("pedestrian", "traffic"), figures: Path | None = None, preamble: str = "", epilogue: str = ""
+) -> list[SceneResult]:
     results = [scene_results(name, figures) for name in scenes]
     lines = [preamble.rstrip(), "", "## Targets", "", *target_table(results), "", "## Tables 5 and 7, per scene", ""]
     for r in results:
@@ -130,6 +171,7 @@ def write_results(path: Path, scenes=("pedestrian", "traffic"), figures: Path | 
             rel = Path("img")
             lines += [f"![{r.name}: velocity against ground truth]({rel}/results_{r.name}_velocity.png)", "",
                       f"![{r.name}: colour against ground truth]({rel}/results_{r.name}_colour.png)", ""]  # fmt: skip
+    lines.append(epilogue)
     with atomic_output(path) as tmp:
         tmp.write_text("\n".join(lines).lstrip() + "\n")
     return results
@@ -155,6 +197,34 @@ paper's evaluation does; "fully visible" leaves out records while an object is p
 """
 
 
+EPILOGUE = """## What limits these figures
+
+The figures are kept as measured. Where a target is missed, the diagnostics under each table
+and the plots above show why.
+
+- **Velocity NRMSE is mostly lag after a change, not steady error.** Both methods are
+  first-order filters; they need time to follow a change of velocity.
+  - A car is in view for about 2.5 s, and its estimates first converge after it enters.
+  - The pedestrian's legs change velocity instantly, every 2 to 3.5 s, and the ground truth
+    steps with them (the velocity plot).
+  - Restricted to evaluations where the object kept its velocity for the last second, the
+    traffic figures fall under the 15 % target ("steady state" lines).
+  - The pedestrian also has a slow leg (1 px/frame), where few events come and the estimates
+    wander.
+  - The paper's real walker turns smoothly, which favours its figures.
+- **The angular error is far below the paper's**, because our synthetic objects are rigid and
+  their motion is exactly translational.
+- **Classification of bright cars.** A log change detector with θ = 0.3 emits an edge event
+  when the intensity has risen by e^0.3 over the road. The event carries the colour at that
+  moment, a mixture of road and car. A white car's edge events therefore sit between the road
+  and the grey entry of the palette, and many of a yellow car's too. The palette also meets
+  the cars' windows. Mixing-aware assignment (TUNING.md) recovers most but not all of them;
+  the per-label line shows white and yellow below the rest.
+- **Traffic chrominance** carries the same mixing, plus the windows' blue cast, which the
+  ground truth averages into each car's colour.
+"""
+
+
 def main() -> int:
     import argparse
 
@@ -162,7 +232,7 @@ def main() -> int:
     parser.add_argument("--write", default="docs/RESULTS.md", metavar="RESULTS.md")
     args = parser.parse_args()
     path = Path(args.write)
-    write_results(path, figures=path.parent / "img", preamble=PREAMBLE)
+    write_results(path, figures=path.parent / "img", preamble=PREAMBLE, epilogue=EPILOGUE)
     print(f"{path}: written")
     return 0
 
