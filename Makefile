@@ -40,7 +40,7 @@ bench: $(STAMP)
 
 # Task accuracy on the built-in scenes: docs/RESULTS.md and its figures.
 results: $(STAMP)
-	$(PY) -m evclust.report.results --write docs/RESULTS.md
+	$(PY) -m evclust.report --write docs/RESULTS.md
 
 clean:
 	rm -rf $(BUILD) .pytest_cache
