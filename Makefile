@@ -6,7 +6,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 BUILD  := build
 
-.PHONY: setup demo test bench results clean
+.PHONY: setup demo test bench results params clean
 
 setup: $(STAMP)
 
@@ -37,6 +37,10 @@ test: $(STAMP)
 bench: $(STAMP)
 	$(PY) bench/simulator.py --write docs/BENCHMARKS.md
 	$(PY) bench/clusterer.py --write docs/BENCHMARKS.md
+
+# The RTL parameter header, generated from the formats table (tests fail when it is stale).
+params: $(STAMP)
+	$(VENV)/bin/evclust formats --verilog rtl/evclust_params.vh > /dev/null
 
 # Task accuracy on the built-in scenes: docs/RESULTS.md and its figures.
 results: $(STAMP)

@@ -84,12 +84,9 @@ def _mixing_palette(y, cb, cr, bg_y, bg_cb, bg_cr, palette, background_mask, lum
     passes within `tolerance` of the event (an edge event mixes background and object); the
     plain nearest entry when no segment does."""
     best, best_d = -1, np.inf
-    plain, plain_d = 0, np.inf
     uy, ucb, ucr = y - bg_y, cb - bg_cb, cr - bg_cr
     for k in range(palette.shape[0]):
         d_end = luma_w * abs(y - palette[k, 0]) + abs(cb - palette[k, 1]) + abs(cr - palette[k, 2])
-        if d_end < plain_d:
-            plain, plain_d = k, d_end
         if background_mask[k]:
             d_line = d_end  # background entries stand for themselves
         else:
@@ -99,7 +96,7 @@ def _mixing_palette(y, cb, cr, bg_y, bg_cb, bg_cr, palette, background_mask, lum
             d_line = luma_w * abs(uy - q * wy) + abs(ucb - q * wcb) + abs(ucr - q * wcr)
         if d_line <= tolerance and d_end < best_d:
             best, best_d = k, d_end
-    return best if best >= 0 else plain
+    return best if best >= 0 else _nearest_palette(y, cb, cr, palette, luma_w)
 
 
 @numba.njit(cache=True, nogil=True)
@@ -186,12 +183,19 @@ def _update(S, H, G, s, t, x, y, lum, cb, cr, k, palette, background_mask):
         vote = 1
         if k[K_VOTE_CONTRAST] != 0.0:
             vote = int(abs(lum - G[BG_Y]) + abs(cb - G[BG_CB]) + abs(cr - G[BG_CR]) + 0.5)
-        H[s, c] = min(H[s, c] + vote, k[K_H_MAX])
-        if H[s, c] >= k[K_H_MAX]:
+        h_max = np.int64(k[K_H_MAX])
+        H[s, c] = min(H[s, c] + vote, h_max)
+        if H[s, c] >= h_max:
             for j in range(H.shape[1]):
                 H[s, j] >>= 1
     S[s, EV_COUNT] += 1.0
     S[s, T_LAST] = t
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _near_border(px, py, k):
+    m = k[K_EXIT_M]
+    return px < m or px > k[K_WIDTH] - 1.0 - m or py < m or py > k[K_HEIGHT] - 1.0 - m
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
@@ -224,9 +228,11 @@ def _exiting(S, s, k):
 @numba.njit(cache=True, nogil=True)
 def _filter_step(S, H, G, t, k, palette, background_mask, out, n_out):
     """Every N_f events: decay, free, interval velocity, noise and exit decisions, records."""
-    interval_due = math.floor(t / k[K_TAU]) > math.floor(G[T_FILTER] / k[K_TAU])
+    # τ boundaries crossed since the last step: usually 0 or 1, more when events are sparse.
+    boundaries = math.floor(t / k[K_TAU]) - math.floor(G[T_FILTER] / k[K_TAU])
+    interval_due = boundaries > 0
+    per_frame = k[K_T_FRAME] / (max(boundaries, 1) * k[K_TAU])  # T_frame over the time measured
     v_min = k[K_V_MIN]
-    m = k[K_EXIT_M]
     for s in range(S.shape[0]):
         if S[s, VALID] == 0.0:
             continue
@@ -240,12 +246,11 @@ def _filter_step(S, H, G, t, k, palette, background_mask, out, n_out):
             S[s, GAMMA] = _gamma(S[s, ACT], k)
         if interval_due:
             if k[K_GAMMA_MODE] == GAMMA_COUNT and S[s, VI_COUNT] >= 1.0:
-                S[s, GAMMA] = S[s, EV_COUNT] * k[K_T_FRAME] / k[K_TAU]  # events per frame over the last τ
+                S[s, GAMMA] = S[s, EV_COUNT] * per_frame  # events per frame since the last boundary
             S[s, EV_COUNT] = 0.0
             # Eq. (4): V_RI += β_vi ((P - P_prev) · T_frame / τ - V_RI); P_prev = P.
-            scale = k[K_T_FRAME] / k[K_TAU]
-            mx = (S[s, PX] - S[s, PPX]) * scale
-            my = (S[s, PY] - S[s, PPY]) * scale
+            mx = (S[s, PX] - S[s, PPX]) * per_frame
+            my = (S[s, PY] - S[s, PPY]) * per_frame
             if k[K_WARM_START] == 0.0 or S[s, VI_COUNT] >= 2.0:
                 S[s, VIX] += k[B_VI] * (mx - S[s, VIX])
                 S[s, VIY] += k[B_VI] * (my - S[s, VIY])
@@ -287,7 +292,7 @@ def _filter_step(S, H, G, t, k, palette, background_mask, out, n_out):
         flags = 0
         if S[s, EVER_REPORTED] == 0.0:
             flags |= FLAG_NEW
-        if S[s, PX] < m or S[s, PX] > k[K_WIDTH] - 1 - m or S[s, PY] < m or S[s, PY] > k[K_HEIGHT] - 1 - m:
+        if _near_border(S[s, PX], S[s, PY], k):
             flags |= FLAG_BORDER
         if moving_mcm:
             flags |= FLAG_MOVING_MCM

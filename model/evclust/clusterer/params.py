@@ -99,6 +99,8 @@ class ClustererParams(BaseModel):
 
     @model_validator(mode="after")
     def _consistent(self):
+        if self.a_min > self.a_valid:
+            raise ValueError(f"need a_min <= a_valid, got {self.a_min} > {self.a_valid}: every cluster would be freed before it is reported")
         if not self.r_min <= self.r_init <= self.r_max:
             raise ValueError(f"need r_min <= r_init <= r_max, got {self.r_min}, {self.r_init}, {self.r_max}")
         names = [e.name for e in self.palette]

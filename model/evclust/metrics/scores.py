@@ -112,6 +112,14 @@ def _id_switches(matches: np.ndarray) -> int:
     return int(np.count_nonzero(same_object & (tid[1:] != tid[:-1])))
 
 
+def class_correct(classes: np.ndarray, labels: np.ndarray, palette) -> np.ndarray:
+    """An evaluation is correct when its class names the ground-truth label; -1 (no class) never is."""
+    classes = np.asarray(classes)
+    valid = (classes >= 0) & (classes < len(palette))
+    names = np.array(list(palette) or [""], dtype=object)[np.where(valid, classes, 0)]
+    return valid & (names == np.asarray(labels).astype(object))
+
+
 def scores_from_matches(matches: np.ndarray, counts: MatchCounts, meta: TrackMeta, gate_px: float, fully_visible_only: bool) -> Scores:
     m = matches
     n = int(m.size)
@@ -140,11 +148,9 @@ def scores_from_matches(matches: np.ndarray, counts: MatchCounts, meta: TrackMet
         chrominance = ColourError(chro, _ratio(chro, (m["gt_Cb"].mean() + m["gt_Cr"].mean()) / 2))
         ycbcr = ColourError(full, _ratio(full, (m["gt_Y"].mean() + m["gt_Cb"].mean() + m["gt_Cr"].mean()) / 3))
         if meta.palette:
-            names = np.array(list(meta.palette) + [""], dtype=object)  # index -1 and out of range -> ""
 
             def correct(cls: np.ndarray) -> np.ndarray:
-                cls = np.where((cls >= 0) & (cls < len(meta.palette)), cls, -1)
-                return names[cls] == m["gt_label"].astype(object)
+                return class_correct(cls, m["gt_label"], meta.palette)
 
             n_class = n
             n_unknown = int(np.count_nonzero(~np.isin(m["gt_label"], np.array(meta.palette, dtype=m["gt_label"].dtype))))

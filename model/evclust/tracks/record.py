@@ -43,7 +43,7 @@ MAGIC = "# evclust-tracks "
 class TrackFlags(enum.IntFlag):
     NEW = 1  # first record of this id
     BORDER = 2  # centre within exit_margin of a border
-    MOVING_MCM = 4  # |V_mcm| >= v_min
+    MOVING_MCM = 4  # uncorrected |V_mcm| >= v_min (the evidence the noise filter weighs)
     MOVING_INT = 8  # |V_int| >= v_min
 
 
@@ -108,8 +108,11 @@ def read_tracks(path: str | Path) -> tuple[np.ndarray, TrackMeta]:
     if not first.startswith(MAGIC):
         raise EvclustError(f"{path}: not an evclust track file (its first line must start with '{MAGIC.strip()}')")
     try:
-        meta = TrackMeta.from_dict(json.loads(first[len(MAGIC):]))
-    except (json.JSONDecodeError, TypeError) as exc:
+        data = json.loads(first[len(MAGIC):])
+        if not isinstance(data, dict):
+            raise TypeError("metadata is not a JSON object")
+        meta = TrackMeta.from_dict(data)
+    except (json.JSONDecodeError, TypeError, ValueError) as exc:
         raise EvclustError(f"{path}: line 1: unreadable metadata ({exc})") from None
     reader = csv.reader(io.StringIO(rest))
     header = next(reader, None)
@@ -119,12 +122,19 @@ def read_tracks(path: str | Path) -> tuple[np.ndarray, TrackMeta]:
     if missing:
         raise EvclustError(f"{path}: missing column(s) {', '.join(missing)}")
     index = [header.index(name) for name in TRACK_FIELDS]
+    limits = {name: np.iinfo(TRACK_DTYPE[name]) for name in _INTEGER_FIELDS}
     rows = []
     for line_no, row in enumerate(reader, start=3):
         if not row:
             continue
         try:
-            rows.append(tuple(float(row[i]) if name not in _INTEGER_FIELDS else int(row[i]) for i, name in zip(index, TRACK_FIELDS)))
+            values = tuple(float(row[i]) if name not in _INTEGER_FIELDS else int(row[i]) for i, name in zip(index, TRACK_FIELDS))
         except (ValueError, IndexError):
             raise EvclustError(f"{path}: line {line_no}: not a track record: {','.join(row)[:80]}") from None
+        for name, value in zip(TRACK_FIELDS, values):
+            if name in limits and not limits[name].min <= value <= limits[name].max:
+                raise EvclustError(f"{path}: line {line_no}: {name}={value} does not fit {TRACK_DTYPE[name]}")
+            if name not in limits and not np.isfinite(value):
+                raise EvclustError(f"{path}: line {line_no}: {name} is {value}")
+        rows.append(values)
     return np.array(rows, dtype=TRACK_DTYPE), meta

@@ -90,10 +90,17 @@ def tune(
 
     optuna.logging.set_verbosity(optuna.logging.WARNING)
     t_frame_us = float(base.t_frame_us or meta.t_frame_us)
+    start = trial_values(base, t_frame_us)
+    # Each range grows to hold the starting value, so the first trial is exactly the base set.
+    space = [
+        (n, lo if sc == "log" and start[n] <= 0 else min(lo, start[n]), max(hi, start[n]), sc)
+        for n, lo, hi, sc in SEARCH_SPACE
+    ]
+    start = {n: min(max(start[n], lo), hi) for n, lo, hi, _ in space} | {n: start[n] for n, _ in CATEGORICAL}
 
     def objective(trial):
         values = {}
-        for name, low, high, scale in SEARCH_SPACE:
+        for name, low, high, scale in space:
             values[name] = trial.suggest_float(name, low, high, log=scale == "log")
         for name, choices in CATEGORICAL:
             values[name] = trial.suggest_categorical(name, choices)
@@ -104,22 +111,22 @@ def tune(
     sampler = optuna.samplers.TPESampler(seed=seed, n_startup_trials=min(20, trials))
     study = optuna.create_study(direction="minimize", sampler=sampler)
     # The starting point: the base parameters, so the search can only improve on them.
-    study.enqueue_trial(trial_values(base, t_frame_us))
+    study.enqueue_trial(start)
     study.optimize(objective, n_trials=trials, show_progress_bar=progress)
     best = params_from_trial(study.best_params, base, t_frame_us)
     return TuneResult(best, float(study.best_value), trials, study)
 
 
 def trial_values(p: ClustererParams, t_frame_us: float) -> dict:
+    """The search coordinates of a parameter set (β on its scale, τ in frames)."""
     values = {}
-    for name, low, high, _ in SEARCH_SPACE:
+    for name, _, _, _ in SEARCH_SPACE:
         if name.startswith("beta_"):
-            v = 1.0 - getattr(p, "alpha_" + name[len("beta_"):])
+            values[name] = 1.0 - getattr(p, "alpha_" + name[len("beta_"):])
         elif name == "tau_frames":
-            v = p.tau_us / t_frame_us
+            values[name] = p.tau_us / t_frame_us
         else:
-            v = getattr(p, name)
-        values[name] = min(max(v, low), high)
+            values[name] = getattr(p, name)
     for name, _ in CATEGORICAL:
         values[name] = getattr(p, name)
     return values
@@ -136,8 +143,19 @@ def segment(events: np.ndarray, truth: np.ndarray, fraction: float) -> tuple[np.
 
 
 def params_to_toml(p: ClustererParams, header: str = "") -> str:
+    """A `[clusterer]` table a person can read: scalars through tomli_w, short arrays and the
+    palette inline, one entry a line."""
+    import json
+
     import tomli_w
 
-    data = p.model_dump(mode="json", exclude_none=True)
-    text = tomli_w.dumps({"clusterer": data})
-    return (header + "\n" if header else "") + text
+    lines = ["[clusterer]"]
+    for key, value in p.model_dump(mode="json", exclude_none=True).items():
+        if key == "palette":
+            entries = [f'  {{ name = {json.dumps(e["name"])}, rgb = [{", ".join(f"{c:g}" for c in e["rgb"])}] }},' for e in value]
+            lines += ["palette = [", *entries, "]"]
+        elif isinstance(value, list):
+            lines.append(f"{key} = [{', '.join(json.dumps(v) for v in value)}]")
+        else:
+            lines.append(tomli_w.dumps({key: value}).strip())
+    return (header + "\n" if header else "") + "\n".join(lines) + "\n"

@@ -1,0 +1,48 @@
+"""evclust formats [--params P.toml] [--width W --height H] [--verilog rtl/evclust_params.vh]"""
+
+from __future__ import annotations
+
+from evclust.clusterer import load_params
+from evclust.errors import EvclustError, atomic_output
+from evclust.fixed import build_formats, render_table, verilog_header
+
+REFERENCE = ("traffic", 480, 270, 50000.0)  # the parameter set the committed RTL header is made from
+
+
+def add_parser(sub) -> None:
+    p = sub.add_parser(
+        "formats",
+        help="print the fixed-point formats table (and write the RTL parameter header)",
+        description=(
+            "Print the fixed model's formats: every input, state field, intermediate and constant with its Q "
+            "notation, range, LSB, rounding and overflow, and each constant's exact and quantised value. "
+            f"The default is the reference configuration of the RTL (preset '{REFERENCE[0]}' on "
+            f"{REFERENCE[1]}x{REFERENCE[2]}). --verilog writes the RTL parameter header from the same table."
+        ),
+    )
+    p.add_argument("--params", metavar="P", help="parameter file (.toml) or preset (default: the reference preset)")
+    p.add_argument("--width", type=int, default=REFERENCE[1], help="sensor width, px")
+    p.add_argument("--height", type=int, default=REFERENCE[2], help="sensor height, px")
+    p.add_argument("--t-frame-us", type=float, default=None, help="frame period, µs (default: the parameters', else 50000)")
+    p.add_argument("--verilog", metavar="VH", help="write the Verilog parameter header here")
+    p.set_defaults(run=run)
+
+
+def reference_table():
+    params, _ = load_params(REFERENCE[0])
+    return build_formats(params, REFERENCE[1], REFERENCE[2], params.t_frame_us or REFERENCE[3])
+
+
+def run(args) -> int:
+    if args.width <= 0 or args.height <= 0:
+        raise EvclustError(f"sensor {args.width}x{args.height}: width and height must be positive")
+    params, origin = load_params(args.params or REFERENCE[0])
+    t_frame = args.t_frame_us or params.t_frame_us or REFERENCE[3]
+    table = build_formats(params, args.width, args.height, t_frame)
+    print(f"formats for {origin} on {args.width}x{args.height}, T_frame {t_frame:g} µs")
+    print(render_table(table))
+    if args.verilog:
+        with atomic_output(args.verilog) as tmp:
+            tmp.write_text(verilog_header(table))
+        print(f"{args.verilog}: written")
+    return 0
