@@ -218,14 +218,15 @@ and the plots above show why.
   - The paper's real walker turns smoothly, which favours its figures.
 - **The angular error is far below the paper's**, because our synthetic objects are rigid and
   their motion is exactly translational.
-- **Classification of bright cars.** A log change detector with θ = 0.3 emits an edge event
-  when the intensity has risen by e^0.3 over the road. The event carries the colour at that
-  moment, a mixture of road and car. A white car's edge events therefore sit between the road
-  and the grey entry of the palette, and many of a yellow car's too. The palette also meets
-  the cars' windows. Mixing-aware assignment (TUNING.md) recovers most but not all of them;
-  the per-label line shows white and yellow below the rest.
-- **Traffic chrominance** carries the same mixing, plus the windows' blue cast, which the
-  ground truth averages into each car's colour.
+- **Traffic chrominance.** A log change detector with θ = 0.3 emits an edge event when the
+  intensity has moved by a factor e^0.3 from the road's. The event carries the colour at that
+  moment, a mixture of road and car, and near the windows a mixture of car and glass. The
+  p correction of eq. (11) undoes one mixing ratio for all cars. The dark cars (red, blue) and
+  the bright ones mix in different proportions, and the ground truth averages each car's blue
+  windows into its colour.
+- **Classification** stays correct despite the mixing: votes are weighted by their contrast
+  with the road, and counted for the palette entry whose mixing segment they lie on
+  (TUNING.md). The palette accuracy per label is under each table.
 """
 
 
