@@ -21,7 +21,10 @@ Overflow = Literal["saturate", "wrap"]
 Role = Literal["input", "state", "intermediate", "constant"]
 
 BETA_REL_ERROR_BITS = 8  # a β is quantised with at least 8 significant bits: < 0.4 % relative error
+MAX_BETA_FRAC_BITS = 32  # a β·x product then fits an int64 for every state format here
 DEAD_BAND_BITS = 6  # guard bits beyond 1/β: an α filter's dead band stays under 2^-6 of its input LSB
+DECAY_TABLE_BITS = 6  # 2^-f for f in [0, 1) in 64 steps
+DECAY_FRAC_BITS = 16
 
 
 @dataclasses.dataclass(frozen=True)
@@ -84,6 +87,7 @@ class FormatTable:
     palette_size: int
     width: int
     height: int
+    beta_shift_only: bool = False  # every β is a power of two: the filters multiply by shifting
 
     def __getitem__(self, name: str) -> Format:
         return self.formats[name]
@@ -95,9 +99,15 @@ def _bits_for(value: float) -> int:
 
 
 def _beta_frac_bits(beta: float, name: str) -> int:
-    if beta <= 0.0:
-        raise EvclustError(f"clusterer.{name}: β = 1 - α = {beta:g} makes the filter frozen; α must be below 1")
-    return max(0, math.ceil(-math.log2(beta))) + BETA_REL_ERROR_BITS
+    if beta >= 1.0:
+        raise EvclustError(f"clusterer.{name}: α = 0 makes β = 1, which UQ0.n cannot hold; the filter would keep no memory (use α > 0)")
+    bits = max(0, math.ceil(-math.log2(beta))) + BETA_REL_ERROR_BITS
+    if bits > MAX_BETA_FRAC_BITS:
+        raise EvclustError(
+            f"clusterer.{name}: β = 1 - α = {beta:.3g} needs UQ0.{bits} to keep {BETA_REL_ERROR_BITS} significant bits; "
+            f"the fixed model holds β in at most UQ0.{MAX_BETA_FRAC_BITS} (α <= {1 - 2.0 ** (BETA_REL_ERROR_BITS - MAX_BETA_FRAC_BITS):.10g})"
+        )
+    return bits
 
 
 def _quantise(value: float, fmt: Format, name: str, param: str) -> int:
@@ -118,8 +128,9 @@ def _quantise(value: float, fmt: Format, name: str, param: str) -> int:
     return raw
 
 
-def build_formats(params: ClustererParams, width: int, height: int, t_frame_us: float) -> FormatTable:
-    """The formats of a parameter set on a sensor, and its quantised constants."""
+def build_formats(params: ClustererParams, width: int, height: int, t_frame_us: float, beta_shift_only: bool = False) -> FormatTable:
+    """The formats of a parameter set on a sensor, and its quantised constants. With
+    `beta_shift_only`, each β is rounded to the nearest power of two (a shift, no multiplier)."""
     p = params
     coord = _bits_for(max(width, height) - 1)
     seek_int = _bits_for(p.r_max + p.seek_margin + max(width, height))
@@ -129,6 +140,8 @@ def build_formats(params: ClustererParams, width: int, height: int, t_frame_us: 
         "beta_bg": 1 - p.alpha_bg,
     }  # fmt: skip
     beta_bits = {name: _beta_frac_bits(b, "alpha_" + name[5:]) for name, b in betas.items()}
+    if beta_shift_only:
+        betas = {name: 2.0 ** -max(1, round(-math.log2(b))) for name, b in betas.items()}  # a shift of at least 1
 
     def guard(beta_name: str) -> int:
         # x moves by (u - x)·β: with f fractional bits, |u - x| < 2^-f / β never moves it.
@@ -176,8 +189,36 @@ def build_formats(params: ClustererParams, width: int, height: int, t_frame_us: 
     const("gamma_per_activity", math.log(2) * t_frame_us / p.t_half_us, False, _bits_for(math.log(2) * t_frame_us / p.t_half_us), 16, "clusterer.t_half_us", "ln2·T_frame/T_half")
     const("frame_per_tau", t_frame_us / p.tau_us, False, _bits_for(t_frame_us / p.tau_us), 16, "clusterer.tau_us", "T_frame/τ")
     const("inv_p", 1.0 / p.p_correction, False, _bits_for(1.0 / p.p_correction), 12, "clusterer.p_correction", "1/p of eq. (11)")
-    const("luma_weight", p.luma_weight, False, _bits_for(p.luma_weight), 6, "clusterer.luma_weight", "w_Y") if p.luma_weight > 0 else None
-    return FormatTable(formats, {k.name: k for k in c}, p.n_clusters, len(p.palette), width, height)
+    if p.luma_weight > 0:
+        const("luma_weight", p.luma_weight, False, _bits_for(p.luma_weight), 6, "clusterer.luma_weight", "w_Y")
+    size = formats["half_size"]
+    for name, value, param in (("r_init", p.r_init, "clusterer.r_init"), ("r_min", p.r_min, "clusterer.r_min"), ("r_max", p.r_max, "clusterer.r_max")):
+        const(name, value, False, size.int_bits, size.frac_bits, param, f"{name}, px")
+    const("seek_margin", p.seek_margin, False, _bits_for(p.seek_margin), pos_frac, "clusterer.seek_margin", "S, px") if p.seek_margin > 0 else None
+    const("exit_margin", p.exit_margin, False, _bits_for(p.exit_margin), pos_frac, "clusterer.exit_margin", "M, px") if p.exit_margin > 0 else None
+    act = formats["activity"]
+    for name, value in (("a_min", p.a_min), ("a_valid", p.a_valid)):
+        if value > 0:
+            const(name, value, False, act.int_bits, act.frac_bits, f"clusterer.{name}", f"{name}, events")
+    sq = formats["speed_sq"]
+    for name, value, param in (("v_min_sq", p.v_min**2, "clusterer.v_min"), ("v_exit_sq", p.v_exit**2, "clusterer.v_exit")):
+        if value > 0:
+            const(name, value, False, sq.int_bits, sq.frac_bits, param, f"{name[:-3]}², (px/frame)²")
+    const("cos_sq_exit", math.cos(math.radians(p.theta_exit_deg)) ** 2, False, 0, 16, "clusterer.theta_exit_deg", "cos²θ_exit") if p.theta_exit_deg < 90 else None
+    const("mixing_tolerance", p.mixing_tolerance, False, 11, 0, "clusterer.mixing_tolerance", "palette mixing tolerance") if p.mixing_tolerance > 0 else None
+    for i, (name, ycc) in enumerate(zip(p.palette_names, p.palette_ycbcr())):
+        for channel, value in zip(("Y", "CB", "CR"), ycc):
+            const(f"palette_{i}_{channel.lower()}", value, False, 8, 0, f"clusterer.palette.{name}", f"palette entry {name} {channel}")
+    table = {k.name: k for k in c}
+    formats["decay_table"] = Format("decay_table", False, 1, DECAY_FRAC_BITS, "constant", "2^-(i/64), i = 0..63 (entry 0 is 1.0)", rounding="nearest")
+    return FormatTable(formats, table, p.n_clusters, len(p.palette), width, height, beta_shift_only)
+
+
+def decay_table(table: FormatTable):
+    """The activity decay's fraction table, as `evclust.fixed.arith.decay_table` makes it."""
+    from evclust.fixed.arith import decay_table as make
+
+    return make(DECAY_TABLE_BITS, DECAY_FRAC_BITS)
 
 
 def format_rows(table: FormatTable) -> list[tuple[str, ...]]:
@@ -197,8 +238,15 @@ def render_table(table: FormatTable) -> str:
     return "\n".join([line(header), line(tuple("-" * w for w in widths)), *map(line, rows)])
 
 
+_ASCII = str.maketrans({"µ": "u", "²": "^2", "α": "alpha", "β": "beta", "γ": "gamma", "θ": "theta", "τ": "tau", "Δ": "d", "·": "*"})
+
+
 def verilog_header(table: FormatTable) -> str:
-    """`rtl/evclust_params.vh`: widths, quantised constants and table sizes as localparams."""
+    """`rtl/evclust_params.vh`: widths, quantised constants and table sizes as localparams (ASCII)."""
+    return _verilog_lines(table).translate(_ASCII)
+
+
+def _verilog_lines(table: FormatTable) -> str:
     out = [
         "// Generated by `evclust formats --verilog`: do not edit. The formats table",
         "// (model/evclust/fixed/formats.py) is the single source for the model and the RTL.",
@@ -216,5 +264,9 @@ def verilog_header(table: FormatTable) -> str:
     for const in table.constants.values():
         stem = const.name.upper()
         out.append(f"localparam [{const.fmt.word_bits - 1}:0] {stem} = {const.fmt.word_bits}'d{const.raw};  // {const.value:.9g}")
+    out.append(f"localparam integer DECAY_TABLE_BITS = {DECAY_TABLE_BITS};")
+    for i, raw in enumerate(decay_table(table)):
+        out.append(f"localparam [{DECAY_FRAC_BITS}:0] DECAY_{i} = {DECAY_FRAC_BITS + 1}'d{int(raw)};")
+    out.append(f"localparam integer BETA_SHIFT_ONLY = {int(table.beta_shift_only)};")
     out.append("`endif")
     return "\n".join(out) + "\n"

@@ -1,0 +1,100 @@
+"""The formats table: one source for the fixed model and the RTL header."""
+
+from __future__ import annotations
+
+import math
+import shutil
+import subprocess
+from fractions import Fraction
+from pathlib import Path
+
+import pytest
+from fxpmath import Fxp
+
+from evclust.cli import main
+from evclust.cli.formats import reference_table
+from evclust.clusterer import ClustererParams, load_params
+from evclust.errors import EvclustError
+from evclust.fixed import build_formats, verilog_header
+
+from test_cli import assert_one_line_error, run_cli
+
+HEADER = Path(__file__).resolve().parents[1] / "rtl" / "evclust_params.vh"
+
+
+def test_the_committed_rtl_header_is_generated_from_the_table():
+    assert HEADER.read_text() == verilog_header(reference_table()), "stale: run `make params`"
+
+
+def test_the_header_is_ascii_and_icarus_compiles_it(tmp_path):
+    text = HEADER.read_text()
+    assert text.isascii()
+    top = tmp_path / "top.v"
+    top.write_text('module top;\n`include "evclust_params.vh"\ninitial $display("%0d %0d", N_CLUSTERS, BETA_POS);\nendmodule\n')
+    iverilog = shutil.which("iverilog")
+    assert iverilog, "Icarus Verilog is part of the machine"
+    subprocess.run([iverilog, "-g2012", "-I", str(HEADER.parent), "-o", str(tmp_path / "top.vvp"), str(top)], check=True)
+    out = subprocess.run(["vvp", str(tmp_path / "top.vvp")], check=True, capture_output=True, text=True).stdout.split()
+    table = reference_table()
+    assert out[:2] == [str(table.n_clusters), str(table.constants["beta_pos"].raw)]
+
+
+def test_every_constant_matches_fxpmath():
+    # fxpmath's 'around' is round-half-even, ours is round-half-up: they may differ only on an
+    # exact tie, which the test checks with exact arithmetic.
+    for const in reference_table().constants.values():
+        f = const.fmt
+        oracle = int(Fxp(const.value, signed=f.signed, n_word=f.word_bits, n_frac=f.frac_bits, rounding="around", overflow="saturate").val)
+        if oracle != const.raw:
+            scaled = Fraction(const.value) * 2**f.frac_bits
+            assert scaled.denominator == 2 and const.raw == math.floor(scaled + Fraction(1, 2)), const.name
+
+
+def test_every_word_fits_the_models_int64_arithmetic():
+    for fmt in reference_table().formats.values():
+        assert fmt.word_bits <= 63, fmt.name
+        assert fmt.raw_min <= 0 <= fmt.raw_max
+
+
+def test_shift_only_betas_are_powers_of_two():
+    params, _ = load_params("traffic")
+    table = build_formats(params, 480, 270, 50000.0, beta_shift_only=True)
+    betas = [c for name, c in table.constants.items() if name.startswith("beta_")]
+    assert len(betas) == 7
+    for c in betas:
+        assert c.raw & (c.raw - 1) == 0 and c.raw > 0, c.name
+        # The nearest power of two, but a shift of at least one bit: β <= 1/2.
+        exact = 1 - getattr(params, "alpha_" + c.name[len("beta_"):])
+        assert c.quantised == 2.0 ** -max(1, round(-math.log2(exact)))
+
+
+@pytest.mark.parametrize(
+    "update, fragments",
+    [
+        ({"alpha_vel_mcm": 1 - 1e-9}, ("clusterer.alpha_vel_mcm", "UQ0.")),
+        ({"alpha_lum": 0.0}, ("clusterer.alpha_lum", "β = 1")),
+        ({"gamma": 5000.0, "gamma_mode": "global"}, ("clusterer.gamma", "saturates UQ12.8", "UQ13.8")),
+    ],
+)
+def test_parameters_a_format_cannot_hold_are_refused(update, fragments):
+    params = ClustererParams(**update)
+    with pytest.raises(EvclustError) as err:
+        build_formats(params, 480, 270, 50000.0)
+    message = str(err.value)
+    assert "\n" not in message and all(f in message for f in fragments), message
+
+
+def test_formats_verb_prints_q_range_and_lsb_and_writes_the_header(tmp_path, capsys):
+    code, out, err = run_cli(capsys, "formats", "--verilog", str(tmp_path / "p.vh"))
+    assert code == 0, err
+    assert "UQ9.0" in out and "SQ" in out and "LSB" in out and "range" in out
+    assert (tmp_path / "p.vh").read_text() == HEADER.read_text()
+
+
+def test_formats_verb_refuses_bad_input(tmp_path, capsys):
+    bad = tmp_path / "bad.toml"
+    bad.write_text("[clusterer]\nalpha_pos = 0.0\n")
+    code, _, err = run_cli(capsys, "formats", "--params", str(bad))
+    assert_one_line_error(code, err, "clusterer.alpha_pos")
+    code, _, err = run_cli(capsys, "formats", "--width", "0")
+    assert_one_line_error(code, err, "sensor 0x270")
