@@ -18,12 +18,13 @@ Two families
     The plain functions (``shift_round``, ``alpha_step``, ...) run in Python on Python ints or
     numpy integers. Each has a numba twin with the suffix ``_nb`` (``shift_round_nb``, ...),
     compiled with ``@njit(cache=True)`` and taking only ints, bools, floats and int64 arrays, for
-    the model's event loop and for other jitted code. The single-expression primitives
+    the model's event loop and for other jitted code. The self-contained primitives
     (`raw_limits`, `saturate`, `saturate_flag`, `wrap`, `shift_round`) are one source compiled
-    twice; the composite ones are written twice in a few lines, and the tests check that both
-    families agree. Python-only design-time helpers: `rounding_code`, `overflow_code`,
-    `quantise` (exact, via Fraction), `decay_table`, `decay_error_bound`, `alpha_dead_band`,
-    `guard_bits_needed`.
+    twice; the composite ones (`mul_round`, `quantise`, `alpha_step`, `alpha_step_shift`,
+    `decay`) are written twice in a few lines, and the tests check that both families agree.
+    Python-only design-time helpers, without a twin: `rounding_code`, `overflow_code`,
+    `decay_table`, `decay_error_bound`, `alpha_dead_band`, `guard_bits_needed`. `quantise` is
+    exact via Fraction; `quantise_nb` reaches the same integers in float64 arithmetic.
 
     Within the documented operand ranges both families are exact and equal. Outside them the
     Python family stays exact (Python ints do not overflow) while the numba family wraps at
@@ -89,7 +90,7 @@ def raw_limits(signed, int_bits, frac_bits):
     """
     n = int_bits + frac_bits
     word = n + (1 if signed else 0)
-    if n < 0 or word < 1 or word > 63:
+    if n < 0 or word < 1 or word > MAX_WORD_BITS:
         raise EvclustError("raw_limits: a format's word must be 1..63 bits with int_bits + frac_bits >= 0")
     if signed:
         return -(1 << n), (1 << n) - 1
@@ -122,7 +123,7 @@ def wrap(raw, word_bits, signed):
     Unsigned: ``raw mod 2^w``; signed: the representative of ``raw mod 2^w`` in
     ``[-2^(w-1), 2^(w-1))``. Any int64 (any Python int in the Python family) is accepted.
     """
-    if word_bits < 1 or word_bits > 63:
+    if word_bits < 1 or word_bits > MAX_WORD_BITS:
         raise ValueError("wrap: word_bits must be 1..63")
     half = 1 << (word_bits - 1)
     v = raw & (half + (half - 1))  # raw mod 2^w, in [0, 2^w)
@@ -139,7 +140,7 @@ def shift_round(raw, shift, mode):
     ``shift == 0`` returns ``raw`` in every mode. Exact for any int64 raw in FLOOR and TRUNC; NEAREST
     needs ``raw <= 2^63 - 1 - 2^(shift-1)`` (the half-LSB adder must not overflow).
     """
-    if shift < 0 or shift > 62:
+    if shift < 0 or shift > MAX_SHIFT:
         raise ValueError("shift_round: shift must be 0..62")
     if shift == 0:
         return raw
@@ -244,6 +245,15 @@ def quantise_nb(x, signed, int_bits, frac_bits, rmode, omode):
     lo, hi = raw_limits_nb(signed, int_bits, frac_bits)
     if x != x:
         raise ValueError("quantise: cannot quantise NaN")
+    word = int_bits + frac_bits + (1 if signed else 0)
+    if omode == WRAP:
+        if np.isinf(x):
+            raise ValueError("quantise: cannot wrap an infinite value")
+        # Drop whole multiples of the wrap period first (exact), so x·2^f cannot overflow; the
+        # remainder keeps x's sign, so every rounding mode commutes with the subtraction.
+        x = np.fmod(x, 2.0 ** (word - frac_bits))
+    elif omode != SATURATE:
+        raise ValueError("quantise: unknown overflow mode code")
     v = x * 2.0**frac_bits
     if rmode == FLOOR:
         r = np.floor(v)
@@ -261,13 +271,8 @@ def quantise_nb(x, signed, int_bits, frac_bits, rmode, omode):
         if r < -_TWO63:
             return lo
         return saturate_nb(np.int64(r), lo, hi)
-    if omode == WRAP:
-        if np.isinf(r):
-            raise ValueError("quantise: cannot wrap an infinite value")
-        word = int_bits + frac_bits + (1 if signed else 0)
-        r = np.fmod(r, 2.0**word)  # exact; |r| < 2^word <= 2^63
-        return wrap_nb(np.int64(r), word, signed)
-    raise ValueError("quantise: unknown overflow mode code")
+    r = np.fmod(r, 2.0**word)  # exact; |r| < 2^word <= 2^63
+    return wrap_nb(np.int64(r), word, signed)
 
 
 # --------------------------------------------------------------------------------------------
@@ -292,10 +297,17 @@ def alpha_step(x, u, beta_raw, beta_frac_bits, guard_bits, mode):
     in int64 when ``m_u + g + 1 + B <= 62``.
 
     Dead band: the step is 0, and the filter stalls, while ``d·β`` rounds to 0 (`alpha_dead_band`):
-    ``0 <= d < 1/β`` for FLOOR, ``-1/(2β) <= d < 1/(2β)`` for NEAREST, ``|d| < 1/β`` for TRUNC, in
-    accumulator LSBs. With ``g >= guard_bits_needed(...)`` (= k for β = 2^-k) that band is inside
-    one LSB of ``u``: X converges to within 1 LSB of a constant input; each extra guard bit
-    halves the band. Read X out in ``F_u`` with ``shift_round(x, g, mode)``.
+    ``0 <= d < 1/β`` for FLOOR (one-sided: X comes to rest at or below u), ``-1/(2β) <= d < 1/(2β)``
+    for NEAREST, ``|d| < 1/β`` for TRUNC, in accumulator LSBs. Without guard bits that is up to
+    ``2^k - 1`` LSBs of ``u`` for β = 2^-k. With ``g >= guard_bits_needed(...)`` (= k for
+    β = 2^-k) the band is inside one LSB of ``u``: X comes to rest within 1 LSB of a constant
+    input; each further guard bit halves the band (g = k + 6 leaves < 2^-6 LSB).
+
+    Step response: each rounded step is within ``ε`` of the exact ``d·β`` (``ε`` < 1 for FLOOR and
+    TRUNC, <= 1/2 for NEAREST), so a step of ``S`` LSBs of ``u`` is within 1 LSB after at most
+    ``ln((2^g - ε/β)/(S·2^g - ε/β)) / ln(1-β)`` updates: the exact ``ln(1/S)/ln(1-β)`` plus at most
+    ``ln(1 - ε·2^(k-g)) / ln(1-β)`` (``≈ 0.29/β`` for g = k + 2, ``0.016/β`` for g = k + 6).
+    Read X out in ``F_u`` with ``shift_round(x, g, mode)``.
     """
     return x + shift_round(((u << guard_bits) - x) * beta_raw, beta_frac_bits, mode)
 
@@ -376,8 +388,8 @@ def decay(a_raw, dt, inv_t_half_raw, inv_frac_bits, table, table_bits, table_fra
     """``a · 2^(-Δt/T_half)``, division-free, in ``a``'s format.
 
     Inputs: ``a_raw >= 0`` (any unsigned format); ``dt >= 0`` in µs (integer); ``1/T_half`` as the
-    constant ``inv_t_half_raw`` in unsigned Q0.Q (``Q = inv_frac_bits``, per µs), e.g.
-    ``quantise(Fraction(1, t_half_us), False, 0, Q)``; ``table = decay_table(L, F)`` with
+    constant ``inv_t_half_raw`` with ``Q = inv_frac_bits`` fractional bits (per µs; unsigned Q0.Q
+    for T_half >= 2 µs), e.g. ``quantise(Fraction(1, t_half_us), False, 0, Q)``; ``table = decay_table(L, F)`` with
     ``L = table_bits <= Q`` and ``F = table_frac_bits``.
 
     Steps (all integer):
@@ -424,7 +436,7 @@ def decay_nb(a_raw, dt, inv_t_half_raw, inv_frac_bits, table, table_bits, table_
 def decay_error_bound(a_raw, dt, t_half, inv_t_half_raw, inv_frac_bits, table_bits, table_frac_bits, mode) -> float:
     """The documented bound of `decay`'s error against ``a·2^(-dt/t_half)``, in LSBs of ``a``."""
     mode = rounding_code(mode)
-    y = float(a_raw) * 2.0 ** (-dt / t_half)
+    n = dt / t_half
     inv_err = abs(float(Fraction(int(inv_t_half_raw), 1 << int(inv_frac_bits)) - Fraction(1) / Fraction(t_half)))
     if inv_frac_bits == table_bits:
         idx_err = 0.0
@@ -434,4 +446,7 @@ def decay_error_bound(a_raw, dt, t_half, inv_t_half_raw, inv_frac_bits, table_bi
         idx_err = 2.0**-table_bits
     e = dt * inv_err + idx_err
     r = 0.5 if mode == NEAREST else 1.0
-    return y * ((1.0 + 2.0**-table_frac_bits) * 2.0**e - 1.0) + r
+    if e - n > 1000.0:  # a coarse 1/T_half over a long Δt: no useful bound
+        return math.inf
+    # y·((1 + 2^-F)·2^E - 1) + r, written so that 2^E cannot overflow while y underflows
+    return float(a_raw) * ((1.0 + 2.0**-table_frac_bits) * 2.0 ** (e - n) - 2.0**-n) + r
