@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from evclust.clusterer import load_params, preset_names, track_events
+from evclust.errors import EvclustError
 from evclust.clusterer.run import MODELS
 from evclust.events import read_events
 from evclust.tracks import write_tracks
@@ -23,6 +24,7 @@ def add_parser(sub) -> None:
     p.add_argument("-o", "--output", required=True, metavar="TRACKS", help="track file to write (.csv)")
     p.add_argument("--params", metavar="P", help=f"parameter file (.toml) or preset ({', '.join(preset_names())})")
     p.add_argument("--model", default="float", choices=sorted(MODELS), help="clusterer model (default: float)")
+    p.add_argument("--ranges", action="store_true", help="fixed model: print each signal's range seen and its saturation count")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     p.set_defaults(run=run)
 
@@ -30,7 +32,16 @@ def add_parser(sub) -> None:
 def run(args) -> int:
     events, meta = read_events(args.events)
     params, origin = load_params(args.params, meta.source)
-    result = track_events(events, meta, params, model=args.model, progress=not args.quiet)
+    if args.ranges and args.model != "fixed":
+        raise EvclustError("--ranges instruments the fixed model: add --model fixed")
+    options = {"ranges": True} if args.ranges else {}
+    result = track_events(events, meta, params, model=args.model, progress=not args.quiet, **options)
     write_tracks(args.output, result.tracks, result.meta)
     print(f"{args.events}: parameters from {origin}; {result.summary()}")
+    if args.ranges:
+        table = result.clusterer.table
+        print(f"{'signal':<20} {'format':<9} {'range of the format':<24} {'seen':<26} saturations")
+        for name, lo, hi, sat in result.clusterer.range_report():
+            fmt = table[{"centre_step": "centre_step", "mcm_step": "v_mcm"}.get(name, name)]
+            print(f"{name:<20} {fmt.q:<9} {f'{fmt.min:g}..{fmt.max:g}':<24} {f'{lo:.6g}..{hi:.6g}':<26} {sat}")
     return 0

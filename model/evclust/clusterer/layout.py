@@ -10,12 +10,13 @@ from __future__ import annotations
 # Slot columns.
 (
     VALID, ID, PX, PY, RX, RY, ACT, T_LAST, VMX, VMY, VIX, VIY, PPX, PPY, CY, CCB, CCR, REPORTED,
-    EVER_REPORTED, GAMMA, VI_COUNT, MCM_NORM, EV_COUNT,
-) = range(23)  # fmt: skip
+    EVER_REPORTED, GAMMA, VI_COUNT, MCM_NORM, EV_COUNT, DECAY_RESIDUAL,
+) = range(24)  # fmt: skip
 SLOT_COLUMNS = (
     "valid", "id", "px", "py", "rx", "ry", "activity", "t_last", "vmx", "vmy", "vix", "viy",
     "p_prev_x", "p_prev_y", "Y", "Cb", "Cr", "reported", "ever_reported", "gamma",
     "interval_updates", "mcm_norm", "events_in_interval",
+    "decay_residual",  # fixed model: Δt/T_half not yet applied, below the decay table's step
 )  # fmt: skip
 
 # Global columns.

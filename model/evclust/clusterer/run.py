@@ -27,6 +27,7 @@ class TrackRun:
     meta: TrackMeta
     stats: dict
     wall_s: float
+    clusterer: object = None  # the model after the run: its state, and the fixed model's logs
 
     def summary(self) -> str:
         s = self.stats
@@ -72,7 +73,13 @@ class FloatClusterer:
         }  # fmt: skip
 
 
-MODELS = {"float": FloatClusterer}
+def _fixed_clusterer(*args, **kwargs):
+    from evclust.fixed.model import FixedClusterer  # the fixed model reads the parameters' formats table
+
+    return FixedClusterer(*args, **kwargs)
+
+
+MODELS = {"float": FloatClusterer, "fixed": _fixed_clusterer}
 
 
 def records_to_tracks(rows: np.ndarray) -> np.ndarray:
@@ -84,16 +91,16 @@ def records_to_tracks(rows: np.ndarray) -> np.ndarray:
 
 
 def track_events(
-    events: np.ndarray, meta: EventMeta, params: ClustererParams, model: str = "float", progress: bool = False
+    events: np.ndarray, meta: EventMeta, params: ClustererParams, model: str = "float", progress: bool = False, **options
 ) -> TrackRun:
-    """Run a clusterer model over a whole stream."""
+    """Run a clusterer model over a whole stream; `options` go to the model (fixed: ranges=True)."""
     if model not in MODELS:
         raise EvclustError(f"unknown model '{model}' (available: {', '.join(MODELS)})")
     t_frame_us = params.t_frame_us or meta.t_frame_us
     if not t_frame_us:
         raise EvclustError(f"{meta.source or 'events'}: no frame period: set clusterer.t_frame_us (velocities are in px/frame)")
     has_colour = bool(meta.has_colour)
-    clusterer = MODELS[model](params, meta.width, meta.height, float(t_frame_us), has_colour)
+    clusterer = MODELS[model](params, meta.width, meta.height, float(t_frame_us), has_colour, **options)
     start = time.perf_counter()
     pieces = []
     with tqdm(total=events.size, unit="ev", unit_scale=True, disable=None if progress else True, desc=f"track ({model})") as bar:
@@ -117,4 +124,4 @@ def track_events(
         exit_margin=params.exit_margin,
         has_colour=has_colour,
     )
-    return TrackRun(records_to_tracks(rows), track_meta, clusterer.stats(), wall)
+    return TrackRun(records_to_tracks(rows), track_meta, clusterer.stats(), wall, clusterer)

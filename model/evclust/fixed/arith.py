@@ -159,7 +159,7 @@ raw_limits_nb = njit(cache=True)(raw_limits)
 saturate_nb = njit(cache=True)(saturate)
 saturate_flag_nb = njit(cache=True)(saturate_flag)
 wrap_nb = njit(cache=True)(wrap)
-shift_round_nb = njit(cache=True)(shift_round)
+shift_round_nb = njit(cache=True, inline="always")(shift_round)  # inlined: a constant mode folds away
 
 
 # --------------------------------------------------------------------------------------------
@@ -238,10 +238,10 @@ def quantise(x, signed, int_bits, frac_bits, rounding="nearest", overflow="satur
 @njit(cache=True)
 def quantise_nb(x, signed, int_bits, frac_bits, rmode, omode):
     """numba twin of `quantise` for a float64 ``x``, with mode codes. Exact (equal to `quantise`)
-    for every finite ``x`` unless ``x·2^frac_bits`` underflows into subnormals (negative
-    ``frac_bits`` and |x| < 2^-1000): scaling by a power of two and floor/trunc are exact in
-    binary floating point, and the half-up test compares ``v`` with ``floor(v) + 0.5``, which is
-    exact whenever ``v`` is not an integer (|v| < 2^52)."""
+    for every finite ``x``: scaling by a power of two and floor/trunc are exact in binary floating
+    point, a scaling that underflows to 0 is resolved from x's sign, and the half-up test
+    compares ``v`` with ``floor(v) + 0.5``, which is exact whenever ``v`` is not an integer
+    (|v| < 2^52). Subnormal products that do not reach 0 keep their exact value in float64."""
     lo, hi = raw_limits_nb(signed, int_bits, frac_bits)
     if x != x:
         raise ValueError("quantise: cannot quantise NaN")
@@ -255,7 +255,10 @@ def quantise_nb(x, signed, int_bits, frac_bits, rmode, omode):
     elif omode != SATURATE:
         raise ValueError("quantise: unknown overflow mode code")
     v = x * 2.0**frac_bits
-    if rmode == FLOOR:
+    if v == 0.0 and x != 0.0:
+        # x·2^f underflowed: the exact value is a tiny non-zero, below one LSB in magnitude.
+        r = -1.0 if (rmode == FLOOR and x < 0.0) else 0.0
+    elif rmode == FLOOR:
         r = np.floor(v)
     elif rmode == NEAREST:
         r = np.floor(v)
@@ -312,7 +315,7 @@ def alpha_step(x, u, beta_raw, beta_frac_bits, guard_bits, mode):
     return x + shift_round(((u << guard_bits) - x) * beta_raw, beta_frac_bits, mode)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def alpha_step_nb(x, u, beta_raw, beta_frac_bits, guard_bits, mode):
     """numba twin of `alpha_step`."""
     return x + shift_round_nb(((u << guard_bits) - x) * beta_raw, beta_frac_bits, mode)

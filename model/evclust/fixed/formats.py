@@ -157,18 +157,20 @@ def build_formats(params: ClustererParams, width: int, height: int, t_frame_us: 
         Format("half_size", False, _bits_for(p.r_max), guard("beta_size"), "state", "half-size R, px"),
         Format("activity", False, _bits_for((1 << 16)), 8, "state", "decayed event count A"),
         Format("t_last", False, 32, 0, "state", "time the activity refers to, µs", overflow="wrap"),
-        Format("v_mcm", True, _bits_for(v_full), guard("beta_vel_mcm"), "state", "MCM velocity accumulator, px/frame"),
+        # V_MCM's input γ·(P_new - P) is large per event even when V is small: γ reaches ~10^4.
+        Format("v_mcm", True, 12, guard("beta_vel_mcm"), "state", "MCM velocity accumulator and its input, px/frame"),
         Format("mcm_norm", False, 0, guard("beta_vel_mcm"), "state", "1 - α_vm^n: the MCM filter run on 1"),
         Format("v_int", True, _bits_for(v_full), 12, "state", "interval velocity, px/frame"),
         Format("colour", False, 8, guard("beta_chro") if p.alpha_chro >= p.alpha_lum else guard("beta_lum"), "state", "cluster colour Y, Cb, Cr"),
         Format("background", False, 8, guard("beta_bg"), "state", "background colour Y, Cb, Cr"),
-        Format("gamma", False, 12, 8, "state", "γ: events per frame"),
+        Format("gamma", False, 14, 8, "state", "γ: events per frame (the activity estimate reaches ~8000 early on)"),
         Format("events_in_interval", False, 16, 0, "state", "events of the cluster since the last τ boundary"),
         Format("hist", False, p.hist_bits, 0, "state", "palette histogram counter"),
         Format("id", False, 32, 0, "state", "cluster id", overflow="wrap"),
         Format("offset", True, coord, pos_frac, "intermediate", "e - P, px"),
         Format("seek_distance", False, seek_int, pos_frac, "intermediate", "L1 distance and seek bounds, px"),
         Format("centre_step", True, 4, pos_frac, "intermediate", "P_new - P, px"),
+        Format("size_target", False, coord + _bits_for(p.size_gain), guard("beta_size"), "intermediate", "g_R·|e - P|, px, before R's clamp"),
         Format("speed_sq", False, 2 * _bits_for(v_full) + 1, 16, "intermediate", "|V|², (px/frame)²"),
         Format("colour_distance", False, 11, 0, "intermediate", "palette L1 distance and vote"),
         Format("dt", False, 32, 0, "intermediate", "t - t_last, µs (modulo 2^32)", overflow="wrap"),
@@ -184,7 +186,7 @@ def build_formats(params: ClustererParams, width: int, height: int, t_frame_us: 
     for name, beta in betas.items():
         const(name, beta, False, 0, beta_bits[name], f"clusterer.alpha_{name[5:]}", f"1 - α of the {name[5:]} filter")
     const("size_gain", p.size_gain, False, _bits_for(p.size_gain), 8, "clusterer.size_gain", "g_R")
-    const("inv_t_half", 1.0 / p.t_half_us, False, 0, max(0, math.ceil(math.log2(p.t_half_us))) + 16, "clusterer.t_half_us", "1/T_half, per µs")
+    const("inv_t_half", 1.0 / p.t_half_us, False, 0, max(0, math.ceil(math.log2(p.t_half_us))) + 24, "clusterer.t_half_us", "1/T_half, per µs")
     const("gamma_global", p.gamma, False, 12, 8, "clusterer.gamma", "the paper's global γ")
     const("gamma_per_activity", math.log(2) * t_frame_us / p.t_half_us, False, _bits_for(math.log(2) * t_frame_us / p.t_half_us), 16, "clusterer.t_half_us", "ln2·T_frame/T_half")
     const("frame_per_tau", t_frame_us / p.tau_us, False, _bits_for(t_frame_us / p.tau_us), 16, "clusterer.tau_us", "T_frame/τ")

@@ -1,0 +1,477 @@
+"""The bit-accurate fixed-point clusterer: SPEC §4 in integer arithmetic, one operation per line,
+each result in its format of the formats table (docs/FIXED_POINT.md is the datapath, step by step).
+
+Raw int64 values throughout; floor rounding (an arithmetic shift) wherever bits are dropped;
+every store saturates to its format and counts it in the overflow log, except the 32-bit time,
+which wraps by design. The state layout is the float model's (clusterer/layout.py).
+"""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+
+from evclust.clusterer.layout import (
+    ACT, BG_CB, BG_CR, BG_Y, CCB, CCR, CREATED, CY, DROPPED, EV_COUNT, EVENTS, EVER_REPORTED, EVICTED,
+    DECAY_RESIDUAL, EXITED, EXPIRED, FLAG_BORDER, FLAG_MOVING_INT, FLAG_MOVING_MCM, FLAG_NEW, GAMMA, ID, MCM_NORM,
+    NEXT_ID, NOISE, PPX, PPY, PX, PY, RECORD_COLUMNS, REPORTED, RX, RY, SINCE_FILTER, STEP, T_FILTER,
+    T_LAST, VALID, VI_COUNT, VIX, VIY, VMX, VMY,
+)  # fmt: skip
+from evclust.fixed.arith import FLOOR, alpha_step_nb, shift_round_nb
+
+TIME_MASK = (1 << 32) - 1
+# Globals beyond the float model's: the τ phase (µs since the last boundary).
+TAU_PHASE = 14
+N_GLOBALS = 15
+
+# Signals of the overflow log and the range instrumentation.
+SIGNALS = (
+    "centre", "half_size", "activity", "v_mcm", "mcm_norm", "v_int", "colour", "background", "gamma",
+    "events_in_interval", "hist", "centre_step", "speed_sq", "mcm_step", "size_target",
+)  # fmt: skip
+(
+    S_CENTRE, S_HALF, S_ACT, S_VM, S_NORM, S_VI, S_COLOUR, S_BG, S_GAMMA, S_EVCOUNT, S_HIST, S_STEP,
+    S_SPEED, S_MCM_IN, S_SIZE_TARGET,
+) = range(len(SIGNALS))  # fmt: skip
+
+# The constant vector the compiled loop reads (built by `constant_vector`).
+(
+    C_FP, C_FR, C_FA, C_FV, C_FW, C_FI, C_FC, C_FB, C_FG,
+    C_SEEK, C_R_INIT, C_R_MIN, C_R_MAX, C_GAIN, C_GAIN_F,
+    C_B_POS, C_BB_POS, C_B_SIZE, C_BB_SIZE, C_B_VM, C_BB_VM, C_B_VI, C_BB_VI,
+    C_B_LUM, C_BB_LUM, C_B_CHRO, C_BB_CHRO, C_B_BG, C_BB_BG,
+    C_INV_TH, C_INV_TH_F, C_A_MIN, C_A_VALID, C_EVERY,
+    C_GAMMA_MODE, C_GAMMA_GLOBAL, C_GPA, C_GPA_F, C_FPT, C_FPT_F, C_TAU_US,
+    C_INV_P, C_INV_P_F, C_BG_FIXED, C_LUMA_W, C_LUMA_W_F, C_H_MAX,
+    C_V_MIN_SQ, C_V_EXIT_SQ, C_SQ_F, C_COS_SQ, C_COS_SQ_F, C_EXIT_M,
+    C_WIDTH, C_HEIGHT, C_COLOUR, C_WARM, C_MCM_CORRECT, C_VOTE_CONTRAST, C_MIXING, C_MIX_TOL,
+    C_MAX_CENTRE, C_MAX_ACT, C_MAX_V, C_MIN_V, C_MAX_VI, C_MIN_VI, C_MAX_W, C_MAX_GAMMA, C_MAX_COLOUR,
+    C_MAX_BG, C_MAX_EVCOUNT, C_MAX_HALF, C_MAX_SIZE_TARGET,
+) = range(74)  # fmt: skip
+N_CONSTANTS = 74
+
+
+def constant_vector(table, params, has_colour: bool) -> np.ndarray:
+    """The formats table and the parameters as the int64 vector the loop reads."""
+    f, c = table.formats, table.constants
+    k = np.zeros(N_CONSTANTS, np.int64)
+    k[C_FP], k[C_FR], k[C_FA] = f["centre"].frac_bits, f["half_size"].frac_bits, f["activity"].frac_bits
+    k[C_FV], k[C_FW], k[C_FI] = f["v_mcm"].frac_bits, f["mcm_norm"].frac_bits, f["v_int"].frac_bits
+    k[C_FC], k[C_FB], k[C_FG] = f["colour"].frac_bits, f["background"].frac_bits, f["gamma"].frac_bits
+
+    def raw(name, default=0):
+        return c[name].raw if name in c else default
+
+    k[C_SEEK] = raw("seek_margin")  # centre fraction bits
+    k[C_R_INIT], k[C_R_MIN], k[C_R_MAX] = raw("r_init"), raw("r_min"), raw("r_max")
+    k[C_GAIN], k[C_GAIN_F] = raw("size_gain"), c["size_gain"].fmt.frac_bits
+    for code, bits, name in ((C_B_POS, C_BB_POS, "beta_pos"), (C_B_SIZE, C_BB_SIZE, "beta_size"),
+                             (C_B_VM, C_BB_VM, "beta_vel_mcm"), (C_B_VI, C_BB_VI, "beta_vel_int"),
+                             (C_B_LUM, C_BB_LUM, "beta_lum"), (C_B_CHRO, C_BB_CHRO, "beta_chro"),
+                             (C_B_BG, C_BB_BG, "beta_bg")):  # fmt: skip
+        k[code], k[bits] = c[name].raw, c[name].fmt.frac_bits
+    k[C_INV_TH], k[C_INV_TH_F] = raw("inv_t_half"), c["inv_t_half"].fmt.frac_bits
+    k[C_A_MIN], k[C_A_VALID], k[C_EVERY] = raw("a_min"), raw("a_valid"), params.filter_every
+    k[C_GAMMA_MODE] = ("global", "activity", "count").index(params.gamma_mode)
+    k[C_GAMMA_GLOBAL] = raw("gamma_global")
+    k[C_GPA], k[C_GPA_F] = raw("gamma_per_activity"), c["gamma_per_activity"].fmt.frac_bits
+    k[C_FPT], k[C_FPT_F] = raw("frame_per_tau"), c["frame_per_tau"].fmt.frac_bits
+    k[C_TAU_US] = int(round(params.tau_us))
+    k[C_INV_P], k[C_INV_P_F] = raw("inv_p"), c["inv_p"].fmt.frac_bits
+    k[C_BG_FIXED] = params.background is not None
+    k[C_LUMA_W], k[C_LUMA_W_F] = raw("luma_weight"), (c["luma_weight"].fmt.frac_bits if "luma_weight" in c else 0)
+    k[C_H_MAX] = (1 << params.hist_bits) - 1
+    k[C_V_MIN_SQ], k[C_V_EXIT_SQ], k[C_SQ_F] = raw("v_min_sq"), raw("v_exit_sq"), f["speed_sq"].frac_bits
+    k[C_COS_SQ], k[C_COS_SQ_F] = raw("cos_sq_exit"), 16
+    k[C_EXIT_M] = raw("exit_margin")
+    k[C_WIDTH], k[C_HEIGHT], k[C_COLOUR] = table.width, table.height, has_colour
+    k[C_WARM], k[C_MCM_CORRECT] = params.velocity_warm_start, params.mcm_bias_correction
+    k[C_VOTE_CONTRAST], k[C_MIXING], k[C_MIX_TOL] = params.palette_vote == "contrast", params.palette_assign == "mixing", raw("mixing_tolerance")
+    k[C_MAX_CENTRE], k[C_MAX_ACT], k[C_MAX_HALF] = f["centre"].raw_max, f["activity"].raw_max, f["half_size"].raw_max
+    k[C_MAX_SIZE_TARGET] = f["size_target"].raw_max
+    k[C_MAX_V], k[C_MIN_V] = f["v_mcm"].raw_max, f["v_mcm"].raw_min
+    k[C_MAX_VI], k[C_MIN_VI] = f["v_int"].raw_max, f["v_int"].raw_min
+    k[C_MAX_W], k[C_MAX_GAMMA], k[C_MAX_COLOUR] = f["mcm_norm"].raw_max, f["gamma"].raw_max, f["colour"].raw_max
+    k[C_MAX_BG], k[C_MAX_EVCOUNT] = f["background"].raw_max, f["events_in_interval"].raw_max
+    return k
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _store(value, lo, hi, signal, log, ranges):
+    """Saturate to [lo, hi] and count a saturation; with range instrumentation on (a `ranges`
+    array with rows), also keep the value's range before saturation."""
+    if ranges.shape[0] > 0:
+        if value < ranges[signal, 0]:
+            ranges[signal, 0] = value
+        if value > ranges[signal, 1]:
+            ranges[signal, 1] = value
+    if value < lo:
+        log[signal] += 1
+        return lo
+    if value > hi:
+        log[signal] += 1
+        return hi
+    return value
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _seen(value, signal, ranges):
+    """Range instrumentation of a value that cannot leave its format (an α filter's result lies
+    between its state and its input, both in range): no saturation logic, just min/max."""
+    if ranges.shape[0] > 0:
+        if value < ranges[signal, 0]:
+            ranges[signal, 0] = value
+        if value > ranges[signal, 1]:
+            ranges[signal, 1] = value
+    return value
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _align(raw, from_frac, to_frac):
+    """Change the fraction bits of a raw value (floor when dropping)."""
+    if to_frac >= from_frac:
+        return raw << (to_frac - from_frac)
+    return raw >> (from_frac - to_frac)
+
+
+DECAY_TABLE_BITS, DECAY_FRAC_BITS = 6, 16
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _decay_steps(dt, residual, k):
+    """Δt/T_half as whole table steps (2^-6 half-lives) and the residual left below one step.
+
+    Δt·(1/T_half) is a multiply; the bits below one table step are kept for the next time,
+    so events microseconds apart still decay (a per-event floor would lose it all)."""
+    n = dt * k[C_INV_TH] + residual
+    drop = k[C_INV_TH_F] - DECAY_TABLE_BITS
+    return n >> drop, n & ((np.int64(1) << drop) - 1)
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _apply_decay(a, m, table):
+    """a · 2^-(m / 64): the integer part of m/64 is a shift, its fraction a table entry."""
+    total = (m >> DECAY_TABLE_BITS) + DECAY_FRAC_BITS
+    if total > 62:
+        return np.int64(0)
+    return shift_round_nb(a * table[m & ((1 << DECAY_TABLE_BITS) - 1)], total, FLOOR)
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _decayed(a, dt, k, table):
+    """For comparisons only (eviction): the activity decayed to now, the slot left unchanged."""
+    m, _ = _decay_steps(dt, 0, k)
+    return _apply_decay(a, m, table)
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _decay_slot(S, s, t, k, table):
+    """Decay the slot's activity to t, carrying the residual; t becomes its reference time."""
+    m, S[s, DECAY_RESIDUAL] = _decay_steps((t - S[s, T_LAST]) & TIME_MASK, S[s, DECAY_RESIDUAL], k)
+    S[s, ACT] = _apply_decay(S[s, ACT], m, table)
+    S[s, T_LAST] = t
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _gamma_from_activity(a, k):
+    if k[C_GAMMA_MODE] == 0:
+        return k[C_GAMMA_GLOBAL]
+    return (a * k[C_GPA]) >> (k[C_FA] + k[C_GPA_F] - k[C_FG])  # A · ln2·T_frame/T_half, in γ's format
+
+
+@numba.njit(cache=True, nogil=True)
+def _seek(S, x, y, k):
+    best, best_d = -1, np.int64(1) << 62
+    fp, fr = k[C_FP], k[C_FR]
+    for s in range(S.shape[0]):
+        if S[s, VALID] == 0:
+            continue
+        dx = abs(x - S[s, PX])
+        dy = abs(y - S[s, PY])
+        if dx <= _align(S[s, RX], fr, fp) + k[C_SEEK] and dy <= _align(S[s, RY], fr, fp) + k[C_SEEK]:
+            d = dx + dy
+            if d < best_d:
+                best, best_d = s, d
+    return best
+
+
+@numba.njit(cache=True, nogil=True)
+def _nearest_palette(ey, ecb, ecr, palette, k):
+    """Integer L1 with the luminance weighted; distances in units of 2^-F_w."""
+    best, best_d = 0, np.int64(1) << 62
+    fw = k[C_LUMA_W_F]
+    for j in range(palette.shape[0]):
+        d = k[C_LUMA_W] * abs(ey - palette[j, 0]) + ((abs(ecb - palette[j, 1]) + abs(ecr - palette[j, 2])) << fw)
+        if d < best_d:
+            best, best_d = j, d
+    return best
+
+
+@numba.njit(cache=True, nogil=True)
+def _mixing_palette(ey, ecb, ecr, bg, palette, inv_ww, background_mask, k):
+    """The mixing rule (docs/FIXED_POINT.md): q in Q0.16 from a precomputed 1/|w|², then the
+    L1 residual against the tolerance; distances in units of 2^-F_w."""
+    fw = k[C_LUMA_W_F]
+    tol = k[C_MIX_TOL] << fw
+    uy, ucb, ucr = ey - bg[0], ecb - bg[1], ecr - bg[2]
+    best, best_d = -1, np.int64(1) << 62
+    for j in range(palette.shape[0]):
+        d_end = k[C_LUMA_W] * abs(ey - palette[j, 0]) + ((abs(ecb - palette[j, 1]) + abs(ecr - palette[j, 2])) << fw)
+        if background_mask[j]:
+            d_line = d_end
+        else:
+            wy, wcb, wcr = palette[j, 0] - bg[0], palette[j, 1] - bg[1], palette[j, 2] - bg[2]
+            dot = uy * wy + ucb * wcb + ucr * wcr
+            q = 0 if dot <= 0 else min((dot * inv_ww[j]) >> 16, np.int64(1) << 16)  # Q0.16
+            ry, rcb, rcr = (uy << 16) - q * wy, (ucb << 16) - q * wcb, (ucr << 16) - q * wcr
+            d_line = (k[C_LUMA_W] * abs(ry) + ((abs(rcb) + abs(rcr)) << fw)) >> 16
+        if d_line <= tol and d_end < best_d:
+            best, best_d = j, d_end
+    return best if best >= 0 else _nearest_palette(ey, ecb, ecr, palette, k)
+
+
+@numba.njit(cache=True, nogil=True)
+def refresh_mixing(G, palette, inv_ww, k):
+    """1/|palette_j - BG|² in Q0.32 (integer colours): a division per entry, at filter steps only."""
+    fb = k[C_FB]
+    for j in range(palette.shape[0]):
+        wy = palette[j, 0] - (G[BG_Y] >> fb)
+        wcb = palette[j, 1] - (G[BG_CB] >> fb)
+        wcr = palette[j, 2] - (G[BG_CR] >> fb)
+        ww = wy * wy + wcb * wcb + wcr * wcr
+        inv_ww[j] = 0 if ww == 0 else (np.int64(1) << 32) // ww
+
+
+@numba.njit(cache=True, nogil=True)
+def _create(S, H, G, s, t, ex, ey, lum, cb, cr, k):
+    S[s, :] = 0
+    S[s, VALID] = 1
+    S[s, ID] = G[NEXT_ID]
+    G[NEXT_ID] = (G[NEXT_ID] + 1) & TIME_MASK  # 32-bit id, wraps by design
+    x, y = ex << k[C_FP], ey << k[C_FP]
+    S[s, PX], S[s, PY], S[s, PPX], S[s, PPY] = x, y, x, y
+    S[s, RX], S[s, RY] = k[C_R_INIT], k[C_R_INIT]
+    S[s, ACT] = np.int64(1) << k[C_FA]
+    S[s, GAMMA] = _gamma_from_activity(S[s, ACT], k)
+    S[s, T_LAST] = t
+    S[s, CY], S[s, CCB], S[s, CCR] = lum << k[C_FC], cb << k[C_FC], cr << k[C_FC]
+    H[s, :] = 0
+    G[CREATED] += 1
+
+
+@numba.njit(cache=True, nogil=True)
+def _update(S, H, G, s, t, ex, ey, lum, cb, cr, k, table, palette, inv_ww, background_mask, log, ranges):
+    fp, fr = k[C_FP], k[C_FR]
+    # 3a. Activity: decay over (t - t_last) mod 2^32, then count the event.
+    _decay_slot(S, s, t, k, table)
+    S[s, ACT] = _store(S[s, ACT] + (np.int64(1) << k[C_FA]), 0, k[C_MAX_ACT], S_ACT, log, ranges)
+    # 3b. Centre: P += β_P (e - P), the event in P's format with all its fraction bits as guard.
+    px, py = S[s, PX], S[s, PY]
+    px_new = alpha_step_nb(px, ex, k[C_B_POS], k[C_BB_POS], fp, FLOOR)
+    py_new = alpha_step_nb(py, ey, k[C_B_POS], k[C_BB_POS], fp, FLOOR)
+    # 3c. Size: R += β_R (g_R |e - P| - R), then the clamp.
+    gx = (abs((ex << fp) - px) * k[C_GAIN]) >> (k[C_GAIN_F] + fp - fr)
+    gy = (abs((ey << fp) - py) * k[C_GAIN]) >> (k[C_GAIN_F] + fp - fr)
+    gx = _store(gx, 0, k[C_MAX_SIZE_TARGET], S_SIZE_TARGET, log, ranges)
+    gy = _store(gy, 0, k[C_MAX_SIZE_TARGET], S_SIZE_TARGET, log, ranges)
+    S[s, RX] = _seen(min(max(alpha_step_nb(S[s, RX], gx, k[C_B_SIZE], k[C_BB_SIZE], 0, FLOOR), k[C_R_MIN]), k[C_R_MAX]), S_HALF, ranges)
+    S[s, RY] = _seen(min(max(alpha_step_nb(S[s, RY], gy, k[C_B_SIZE], k[C_BB_SIZE], 0, FLOOR), k[C_R_MIN]), k[C_R_MAX]), S_HALF, ranges)
+    # 3d. MCM: V += β_vm (γ (P_new - P) - V); the same filter on 1 gives the bias-correction weight.
+    step_x = _store(px_new - px, -(np.int64(1) << (4 + fp)), (np.int64(1) << (4 + fp)) - 1, S_STEP, log, ranges)
+    step_y = _store(py_new - py, -(np.int64(1) << (4 + fp)), (np.int64(1) << (4 + fp)) - 1, S_STEP, log, ranges)
+    ux = _store(_align(S[s, GAMMA] * step_x, k[C_FG] + fp, k[C_FV]), k[C_MIN_V], k[C_MAX_V], S_MCM_IN, log, ranges)
+    uy = _store(_align(S[s, GAMMA] * step_y, k[C_FG] + fp, k[C_FV]), k[C_MIN_V], k[C_MAX_V], S_MCM_IN, log, ranges)
+    S[s, VMX] = _seen(alpha_step_nb(S[s, VMX], ux, k[C_B_VM], k[C_BB_VM], 0, FLOOR), S_VM, ranges)
+    S[s, VMY] = _seen(alpha_step_nb(S[s, VMY], uy, k[C_B_VM], k[C_BB_VM], 0, FLOOR), S_VM, ranges)
+    S[s, MCM_NORM] = alpha_step_nb(S[s, MCM_NORM], k[C_MAX_W] + 1, k[C_B_VM], k[C_BB_VM], 0, FLOOR)
+    S[s, MCM_NORM] = _store(S[s, MCM_NORM], 0, k[C_MAX_W], S_NORM, log, ranges)
+    S[s, PX] = _seen(px_new, S_CENTRE, ranges)
+    S[s, PY] = _seen(py_new, S_CENTRE, ranges)
+    if k[C_COLOUR] != 0:
+        # 3e. Colour: three α filters, the event's byte with all of C's fraction bits as guard.
+        fc = k[C_FC]
+        S[s, CY] = _seen(alpha_step_nb(S[s, CY], lum, k[C_B_LUM], k[C_BB_LUM], fc, FLOOR), S_COLOUR, ranges)
+        S[s, CCB] = _seen(alpha_step_nb(S[s, CCB], cb, k[C_B_CHRO], k[C_BB_CHRO], fc, FLOOR), S_COLOUR, ranges)
+        S[s, CCR] = _seen(alpha_step_nb(S[s, CCR], cr, k[C_B_CHRO], k[C_BB_CHRO], fc, FLOOR), S_COLOUR, ranges)
+        # 3f. Palette vote.
+        fb = k[C_FB]
+        bg = (G[BG_Y] >> fb, G[BG_CB] >> fb, G[BG_CR] >> fb)
+        if k[C_MIXING] != 0:
+            c = _mixing_palette(lum, cb, cr, bg, palette, inv_ww, background_mask, k)
+        else:
+            c = _nearest_palette(lum, cb, cr, palette, k)
+        vote = np.int64(1)
+        if k[C_VOTE_CONTRAST] != 0:
+            vote = abs(lum - bg[0]) + abs(cb - bg[1]) + abs(cr - bg[2])
+        # Saturating by design (SPEC §4): reaching the top halves every counter, so not an overflow.
+        H[s, c] = min(_seen(H[s, c] + vote, S_HIST, ranges), k[C_H_MAX])
+        if H[s, c] >= k[C_H_MAX]:
+            for j in range(H.shape[1]):
+                H[s, j] >>= 1
+    S[s, EV_COUNT] = _store(S[s, EV_COUNT] + 1, 0, k[C_MAX_EVCOUNT], S_EVCOUNT, log, ranges)
+    S[s, T_LAST] = t
+
+
+@numba.njit(cache=True, nogil=True)
+def _slot_for_new(S, G, t, k, table):
+    for s in range(S.shape[0]):
+        if S[s, VALID] == 0:
+            return s
+    weakest, weakest_a = -1, np.int64(1) << 62
+    for s in range(S.shape[0]):
+        a = _decayed(S[s, ACT], (t - S[s, T_LAST]) & TIME_MASK, k, table)
+        if a < weakest_a:
+            weakest, weakest_a = s, a
+    if weakest_a < k[C_A_VALID]:
+        G[EVICTED] += 1
+        return weakest
+    return -1
+
+
+@numba.njit(cache=True, nogil=True)
+def _near(px, py, k):
+    m = k[C_EXIT_M]
+    hi_x = ((k[C_WIDTH] - 1) << k[C_FP]) - m
+    hi_y = ((k[C_HEIGHT] - 1) << k[C_FP]) - m
+    return px < m, px > hi_x, py < m, py > hi_y
+
+
+@numba.njit(cache=True, nogil=True)
+def _speed_sq(vx, vy, frac, k):
+    """|V|² in the speed_sq format from a velocity with `frac` fraction bits."""
+    return _align(vx * vx + vy * vy, 2 * frac, k[C_SQ_F])
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _corrected(colour, background, k):
+    """Eq. (11): BG + (C - BG)·(1/p), in C's format, clamped to the byte range."""
+    bg = _align(background, k[C_FB], k[C_FC])
+    obj = bg + (((colour - bg) * k[C_INV_P]) >> k[C_INV_P_F])
+    return min(max(obj, 0), k[C_MAX_COLOUR])
+
+
+@numba.njit(cache=True, nogil=True)
+def _filter_step(S, H, G, t, k, table, palette, inv_ww, background_mask, out, n_out, log, ranges):
+    # τ boundaries since the last step, from a phase counter (no division of the wrapping time).
+    phase = G[TAU_PHASE] + ((t - G[T_FILTER]) & TIME_MASK)
+    boundaries = phase // k[C_TAU_US]
+    G[TAU_PHASE] = phase - boundaries * k[C_TAU_US]
+    per_frame = k[C_FPT] // max(boundaries, 1)  # T_frame/(n·τ), Q?.F_fpt
+    fp, fv, fw, fi, fc, fb = k[C_FP], k[C_FV], k[C_FW], k[C_FI], k[C_FC], k[C_FB]
+    for s in range(S.shape[0]):
+        if S[s, VALID] == 0:
+            continue
+        _decay_slot(S, s, t, k, table)
+        if S[s, ACT] < k[C_A_MIN]:
+            S[s, VALID] = 0
+            G[EXPIRED] += 1
+            continue
+        if k[C_GAMMA_MODE] != 2 or S[s, VI_COUNT] == 0:
+            S[s, GAMMA] = _store(_gamma_from_activity(S[s, ACT], k), 0, k[C_MAX_GAMMA], S_GAMMA, log, ranges)
+        if boundaries > 0:
+            if k[C_GAMMA_MODE] == 2 and S[s, VI_COUNT] >= 1:
+                g = (S[s, EV_COUNT] * per_frame) >> (k[C_FPT_F] - k[C_FG])
+                S[s, GAMMA] = _store(g, 0, k[C_MAX_GAMMA], S_GAMMA, log, ranges)
+            S[s, EV_COUNT] = 0
+            mx = _store(_align((S[s, PX] - S[s, PPX]) * per_frame, fp + k[C_FPT_F], fi), k[C_MIN_VI], k[C_MAX_VI], S_VI, log, ranges)
+            my = _store(_align((S[s, PY] - S[s, PPY]) * per_frame, fp + k[C_FPT_F], fi), k[C_MIN_VI], k[C_MAX_VI], S_VI, log, ranges)
+            if k[C_WARM] == 0 or S[s, VI_COUNT] >= 2:
+                S[s, VIX] = alpha_step_nb(S[s, VIX], mx, k[C_B_VI], k[C_BB_VI], 0, FLOOR)
+                S[s, VIY] = alpha_step_nb(S[s, VIY], my, k[C_B_VI], k[C_BB_VI], 0, FLOOR)
+            elif S[s, VI_COUNT] == 1:
+                S[s, VIX], S[s, VIY] = mx, my
+            S[s, VI_COUNT] = min(S[s, VI_COUNT] + 1, 2)
+            S[s, PPX], S[s, PPY] = S[s, PX], S[s, PY]
+        # The reported MCM velocity: V / w, the sweep's one division.
+        vmx, vmy = S[s, VMX], S[s, VMY]
+        if k[C_MCM_CORRECT] != 0 and S[s, MCM_NORM] > 0:
+            vmx = (S[s, VMX] << fw) // S[s, MCM_NORM]
+            vmy = (S[s, VMY] << fw) // S[s, MCM_NORM]
+        # Exit prediction on the squared speed (no square root).
+        speed_sq = _store(_speed_sq(vmx, vmy, fv, k), 0, np.int64(1) << 62, S_SPEED, log, ranges)
+        left, right, top, bottom = _near(S[s, PX], S[s, PY], k)
+        if speed_sq >= k[C_V_EXIT_SQ] and speed_sq > 0:
+            limit = (speed_sq * k[C_COS_SQ]) >> k[C_COS_SQ_F]
+            if (left and vmx < 0 and _speed_sq(vmx, 0, fv, k) >= limit) or (right and vmx > 0 and _speed_sq(vmx, 0, fv, k) >= limit) \
+                    or (top and vmy < 0 and _speed_sq(0, vmy, fv, k) >= limit) or (bottom and vmy > 0 and _speed_sq(0, vmy, fv, k) >= limit):  # fmt: skip
+                S[s, VALID] = 0
+                G[EXITED] += 1
+                continue
+        moving_mcm = _speed_sq(S[s, VMX], S[s, VMY], fv, k) >= k[C_V_MIN_SQ]
+        moving_int = _speed_sq(S[s, VIX], S[s, VIY], fi, k) >= k[C_V_MIN_SQ]
+        reported = S[s, ACT] >= k[C_A_VALID] and (moving_mcm or moving_int)
+        if S[s, ACT] >= k[C_A_VALID] and not reported:
+            G[NOISE] += 1
+        S[s, REPORTED] = 1 if reported else 0
+        if not reported:
+            continue
+        row = out[n_out]
+        row[0], row[1], row[2], row[3] = t, G[STEP], s, S[s, ID]
+        row[4], row[5] = S[s, PX] / 2.0**fp, S[s, PY] / 2.0**fp
+        row[6], row[7] = S[s, RX] / 2.0 ** k[C_FR], S[s, RY] / 2.0 ** k[C_FR]
+        row[8] = S[s, ACT] / 2.0 ** k[C_FA]
+        row[9], row[10] = vmx / 2.0**fv, vmy / 2.0**fv
+        row[11], row[12] = S[s, VIX] / 2.0**fi, S[s, VIY] / 2.0**fi
+        cls = -1
+        row[13], row[14], row[15] = 0.0, 0.0, 0.0
+        if k[C_COLOUR] != 0:
+            # Eq. (11): C_obj = BG + (C - BG)·(1/p), clamped to the byte range.
+            row[13] = _corrected(S[s, CY], G[BG_Y], k) / 2.0**fc
+            row[14] = _corrected(S[s, CCB], G[BG_CB], k) / 2.0**fc
+            row[15] = _corrected(S[s, CCR], G[BG_CR], k) / 2.0**fc
+            best = 0
+            for j in range(H.shape[1]):
+                if not background_mask[j] and H[s, j] > best:
+                    best, cls = H[s, j], j
+        row[16] = cls
+        flags = 0
+        if S[s, EVER_REPORTED] == 0:
+            flags |= FLAG_NEW
+        if left or right or top or bottom:
+            flags |= FLAG_BORDER
+        if moving_mcm:
+            flags |= FLAG_MOVING_MCM
+        if moving_int:
+            flags |= FLAG_MOVING_INT
+        row[17] = flags
+        S[s, EVER_REPORTED] = 1
+        n_out += 1
+    if k[C_MIXING] != 0 and k[C_BG_FIXED] == 0:
+        refresh_mixing(G, palette, inv_ww, k)
+    G[STEP] += 1
+    G[T_FILTER] = t
+    return n_out
+
+
+@numba.njit(cache=True, nogil=True)
+def run_events(S, H, G, k, table, palette, inv_ww, background_mask, t_us, xs, ys, lums, cbs, crs, out, log, ranges):
+    n_out = 0
+    fb = k[C_FB]
+    for i in range(t_us.size):
+        t = np.int64(t_us[i]) & TIME_MASK  # the 32-bit timestamp counter
+        ex, ey = np.int64(xs[i]), np.int64(ys[i])
+        lum, cb, cr = np.int64(lums[i]), np.int64(cbs[i]), np.int64(crs[i])
+        if G[EVENTS] == 0:
+            G[T_FILTER] = t
+            G[TAU_PHASE] = (np.int64(t_us[i]) % k[C_TAU_US])  # the float model's boundaries are multiples of τ
+        G[EVENTS] += 1
+        s = _seek(S, ex << k[C_FP], ey << k[C_FP], k)
+        updated_reported = False
+        if s < 0:
+            s = _slot_for_new(S, G, t, k, table)
+            if s >= 0:
+                _create(S, H, G, s, t, ex, ey, lum, cb, cr, k)
+            else:
+                G[DROPPED] += 1
+        else:
+            _update(S, H, G, s, t, ex, ey, lum, cb, cr, k, table, palette, inv_ww, background_mask, log, ranges)
+            updated_reported = S[s, REPORTED] != 0
+        if k[C_COLOUR] != 0 and k[C_BG_FIXED] == 0 and not updated_reported:
+            G[BG_Y] = _seen(alpha_step_nb(G[BG_Y], lum, k[C_B_BG], k[C_BB_BG], fb, FLOOR), S_BG, ranges)
+            G[BG_CB] = _seen(alpha_step_nb(G[BG_CB], cb, k[C_B_BG], k[C_BB_BG], fb, FLOOR), S_BG, ranges)
+            G[BG_CR] = _seen(alpha_step_nb(G[BG_CR], cr, k[C_B_BG], k[C_BB_BG], fb, FLOOR), S_BG, ranges)
+        G[SINCE_FILTER] += 1
+        if G[SINCE_FILTER] >= k[C_EVERY]:
+            G[SINCE_FILTER] = 0
+            n_out = _filter_step(S, H, G, t, k, table, palette, inv_ww, background_mask, out, n_out, log, ranges)
+    return n_out

@@ -1,0 +1,122 @@
+"""The fixed model against the float model, and its numerical hard cases (issue 4's suite, begun)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.optimize import linear_sum_assignment
+
+from evclust.clusterer import ClustererParams, track_events
+from evclust.events import EVENT_DTYPE, EventMeta
+
+from conftest import simulate_toml
+from test_clusterer import square_scene
+
+T_FRAME = 1e4
+
+
+@pytest.fixture(scope="module")
+def square():
+    return simulate_toml(square_scene([(120, (2.0, 1.0))], start=(40.0, 40.0), width=320, height=240, theta=0.1))
+
+
+PARAMS = dict(alpha_pos=0.995, v_min=0.0, tau_us=4 * T_FRAME, alpha_vel_int=0.8)
+
+
+def by_step(tracks):
+    out = {}
+    for row in tracks:
+        out.setdefault(int(row["step"]), []).append(row)
+    return out
+
+
+def test_fixed_follows_float_on_a_rigid_square(square):
+    params = ClustererParams(**PARAMS)
+    flt = track_events(square.events, square.meta, params, model="float")
+    fix = track_events(square.events, square.meta, params, model="fixed")
+    assert fix.stats["saturations"] == {}
+    a, b = by_step(flt.tracks), by_step(fix.tracks)
+    steps = set(a) | set(b)
+    same, dist = 0, []
+    for s in steps:
+        ra, rb = a.get(s, []), b.get(s, [])
+        if len(ra) == len(rb) and ra:
+            pa = np.array([[r["x"], r["y"]] for r in ra])
+            pb = np.array([[r["x"], r["y"]] for r in rb])
+            cost = np.linalg.norm(pa[:, None] - pb[None], axis=2)
+            i, j = linear_sum_assignment(cost)
+            same += 1
+            dist.extend(cost[i, j])
+    assert same >= 0.99 * len(steps)
+    late = np.array(dist[len(dist) // 4 :])  # after convergence
+    assert late.max() <= 0.25
+    # Velocities agree to a small fraction of the speed.
+    va = np.array([[r["vx_int"], r["vy_int"]] for r in flt.tracks[-50:]])
+    vb = np.array([[r["vx_int"], r["vy_int"]] for r in fix.tracks[-50:]])
+    assert np.max(np.abs(va - vb)) <= 0.02 * np.hypot(2.0, 1.0)
+
+
+def test_a_stream_across_the_timestamp_wrap_gives_the_same_tracks(square):
+    params = ClustererParams(**PARAMS)
+    # Shift by a whole number of τ so that τ boundaries fall at the same places, far enough that
+    # the 32-bit time wraps in the middle of the stream.
+    tau = int(params.tau_us)
+    span = int(square.events["t"][-1])
+    offset = ((1 << 32) - span // 2) // tau * tau
+    shifted = square.events.copy()
+    shifted["t"] += np.uint64(offset)
+    assert (int(shifted["t"][0]) >> 32) == 0 and (int(shifted["t"][-1]) >> 32) == 1
+    base = track_events(square.events, square.meta, params, model="fixed").tracks
+    moved = track_events(shifted, square.meta, params, model="fixed").tracks
+    assert base.size == moved.size > 0
+    for name in base.dtype.names:
+        if name == "t_us":
+            assert np.array_equal((base["t_us"] + np.uint64(offset)) & np.uint64(0xFFFFFFFF), moved["t_us"])
+        else:
+            assert np.array_equal(base[name], moved[name]), name
+
+
+def events_at(points):
+    ev = np.zeros(len(points), EVENT_DTYPE)
+    for i, (t, x, y, lum) in enumerate(points):
+        ev[i] = (t, x, y, 1, lum, 128, 128)
+    return ev
+
+
+META = EventMeta(width=64, height=48, source="unit", t_frame_us=T_FRAME)
+
+
+def test_a_burst_of_simultaneous_events_on_one_pixel_stays_bounded():
+    params = ClustererParams(v_min=0.0, a_valid=5.0)
+    burst = events_at([(1000, 10, 20, 200)] * 100_000)
+    run = track_events(burst, META, params, model="fixed")
+    assert run.stats["created"] == 1
+    # 10^5 events in zero time exceed what the counters are sized for (γ, the events of an
+    # interval): they saturate, are counted, and never wrap.
+    assert set(run.stats["saturations"]) <= {"gamma", "events_in_interval"}
+    last = run.tracks[-1]
+    # Every event is at (10, 20): the centre stays exactly there, the size at r_min.
+    assert (last["x"], last["y"]) == (10.0, 20.0) and last["rx"] == params.r_min
+    # No decay in zero time: the activity counts every event up to the last filter step, which
+    # comes after floor(N / N_f)·N_f events.
+    assert last["activity"] == (100_000 // params.filter_every) * params.filter_every
+
+
+def test_a_gap_of_hours_frees_the_old_clusters():
+    params = ClustererParams(v_min=0.0, a_valid=5.0, filter_every=16)
+    before = events_at([(1000 + i, 10, 20, 200) for i in range(64)])
+    hours = 2 * 3600 * 10**6  # longer than the 32-bit µs counter: it aliases to 48 min, still ≫ T_half
+    after = events_at([(1000 + hours + i, 50, 30, 200) for i in range(64)])
+    run = track_events(np.concatenate([before, after]), META, params, model="fixed")
+    assert run.stats["expired"] >= 1
+    late = run.tracks[run.tracks["t_us"] > (1000 + hours) % (1 << 32)]
+    assert set(late["id"].tolist()) == {1}  # only the new cluster is reported after the gap
+
+
+def test_inputs_at_every_extreme_never_saturate_state():
+    params = ClustererParams(v_min=0.0, a_valid=2.0, filter_every=8)
+    corners = [(0, 0), (63, 0), (0, 47), (63, 47)]
+    points = [(1000 * i + j, x, y, lum) for i, ((x, y), lum) in enumerate(zip(corners * 50, [0, 255] * 100)) for j in range(4)]
+    run = track_events(events_at(points), META, params, model="fixed")
+    assert run.stats["saturations"] == {}
+    assert np.all((run.tracks["x"] >= 0) & (run.tracks["x"] <= 63) & (run.tracks["y"] >= 0) & (run.tracks["y"] <= 47))
