@@ -181,14 +181,17 @@ def _gamma_from_activity(a, k):
 
 @numba.njit(cache=True, nogil=True)
 def _seek(S, x, y, k):
+    """Step 1: the candidate nearest in L1; ties go to the lower slot. R is brought to P's
+    fraction bits with one fixed shift (hoisted out of the loop)."""
     best, best_d = -1, np.int64(1) << 62
-    fp, fr = k[C_FP], k[C_FR]
+    up = k[C_FP] - k[C_FR]  # the formats table gives the centre at least R's fraction bits
+    seek = k[C_SEEK]
     for s in range(S.shape[0]):
         if S[s, VALID] == 0:
             continue
         dx = abs(x - S[s, PX])
         dy = abs(y - S[s, PY])
-        if dx <= _align(S[s, RX], fr, fp) + k[C_SEEK] and dy <= _align(S[s, RY], fr, fp) + k[C_SEEK]:
+        if dx <= (S[s, RX] << up) + seek and dy <= (S[s, RY] << up) + seek:
             d = dx + dy
             if d < best_d:
                 best, best_d = s, d

@@ -147,7 +147,8 @@ def build_formats(params: ClustererParams, width: int, height: int, t_frame_us: 
         # x moves by (u - x)·β: with f fractional bits, |u - x| < 2^-f / β never moves it.
         return max(0, math.ceil(-math.log2(betas[beta_name]))) + DEAD_BAND_BITS
 
-    pos_frac = guard("beta_pos")
+    # The centre keeps at least R's fraction bits: the seek shifts R up to P's, never down.
+    pos_frac = max(guard("beta_pos"), guard("beta_size"))
     v_full = 2.0 ** _bits_for(max(p.r_max, 64.0))  # px/frame: a speed above this is not an object
     f = [
         Format("ev_t", False, 32, 0, "input", "event time, µs; wraps by design", overflow="wrap"),
