@@ -120,3 +120,52 @@ def test_inputs_at_every_extreme_never_saturate_state():
     run = track_events(events_at(points), META, params, model="fixed")
     assert run.stats["saturations"] == {}
     assert np.all((run.tracks["x"] >= 0) & (run.tracks["x"] <= 63) & (run.tracks["y"] >= 0) & (run.tracks["y"] <= 47))
+
+
+def test_full_table_evicts_exactly_as_the_float_model_does():
+    from evclust.fixed.model import FixedClusterer
+    from evclust.clusterer.layout import ID, PX
+
+    params = ClustererParams(n_clusters=2, a_valid=5.0, a_min=0.0, filter_every=10**6, seek_margin=2.0, t_half_us=1e9, r_init=3.0)
+    model = FixedClusterer(params, 100, 100, T_FRAME)
+    fp = model.table["centre"].frac_bits
+    model.feed(events_at([(i, 10, 10, 100) for i in range(6)] + [(10 + i, 50, 50, 100) for i in range(2)]))
+    model.feed(events_at([(20, 90, 90, 100)]))  # table full: slot 1 (activity 2 < 5) is evicted
+    s = model.stats()
+    assert (s["created"], s["evicted"], s["dropped"]) == (3, 1, 0)
+    assert model.slots[1, ID] == 2 and model.slots[1, PX] == 90 << fp
+    model.feed(events_at([(21 + i, 90, 90, 100) for i in range(5)]))
+    model.feed(events_at([(40, 30, 70, 100)]))  # both >= a_valid now: dropped
+    s = model.stats()
+    assert (s["created"], s["evicted"], s["dropped"]) == (3, 1, 1)
+
+
+def test_a_long_soak_keeps_the_state_bounded_without_drift():
+    # 10^7 events: a square's worth of events repeated, with a slow drift of the whole pattern;
+    # the fixed centre must follow the float centre without its error growing.
+    rng = np.random.default_rng(1)
+    n = 10_000_000
+    t = np.arange(n, dtype=np.uint64) * np.uint64(3)  # 3 µs apart: 30 s, crossing the 32-bit wrap? no: ~0.03 of it
+    drift = (np.arange(n) / n * 200.0)
+    x = np.clip(np.rint(60 + drift + rng.integers(-10, 11, n)), 0, 319).astype(np.uint16)
+    y = np.clip(np.rint(120 + rng.integers(-10, 11, n)), 0, 239).astype(np.uint16)
+    ev = np.zeros(n, EVENT_DTYPE)
+    ev["t"], ev["x"], ev["y"], ev["p"] = t, x, y, 1
+    ev["Y"], ev["Cb"], ev["Cr"] = rng.integers(0, 256, n), 128, 128
+    meta = EventMeta(width=320, height=240, source="soak", t_frame_us=T_FRAME)
+    params = ClustererParams(v_min=0.0, a_valid=5.0, r_max=40.0, seek_margin=12.0, filter_every=1024)
+    flt = track_events(ev, meta, params, model="float").tracks
+    fix = track_events(ev, meta, params, model="fixed")
+    assert fix.stats["saturations"] == {}
+    fix = fix.tracks
+    steps = np.intersect1d(flt["step"], fix["step"])
+    a = flt[np.isin(flt["step"], steps) & (flt["slot"] == 0)]
+    b = fix[np.isin(fix["step"], steps) & (fix["slot"] == 0)]
+    assert a.size == b.size > 5000
+    err = b["x"] - a["x"]
+    # Mean error within half an input LSB (1 px) over the whole soak, and no drift: the last
+    # tenth is no worse than the first tenth by more than a hundredth of a pixel.
+    assert abs(err.mean()) <= 0.5
+    tenth = err.size // 10
+    assert abs(err[-tenth:].mean()) <= abs(err[:tenth].mean()) + 0.01
+    assert np.all((b["rx"] >= params.r_min) & (b["rx"] <= params.r_max) & (b["activity"] >= 0))

@@ -110,6 +110,13 @@ def _beta_frac_bits(beta: float, name: str) -> int:
     return bits
 
 
+def _frac_for(value: float, at_least: int = 16) -> int:
+    """Fraction bits that keep `value` to BETA_REL_ERROR_BITS significant bits (and at least `at_least`)."""
+    if value <= 0:
+        return at_least
+    return max(at_least, math.ceil(-math.log2(value)) + BETA_REL_ERROR_BITS)
+
+
 def _quantise(value: float, fmt: Format, name: str, param: str) -> int:
     from evclust.fixed.arith import quantise
 
@@ -189,8 +196,9 @@ def build_formats(params: ClustererParams, width: int, height: int, t_frame_us: 
     const("size_gain", p.size_gain, False, _bits_for(p.size_gain), 8, "clusterer.size_gain", "g_R")
     const("inv_t_half", 1.0 / p.t_half_us, False, 0, max(0, math.ceil(math.log2(p.t_half_us))) + 24, "clusterer.t_half_us", "1/T_half, per µs")
     const("gamma_global", p.gamma, False, 12, 8, "clusterer.gamma", "the paper's global γ")
-    const("gamma_per_activity", math.log(2) * t_frame_us / p.t_half_us, False, _bits_for(math.log(2) * t_frame_us / p.t_half_us), 16, "clusterer.t_half_us", "ln2·T_frame/T_half")
-    const("frame_per_tau", t_frame_us / p.tau_us, False, _bits_for(t_frame_us / p.tau_us), 16, "clusterer.tau_us", "T_frame/τ")
+    gpa, fpt = math.log(2) * t_frame_us / p.t_half_us, t_frame_us / p.tau_us
+    const("gamma_per_activity", gpa, False, _bits_for(gpa), _frac_for(gpa), "clusterer.t_half_us", "ln2·T_frame/T_half")
+    const("frame_per_tau", fpt, False, _bits_for(fpt), _frac_for(fpt), "clusterer.tau_us", "T_frame/τ")
     const("inv_p", 1.0 / p.p_correction, False, _bits_for(1.0 / p.p_correction), 12, "clusterer.p_correction", "1/p of eq. (11)")
     if p.luma_weight > 0:
         const("luma_weight", p.luma_weight, False, _bits_for(p.luma_weight), 6, "clusterer.luma_weight", "w_Y")
