@@ -98,9 +98,10 @@ def constant_vector(table, params, has_colour: bool) -> np.ndarray:
 
 @numba.njit(cache=True, nogil=True, inline="always")
 def _store(value, lo, hi, signal, log, ranges):
-    """Saturate to [lo, hi] and count a saturation; with range instrumentation on (a `ranges`
-    array with rows), also keep the value's range before saturation."""
-    if ranges.shape[0] > 0:
+    """Saturate to [lo, hi] and count a saturation; with range instrumentation on (`ranges` an
+    array, not None), also keep the value's range before saturation. numba compiles the
+    None case without the branch: instrumentation off costs nothing."""
+    if ranges is not None:
         if value < ranges[signal, 0]:
             ranges[signal, 0] = value
         if value > ranges[signal, 1]:
@@ -118,7 +119,7 @@ def _store(value, lo, hi, signal, log, ranges):
 def _seen(value, signal, ranges):
     """Range instrumentation of a value that cannot leave its format (an α filter's result lies
     between its state and its input, both in range): no saturation logic, just min/max."""
-    if ranges.shape[0] > 0:
+    if ranges is not None:
         if value < ranges[signal, 0]:
             ranges[signal, 0] = value
         if value > ranges[signal, 1]:

@@ -31,9 +31,11 @@ class FixedClusterer:
         self.inv_ww = np.zeros(len(params.palette), dtype=np.int64)
         fixed_model.refresh_mixing(self.globals, self.palette, self.inv_ww, self.k)
         self.overflow = np.zeros(len(fixed_model.SIGNALS), dtype=np.int64)
-        # Range instrumentation costs time per store: on request only (an empty array turns it off).
-        self.ranges = np.zeros((len(fixed_model.SIGNALS) if ranges else 0, 2), dtype=np.int64)
-        self.ranges[:, 0], self.ranges[:, 1] = np.iinfo(np.int64).max, np.iinfo(np.int64).min
+        # Range instrumentation on request only: None compiles a loop without it.
+        self.ranges = None
+        if ranges:
+            self.ranges = np.zeros((len(fixed_model.SIGNALS), 2), dtype=np.int64)
+            self.ranges[:, 0], self.ranges[:, 1] = np.iinfo(np.int64).max, np.iinfo(np.int64).min
 
     def feed(self, events: np.ndarray) -> np.ndarray:
         every = self.params.filter_every
@@ -59,7 +61,9 @@ class FixedClusterer:
                 "events_in_interval": "events_in_interval", "hist": "hist", "centre_step": "centre", "speed_sq": "speed_sq",
                 "mcm_step": "v_mcm", "size_target": "size_target"}  # fmt: skip
         rows = []
-        for j, name in enumerate(fixed_model.SIGNALS[: self.ranges.shape[0]]):
+        if self.ranges is None:
+            return rows
+        for j, name in enumerate(fixed_model.SIGNALS):
             lo, hi = self.ranges[j]
             if lo > hi:
                 continue
