@@ -67,7 +67,14 @@ def main() -> int:
         lines.append(f"| {name} | {model} | {n} | {events:,} | {records:,} | {median:.3f} | {best:.3f} | {events / median / 1e6:.2f} |")
     traffic_float = next(r for r in rows if r[0] == "traffic" and r[1] == "float")
     rate = traffic_float[3] / traffic_float[5] / 1e6
-    lines += ["", f"Target: float model ≥ 5 Mevents/s with N = 16 on `traffic`: {rate:.2f} Mevents/s, **{'PASS' if rate >= 5 else 'FAIL'}**.", END]
+    traffic_fixed = next(r for r in rows if r[0] == "traffic" and r[1] == "fixed")
+    fixed_rate = traffic_fixed[3] / traffic_fixed[5] / 1e6
+    lines += [
+        "",
+        f"Targets on `traffic`, N = 16, one core: float model ≥ 5 Mevents/s: {rate:.2f}, **{'PASS' if rate >= 5 else 'FAIL'}**; "
+        f"fixed model ≥ 2 Mevents/s: {fixed_rate:.2f}, **{'PASS' if fixed_rate >= 2 else 'FAIL'}**.",
+        END,
+    ]
     text = "\n".join(lines) + "\n"
     print(text)
     if args.write:

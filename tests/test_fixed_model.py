@@ -169,3 +169,38 @@ def test_a_long_soak_keeps_the_state_bounded_without_drift():
     tenth = err.size // 10
     assert abs(err[-tenth:].mean()) <= abs(err[:tenth].mean()) + 0.01
     assert np.all((b["rx"] >= params.r_min) & (b["rx"] <= params.r_max) & (b["activity"] >= 0))
+
+
+def test_size_at_r_max_and_velocities_at_full_scale_never_wrap():
+    from evclust.clusterer.layout import RX, RY, VALID, VIX, VIY, VMX, VMY
+    from evclust.fixed.model import FixedClusterer
+
+    params = ClustererParams(v_min=0.0, a_valid=2.0, filter_every=4, r_max=20.0, r_init=20.0, r_min=2.0, seek_margin=30.0)
+    model = FixedClusterer(params, 64, 48, T_FRAME)
+    model.feed(events_at([(0, 32, 24, 100)]))  # one cluster
+    f = model.table
+    s = int(np.flatnonzero(model.slots[:, VALID])[0])
+    # Put the state at its extremes: size at r_max, both velocities at plus and minus full scale.
+    model.slots[s, RX] = model.slots[s, RY] = f.constants["r_max"].raw
+    model.slots[s, VMX], model.slots[s, VMY] = f["v_mcm"].raw_max, f["v_mcm"].raw_min
+    model.slots[s, VIX], model.slots[s, VIY] = f["v_int"].raw_min, f["v_int"].raw_max
+    # Events far out at both sides keep pushing the size up; the velocities may only decay.
+    far = [(10 + i, 0 if i % 2 else 63, 0 if i % 3 else 47, 255 * (i % 2)) for i in range(400)]
+    model.feed(events_at(far))
+    assert model.stats()["saturations"] == {}
+    for col, fmt in ((RX, "half_size"), (RY, "half_size"), (VMX, "v_mcm"), (VMY, "v_mcm"), (VIX, "v_int"), (VIY, "v_int")):
+        live = model.slots[model.slots[:, VALID] == 1, col]
+        assert np.all((live >= f[fmt].raw_min) & (live <= f[fmt].raw_max)), fmt
+    assert np.all(model.slots[model.slots[:, VALID] == 1, RX] <= f.constants["r_max"].raw)
+
+
+def test_shift_only_betas_run_close_to_the_multiplier_model(square):
+    params = ClustererParams(**PARAMS)
+    exact = track_events(square.events, square.meta, params, model="fixed")
+    shifted = track_events(square.events, square.meta, params, model="fixed", beta_shift_only=True)
+    assert shifted.stats["saturations"] == {}
+    assert all(c.raw & (c.raw - 1) == 0 for n, c in shifted.clusterer.table.constants.items() if n.startswith("beta_"))
+    # Powers of two move each time constant by up to √2, so the track differs, but the object
+    # is still followed: the last centres within a pixel of each other.
+    a, b = exact.tracks[-1], shifted.tracks[-1]
+    assert abs(a["x"] - b["x"]) <= 1.0 and abs(a["y"] - b["y"]) <= 1.0

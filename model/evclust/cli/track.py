@@ -25,6 +25,7 @@ def add_parser(sub) -> None:
     p.add_argument("--params", metavar="P", help=f"parameter file (.toml) or preset ({', '.join(preset_names())})")
     p.add_argument("--model", default="float", choices=sorted(MODELS), help="clusterer model (default: float)")
     p.add_argument("--ranges", action="store_true", help="fixed model: print each signal's range seen and its saturation count")
+    p.add_argument("--beta-shift", action="store_true", help="fixed model: round every β to a power of two (shift-only filters)")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     p.set_defaults(run=run)
 
@@ -32,9 +33,9 @@ def add_parser(sub) -> None:
 def run(args) -> int:
     events, meta = read_events(args.events)
     params, origin = load_params(args.params, meta.source)
-    if args.ranges and args.model != "fixed":
-        raise EvclustError("--ranges instruments the fixed model: add --model fixed")
-    options = {"ranges": True} if args.ranges else {}
+    if (args.ranges or args.beta_shift) and args.model != "fixed":
+        raise EvclustError("--ranges and --beta-shift are options of the fixed model: add --model fixed")
+    options = {"ranges": args.ranges, "beta_shift_only": args.beta_shift} if args.model == "fixed" else {}
     result = track_events(events, meta, params, model=args.model, progress=not args.quiet, **options)
     write_tracks(args.output, result.tracks, result.meta)
     print(f"{args.events}: parameters from {origin}; {result.summary()}")

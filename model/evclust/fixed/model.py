@@ -15,9 +15,13 @@ class FixedClusterer:
 
     model = "fixed"
 
-    def __init__(self, params: ClustererParams, width: int, height: int, t_frame_us: float, has_colour: bool = True, ranges: bool = False):
+    def __init__(
+        self, params: ClustererParams, width: int, height: int, t_frame_us: float, has_colour: bool = True,
+        ranges: bool = False, beta_shift_only: bool = False,
+    ):  # fmt: skip
         self.params = params
-        self.table = build_formats(params, width, height, t_frame_us)
+        # beta_shift_only: every β a power of two, so each α filter multiplies by shifting.
+        self.table = build_formats(params, width, height, t_frame_us, beta_shift_only=beta_shift_only)
         self.k = fixed_model.constant_vector(self.table, params, has_colour)
         self.decay = np.asarray(decay_table(self.table), dtype=np.int64)
         self.palette = np.array([[self.table.constants[f"palette_{j}_{c}"].raw for c in ("y", "cb", "cr")] for j in range(len(params.palette))], dtype=np.int64)
