@@ -14,7 +14,7 @@ import numpy as np
 
 from evclust.clusterer.layout import (
     ACT, BG_CB, BG_CR, BG_Y, CCB, CCR, CREATED, CY, DROPPED, EV_COUNT, EVENTS, EVER_REPORTED, EVICTED, EXITED,
-    EXPIRED, FLAG_BORDER, FLAG_MOVING_INT, FLAG_MOVING_MCM, FLAG_NEW, GAMMA, ID, MCM_NORM, NEXT_ID, NOISE, PPX, PPY, PX,
+    EXPIRED, T_FIRST, FLAG_BORDER, FLAG_MOVING_INT, FLAG_MOVING_MCM, FLAG_NEW, GAMMA, ID, MCM_NORM, NEXT_ID, NOISE, PPX, PPY, PX,
     PY, RECORD_COLUMNS, REPORTED, RX, RY, SINCE_FILTER, STEP, T_FILTER, T_LAST, VALID, VI_COUNT, VIX, VIY, VMX,
     VMY,
 )  # fmt: skip
@@ -229,7 +229,7 @@ def _exiting(S, s, k):
 def _filter_step(S, H, G, t, k, palette, background_mask, out, n_out):
     """Every N_f events: decay, free, interval velocity, noise and exit decisions, records."""
     # τ boundaries crossed since the last step: usually 0 or 1, more when events are sparse.
-    boundaries = math.floor(t / k[K_TAU]) - math.floor(G[T_FILTER] / k[K_TAU])
+    boundaries = math.floor((t - G[T_FIRST]) / k[K_TAU]) - math.floor((G[T_FILTER] - G[T_FIRST]) / k[K_TAU])
     interval_due = boundaries > 0
     per_frame = k[K_T_FRAME] / (max(boundaries, 1) * k[K_TAU])  # T_frame over the time measured
     v_min = k[K_V_MIN]
@@ -316,7 +316,8 @@ def run_events(S, H, G, k, palette, background_mask, t_us, xs, ys, lums, cbs, cr
         x, y = float(xs[i]), float(ys[i])
         lum, cb, cr = float(lums[i]), float(cbs[i]), float(crs[i])
         if G[EVENTS] == 0:
-            G[T_FILTER] = t  # the filter-step clock starts at the first event
+            G[T_FILTER] = t  # the filter-step clock and the τ boundaries start at the first event
+            G[T_FIRST] = t
         G[EVENTS] += 1
         s = _seek(S, x, y, k[K_SEEK])
         updated_reported = False

@@ -20,10 +20,13 @@ SLOT_COLUMNS = (
 )  # fmt: skip
 
 # Global columns.
-NEXT_ID, BG_Y, BG_CB, BG_CR, SINCE_FILTER, STEP, T_FILTER, EVENTS, CREATED, EVICTED, DROPPED, EXPIRED, EXITED, NOISE = range(14)
+(
+    NEXT_ID, BG_Y, BG_CB, BG_CR, SINCE_FILTER, STEP, T_FILTER, EVENTS, CREATED, EVICTED, DROPPED, EXPIRED,
+    EXITED, NOISE, T_FIRST,
+) = range(15)  # fmt: skip
 GLOBAL_COLUMNS = (
     "next_id", "bg_Y", "bg_Cb", "bg_Cr", "since_filter", "step", "t_filter", "events",
-    "created", "evicted", "dropped", "expired", "exited", "noise",
+    "created", "evicted", "dropped", "expired", "exited", "noise", "t_first",  # τ boundaries count from t_first
 )  # fmt: skip
 
 # Track-record columns as the models write them (the order of evclust.tracks.TRACK_DTYPE).

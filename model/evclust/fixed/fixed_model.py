@@ -13,16 +13,16 @@ import numpy as np
 
 from evclust.clusterer.layout import (
     ACT, BG_CB, BG_CR, BG_Y, CCB, CCR, CREATED, CY, DROPPED, EV_COUNT, EVENTS, EVER_REPORTED, EVICTED,
-    DECAY_RESIDUAL, EXITED, EXPIRED, FLAG_BORDER, FLAG_MOVING_INT, FLAG_MOVING_MCM, FLAG_NEW, GAMMA, ID, MCM_NORM,
+    DECAY_RESIDUAL, EXITED, EXPIRED, T_FIRST, FLAG_BORDER, FLAG_MOVING_INT, FLAG_MOVING_MCM, FLAG_NEW, GAMMA, ID, MCM_NORM,
     NEXT_ID, NOISE, PPX, PPY, PX, PY, RECORD_COLUMNS, REPORTED, RX, RY, SINCE_FILTER, STEP, T_FILTER,
     T_LAST, VALID, VI_COUNT, VIX, VIY, VMX, VMY,
 )  # fmt: skip
-from evclust.fixed.arith import FLOOR, alpha_step_nb, shift_round_nb
+from evclust.fixed.arith import FLOOR, NEAREST, alpha_step_nb, shift_round_nb
 
 TIME_MASK = (1 << 32) - 1
 # Globals beyond the float model's: the τ phase (µs since the last boundary).
-TAU_PHASE = 14
-N_GLOBALS = 15
+TAU_PHASE = 15
+N_GLOBALS = 16
 
 # Signals of the overflow log and the range instrumentation.
 SIGNALS = (
@@ -46,9 +46,9 @@ SIGNALS = (
     C_V_MIN_SQ, C_V_EXIT_SQ, C_SQ_F, C_COS_SQ, C_COS_SQ_F, C_EXIT_M,
     C_WIDTH, C_HEIGHT, C_COLOUR, C_WARM, C_MCM_CORRECT, C_VOTE_CONTRAST, C_MIXING, C_MIX_TOL,
     C_MAX_CENTRE, C_MAX_ACT, C_MAX_V, C_MIN_V, C_MAX_VI, C_MIN_VI, C_MAX_W, C_MAX_GAMMA, C_MAX_COLOUR,
-    C_MAX_BG, C_MAX_EVCOUNT, C_MAX_HALF, C_MAX_SIZE_TARGET,
-) = range(74)  # fmt: skip
-N_CONSTANTS = 74
+    C_MAX_BG, C_MAX_EVCOUNT, C_MAX_HALF, C_MAX_SIZE_TARGET, C_V_FULL_BITS, C_MAX_SPEED_SQ,
+) = range(76)  # fmt: skip
+N_CONSTANTS = 76
 
 
 def constant_vector(table, params, has_colour: bool) -> np.ndarray:
@@ -89,6 +89,7 @@ def constant_vector(table, params, has_colour: bool) -> np.ndarray:
     k[C_VOTE_CONTRAST], k[C_MIXING], k[C_MIX_TOL] = params.palette_vote == "contrast", params.palette_assign == "mixing", raw("mixing_tolerance")
     k[C_MAX_CENTRE], k[C_MAX_ACT], k[C_MAX_HALF] = f["centre"].raw_max, f["activity"].raw_max, f["half_size"].raw_max
     k[C_MAX_SIZE_TARGET] = f["size_target"].raw_max
+    k[C_V_FULL_BITS], k[C_MAX_SPEED_SQ] = f["v_int"].int_bits, f["speed_sq"].raw_max
     k[C_MAX_V], k[C_MIN_V] = f["v_mcm"].raw_max, f["v_mcm"].raw_min
     k[C_MAX_VI], k[C_MIN_VI] = f["v_int"].raw_max, f["v_int"].raw_min
     k[C_MAX_W], k[C_MAX_GAMMA], k[C_MAX_COLOUR] = f["mcm_norm"].raw_max, f["gamma"].raw_max, f["colour"].raw_max
@@ -285,10 +286,11 @@ def _update(S, H, G, s, t, ex, ey, lum, cb, cr, k, table, palette, inv_ww, backg
     step_y = _store(py_new - py, -(np.int64(1) << (4 + fp)), (np.int64(1) << (4 + fp)) - 1, S_STEP, log, ranges)
     ux = _store(_align(S[s, GAMMA] * step_x, k[C_FG] + fp, k[C_FV]), k[C_MIN_V], k[C_MAX_V], S_MCM_IN, log, ranges)
     uy = _store(_align(S[s, GAMMA] * step_y, k[C_FG] + fp, k[C_FV]), k[C_MIN_V], k[C_MAX_V], S_MCM_IN, log, ranges)
-    S[s, VMX] = _seen(alpha_step_nb(S[s, VMX], ux, k[C_B_VM], k[C_BB_VM], 0, FLOOR), S_VM, ranges)
-    S[s, VMY] = _seen(alpha_step_nb(S[s, VMY], uy, k[C_B_VM], k[C_BB_VM], 0, FLOOR), S_VM, ranges)
-    S[s, MCM_NORM] = alpha_step_nb(S[s, MCM_NORM], k[C_MAX_W] + 1, k[C_B_VM], k[C_BB_VM], 0, FLOOR)
-    S[s, MCM_NORM] = _store(S[s, MCM_NORM], 0, k[C_MAX_W], S_NORM, log, ranges)
+    # Rounded to nearest: V's input is at V's own LSB, so a floor would drift one way.
+    S[s, VMX] = _seen(alpha_step_nb(S[s, VMX], ux, k[C_B_VM], k[C_BB_VM], 0, NEAREST), S_VM, ranges)
+    S[s, VMY] = _seen(alpha_step_nb(S[s, VMY], uy, k[C_B_VM], k[C_BB_VM], 0, NEAREST), S_VM, ranges)
+    # w = 1 - α^n: the same filter on the integer 1, with all of w's fraction bits as guard.
+    S[s, MCM_NORM] = _seen(alpha_step_nb(S[s, MCM_NORM], 1, k[C_B_VM], k[C_BB_VM], k[C_FW], NEAREST), S_NORM, ranges)
     S[s, PX] = _seen(px_new, S_CENTRE, ranges)
     S[s, PY] = _seen(py_new, S_CENTRE, ranges)
     if k[C_COLOUR] != 0:
@@ -305,8 +307,8 @@ def _update(S, H, G, s, t, ex, ey, lum, cb, cr, k, table, palette, inv_ww, backg
         else:
             c = _nearest_palette(lum, cb, cr, palette, k)
         vote = np.int64(1)
-        if k[C_VOTE_CONTRAST] != 0:
-            vote = abs(lum - bg[0]) + abs(cb - bg[1]) + abs(cr - bg[2])
+        if k[C_VOTE_CONTRAST] != 0:  # |e - BG|₁ from the exact background, rounded half up
+            vote = (abs((lum << fb) - G[BG_Y]) + abs((cb << fb) - G[BG_CB]) + abs((cr << fb) - G[BG_CR]) + (np.int64(1) << (fb - 1))) >> fb
         # Saturating by design (SPEC §4): reaching the top halves every counter, so not an overflow.
         H[s, c] = min(_seen(H[s, c] + vote, S_HIST, ranges), k[C_H_MAX])
         if H[s, c] >= k[C_H_MAX]:
@@ -342,7 +344,11 @@ def _near(px, py, k):
 
 @numba.njit(cache=True, nogil=True)
 def _speed_sq(vx, vy, frac, k):
-    """|V|² in the speed_sq format from a velocity with `frac` fraction bits."""
+    """|V|² in the speed_sq format from a velocity with `frac` fraction bits. Each component is
+    first clamped to full scale (±2^V_FULL_BITS px/frame), so the squares fit an int64."""
+    full = (np.int64(1) << (k[C_V_FULL_BITS] + frac)) - 1
+    vx = min(max(vx, -full), full)
+    vy = min(max(vy, -full), full)
     return _align(vx * vx + vy * vy, 2 * frac, k[C_SQ_F])
 
 
@@ -351,7 +357,7 @@ def _corrected(colour, background, k):
     """Eq. (11): BG + (C - BG)·(1/p), in C's format, clamped to the byte range."""
     bg = _align(background, k[C_FB], k[C_FC])
     obj = bg + (((colour - bg) * k[C_INV_P]) >> k[C_INV_P_F])
-    return min(max(obj, 0), k[C_MAX_COLOUR])
+    return min(max(obj, 0), np.int64(255) << k[C_FC])
 
 
 @numba.njit(cache=True, nogil=True)
@@ -388,11 +394,12 @@ def _filter_step(S, H, G, t, k, table, palette, inv_ww, background_mask, out, n_
             S[s, PPX], S[s, PPY] = S[s, PX], S[s, PY]
         # The reported MCM velocity: V / w, the sweep's one division.
         vmx, vmy = S[s, VMX], S[s, VMY]
-        if k[C_MCM_CORRECT] != 0 and S[s, MCM_NORM] > 0:
-            vmx = (S[s, VMX] << fw) // S[s, MCM_NORM]
-            vmy = (S[s, VMY] << fw) // S[s, MCM_NORM]
+        w20 = S[s, MCM_NORM] >> (fw - 20)  # w to 20 fraction bits: V·2^20 fits an int64
+        if k[C_MCM_CORRECT] != 0 and w20 > 0:
+            vmx = (S[s, VMX] << 20) // w20
+            vmy = (S[s, VMY] << 20) // w20
         # Exit prediction on the squared speed (no square root).
-        speed_sq = _store(_speed_sq(vmx, vmy, fv, k), 0, np.int64(1) << 62, S_SPEED, log, ranges)
+        speed_sq = _store(_speed_sq(vmx, vmy, fv, k), 0, k[C_MAX_SPEED_SQ], S_SPEED, log, ranges)
         left, right, top, bottom = _near(S[s, PX], S[s, PY], k)
         if speed_sq >= k[C_V_EXIT_SQ] and speed_sq > 0:
             limit = (speed_sq * k[C_COS_SQ]) >> k[C_COS_SQ_F]
@@ -457,7 +464,8 @@ def run_events(S, H, G, k, table, palette, inv_ww, background_mask, t_us, xs, ys
         lum, cb, cr = np.int64(lums[i]), np.int64(cbs[i]), np.int64(crs[i])
         if G[EVENTS] == 0:
             G[T_FILTER] = t
-            G[TAU_PHASE] = (np.int64(t_us[i]) % k[C_TAU_US])  # the float model's boundaries are multiples of τ
+            G[T_FIRST] = t
+            G[TAU_PHASE] = 0  # τ boundaries count from the first event, as in the float model
         G[EVENTS] += 1
         s = _seek(S, ex << k[C_FP], ey << k[C_FP], k)
         updated_reported = False

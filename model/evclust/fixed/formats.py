@@ -167,8 +167,9 @@ def build_formats(params: ClustererParams, width: int, height: int, t_frame_us: 
         Format("t_last", False, 32, 0, "state", "time the activity refers to, µs", overflow="wrap"),
         # V_MCM's input γ·(P_new - P) is large per event even when V is small: γ reaches ~10^4.
         Format("v_mcm", True, 12, guard("beta_vel_mcm"), "state", "MCM velocity accumulator and its input, px/frame"),
-        Format("mcm_norm", False, 0, guard("beta_vel_mcm"), "state", "1 - α_vm^n: the MCM filter run on 1"),
-        Format("v_int", True, _bits_for(v_full), 12, "state", "interval velocity, px/frame"),
+        # w is a divisor: its dead band must be tiny relative to 1, not to a pixel (2^-20).
+        Format("mcm_norm", False, 1, guard("beta_vel_mcm") + 14, "state", "1 - α_vm^n: the MCM filter run on 1 (reaches 1.0)"),
+        Format("v_int", True, _bits_for(v_full), guard("beta_vel_int"), "state", "interval velocity, px/frame"),
         Format("colour", False, 8, guard("beta_chro") if p.alpha_chro >= p.alpha_lum else guard("beta_lum"), "state", "cluster colour Y, Cb, Cr"),
         Format("background", False, 8, guard("beta_bg"), "state", "background colour Y, Cb, Cr"),
         Format("gamma", False, 14, 8, "state", "γ: events per frame (the activity estimate reaches ~8000 early on)"),
@@ -180,7 +181,13 @@ def build_formats(params: ClustererParams, width: int, height: int, t_frame_us: 
         Format("centre_step", True, 4, pos_frac, "intermediate", "P_new - P, px"),
         Format("size_target", False, coord + _bits_for(p.size_gain), guard("beta_size"), "intermediate", "g_R·|e - P|, px, before R's clamp"),
         Format("speed_sq", False, 2 * _bits_for(v_full) + 1, 16, "intermediate", "|V|², (px/frame)²"),
-        Format("colour_distance", False, 11, 0, "intermediate", "palette L1 distance and vote"),
+        Format("colour_distance", False, 11 + _bits_for(p.luma_weight), 6, "intermediate", "palette L1 distance (w_Y·|ΔY| in 2^-6)"),
+        Format("vote", False, 10, 0, "intermediate", "palette vote: 1, or |e - BG|₁ rounded"),
+        Format("decay_residual", False, 0, 0, "state", "Δt/T_half below one decay-table step (fraction bits set below)"),
+        Format("tau_phase", False, _bits_for(p.tau_us), 0, "state", "µs since the last τ boundary"),
+        Format("interval_updates", False, 2, 0, "state", "interval velocity warm-start state: 0, 1, 2"),
+        Format("inv_ww", False, 33, 0, "intermediate", "2^32 / |palette_j - BG|², refreshed at filter steps"),
+        Format("mixing_q", False, 1, 16, "intermediate", "mixing fraction q, clamped to [0, 1]"),
         Format("dt", False, 32, 0, "intermediate", "t - t_last, µs (modulo 2^32)", overflow="wrap"),
     ]
     formats = {fmt.name: fmt for fmt in f}
@@ -196,6 +203,8 @@ def build_formats(params: ClustererParams, width: int, height: int, t_frame_us: 
     const("size_gain", p.size_gain, False, _bits_for(p.size_gain), 8, "clusterer.size_gain", "g_R")
     const("inv_t_half", 1.0 / p.t_half_us, False, 0, max(0, math.ceil(math.log2(p.t_half_us))) + 24, "clusterer.t_half_us", "1/T_half, per µs")
     const("gamma_global", p.gamma, False, 12, 8, "clusterer.gamma", "the paper's global γ")
+    if p.tau_us != round(p.tau_us):
+        raise EvclustError(f"clusterer.tau_us: {p.tau_us:g} µs; the fixed model counts τ in whole µs (use {round(p.tau_us)})")
     gpa, fpt = math.log(2) * t_frame_us / p.t_half_us, t_frame_us / p.tau_us
     const("gamma_per_activity", gpa, False, _bits_for(gpa), _frac_for(gpa), "clusterer.t_half_us", "ln2·T_frame/T_half")
     const("frame_per_tau", fpt, False, _bits_for(fpt), _frac_for(fpt), "clusterer.tau_us", "T_frame/τ")
@@ -221,6 +230,8 @@ def build_formats(params: ClustererParams, width: int, height: int, t_frame_us: 
         for channel, value in zip(("Y", "CB", "CR"), ycc):
             const(f"palette_{i}_{channel.lower()}", value, False, 8, 0, f"clusterer.palette.{name}", f"palette entry {name} {channel}")
     table = {k.name: k for k in c}
+    residual_bits = table["inv_t_half"].fmt.frac_bits - DECAY_TABLE_BITS
+    formats["decay_residual"] = dataclasses.replace(formats["decay_residual"], frac_bits=residual_bits)
     formats["decay_table"] = Format("decay_table", False, 1, DECAY_FRAC_BITS, "constant", "2^-(i/64), i = 0..63 (entry 0 is 1.0)", rounding="nearest")
     return FormatTable(formats, table, p.n_clusters, len(p.palette), width, height, beta_shift_only)
 
@@ -249,7 +260,7 @@ def render_table(table: FormatTable) -> str:
     return "\n".join([line(header), line(tuple("-" * w for w in widths)), *map(line, rows)])
 
 
-_ASCII = str.maketrans({"µ": "u", "²": "^2", "α": "alpha", "β": "beta", "γ": "gamma", "θ": "theta", "τ": "tau", "Δ": "d", "·": "*"})
+_ASCII = str.maketrans({"µ": "u", "²": "^2", "₁": "_1", "α": "alpha", "β": "beta", "γ": "gamma", "θ": "theta", "τ": "tau", "Δ": "d", "·": "*"})
 
 
 def verilog_header(table: FormatTable) -> str:

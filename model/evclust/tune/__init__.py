@@ -46,7 +46,7 @@ def params_from_trial(values: dict, base: ClustererParams, t_frame_us: float) ->
         if name.startswith("beta_"):
             update["alpha_" + name[len("beta_"):]] = 1.0 - value
         elif name == "tau_frames":
-            update["tau_us"] = value * t_frame_us
+            update["tau_us"] = float(round(value * t_frame_us))  # whole µs: the hardware counts τ in µs
         else:
             update[name] = value
     update["r_max"] = max(base.r_max, update.get("r_init", base.r_init))
