@@ -12,6 +12,15 @@ class EvclustError(Exception):
     """Bad input or an impossible request. The CLI prints it as one line and exits non-zero."""
 
 
+def validation_message(exc, prefix: str = "") -> str:
+    """One line from a pydantic ValidationError: the first fault's dotted key (under `prefix`),
+    its message, and how many more faults there are."""
+    err = exc.errors()[0]
+    where = ".".join(str(part) for part in (prefix.split(".") if prefix else []) + list(err["loc"]))
+    more = f" (and {exc.error_count() - 1} more)" if exc.error_count() > 1 else ""
+    return f"{where}: {err['msg']}{more}" if where else f"{err['msg']}{more}"
+
+
 @contextlib.contextmanager
 def atomic_output(path: str | os.PathLike, suffix: str | None = None):
     """Yield a temporary path beside `path`; move it into place only if the block succeeds.

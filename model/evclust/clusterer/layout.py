@@ -34,3 +34,11 @@ RECORD_COLUMNS = 18
 
 # Flags of a record (evclust.tracks.TrackFlags).
 FLAG_NEW, FLAG_BORDER, FLAG_MOVING_MCM, FLAG_MOVING_INT = 1, 2, 4, 8
+
+
+def run_stats(g) -> dict:
+    """The counters of a run, from the globals (float or fixed)."""
+    return {
+        "events": int(g[EVENTS]), "steps": int(g[STEP]), "created": int(g[CREATED]), "evicted": int(g[EVICTED]),
+        "dropped": int(g[DROPPED]), "expired": int(g[EXPIRED]), "exited": int(g[EXITED]), "noise_decisions": int(g[NOISE]),
+    }  # fmt: skip

@@ -15,7 +15,7 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 from evclust.colour import rgb_to_ycbcr
-from evclust.errors import EvclustError
+from evclust.errors import EvclustError, validation_message
 
 Alpha = Annotated[float, Field(ge=0.0, lt=1.0)]
 Positive = Annotated[float, Field(gt=0.0)]
@@ -125,13 +125,6 @@ class ClustererParams(BaseModel):
         return np.array([e.name in self.palette_background for e in self.palette], dtype=np.bool_)
 
 
-def _message(exc: ValidationError) -> str:
-    err = exc.errors()[0]
-    where = ".".join(str(p) for p in err["loc"])
-    more = f" (and {exc.error_count() - 1} more)" if exc.error_count() > 1 else ""
-    return f"clusterer.{where}: {err['msg']}{more}" if where else f"clusterer: {err['msg']}{more}"
-
-
 def parse_params(text: str, name: str) -> ClustererParams:
     try:
         data = tomllib.loads(text)
@@ -143,7 +136,7 @@ def parse_params(text: str, name: str) -> ClustererParams:
     try:
         return ClustererParams.model_validate(data.get("clusterer", {}))
     except ValidationError as exc:
-        raise EvclustError(f"{name}: {_message(exc)}") from None
+        raise EvclustError(f"{name}: {validation_message(exc, 'clusterer')}") from None
 
 
 def preset_names() -> list[str]:

@@ -9,10 +9,7 @@ import numpy as np
 from tqdm import tqdm
 
 from evclust.clusterer import float_model
-from evclust.clusterer.layout import (
-    BG_CB, BG_CR, BG_Y, CREATED, DROPPED, EVENTS, EVICTED, EXITED, EXPIRED, GLOBAL_COLUMNS, NOISE,
-    RECORD_COLUMNS, SLOT_COLUMNS, STEP,
-)  # fmt: skip
+from evclust.clusterer.layout import BG_CB, BG_CR, BG_Y, GLOBAL_COLUMNS, RECORD_COLUMNS, SLOT_COLUMNS, run_stats
 from evclust.clusterer.params import ClustererParams
 from evclust.errors import EvclustError
 from evclust.events import EventMeta
@@ -66,11 +63,7 @@ class FloatClusterer:
         return out[:n]
 
     def stats(self) -> dict:
-        g = self.globals
-        return {
-            "events": int(g[EVENTS]), "steps": int(g[STEP]), "created": int(g[CREATED]), "evicted": int(g[EVICTED]),
-            "dropped": int(g[DROPPED]), "expired": int(g[EXPIRED]), "exited": int(g[EXITED]), "noise_decisions": int(g[NOISE]),
-        }  # fmt: skip
+        return run_stats(self.globals)
 
 
 def _fixed_clusterer(*args, **kwargs):

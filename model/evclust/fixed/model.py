@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from evclust.clusterer.layout import BG_CB, BG_CR, BG_Y, CREATED, DROPPED, EVENTS, EVICTED, EXITED, EXPIRED, NOISE, RECORD_COLUMNS, SLOT_COLUMNS, STEP
+from evclust.clusterer.layout import BG_CB, BG_CR, BG_Y, RECORD_COLUMNS, SLOT_COLUMNS, run_stats
 from evclust.clusterer.params import ClustererParams
 from evclust.fixed import fixed_model
 from evclust.fixed.formats import build_formats, decay_table
@@ -51,12 +51,8 @@ class FixedClusterer:
         return out[:n]
 
     def stats(self) -> dict:
-        g = self.globals
-        return {
-            "events": int(g[EVENTS]), "steps": int(g[STEP]), "created": int(g[CREATED]), "evicted": int(g[EVICTED]),
-            "dropped": int(g[DROPPED]), "expired": int(g[EXPIRED]), "exited": int(g[EXITED]), "noise_decisions": int(g[NOISE]),
-            "saturations": {name: int(c) for name, c in zip(fixed_model.SIGNALS, self.overflow) if c},
-        }  # fmt: skip
+        saturations = {name: int(c) for name, c in zip(fixed_model.SIGNALS, self.overflow) if c}
+        return run_stats(self.globals) | {"saturations": saturations}
 
     def range_report(self) -> list[tuple[str, float, float, int]]:
         """(signal, min seen, max seen, saturations) in real units, for `--ranges`."""

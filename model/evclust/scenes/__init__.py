@@ -9,7 +9,7 @@ from pathlib import Path
 
 from pydantic import ValidationError
 
-from evclust.errors import EvclustError
+from evclust.errors import EvclustError, validation_message
 from evclust.scenes.schema import SceneSpec, SensorSpec
 from evclust.scenes.synthetic import TRUTH_COLUMNS, SyntheticSource
 from evclust.scenes.truth import write_truth
@@ -35,13 +35,6 @@ def builtin_scenes() -> list[str]:
     return sorted(p.name[: -len(".toml")] for p in folder.iterdir() if p.name.endswith(".toml"))
 
 
-def _pydantic_message(exc: ValidationError) -> str:
-    err = exc.errors()[0]
-    where = ".".join(str(part) for part in err["loc"])
-    extra = f" (and {exc.error_count() - 1} more)" if exc.error_count() > 1 else ""
-    return f"{where}: {err['msg']}{extra}" if where else f"{err['msg']}{extra}"
-
-
 def parse_scene(text: str, name: str) -> SceneSpec:
     try:
         data = tomllib.loads(text)
@@ -50,7 +43,7 @@ def parse_scene(text: str, name: str) -> SceneSpec:
     try:
         return SceneSpec.model_validate(data)
     except ValidationError as exc:
-        raise EvclustError(f"{name}: {_pydantic_message(exc)}") from None
+        raise EvclustError(f"{name}: {validation_message(exc)}") from None
 
 
 def scene_from_toml(text: str, name: str = "<scene>", base_dir: Path = Path(".")) -> Scene:

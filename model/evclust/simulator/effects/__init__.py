@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pydantic import ValidationError
 
-from evclust.errors import EvclustError
+from evclust.errors import EvclustError, validation_message
 from evclust.simulator.effects.base import Effect, EffectParams, Interval, SensorGeometry
 from evclust.simulator.effects.background import BackgroundActivity
 from evclust.simulator.effects.bayer import Bayer
@@ -50,8 +50,6 @@ def build_effects(config: dict[str, dict], geometry: SensorGeometry, seed: int) 
         try:
             params = cls.Params.model_validate(raw)
         except ValidationError as exc:
-            err = exc.errors()[0]
-            where = ".".join(str(p) for p in err["loc"])
-            raise EvclustError(f"effects.{name}.{where}: {err['msg']}") from None
+            raise EvclustError(validation_message(exc, f"effects.{name}")) from None
         effects.append(cls(params, geometry, seed))
     return effects
