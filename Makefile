@@ -6,7 +6,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 BUILD  := build
 
-.PHONY: setup demo test bench results params clean
+.PHONY: setup demo test bench results params vectors clean
 
 setup: $(STAMP)
 
@@ -41,6 +41,10 @@ bench: $(STAMP)
 # The RTL parameter header, generated from the formats table (tests fail when it is stale).
 params: $(STAMP)
 	$(VENV)/bin/evclust formats --verilog rtl/evclust_params.vh > /dev/null
+
+# Golden vectors for the RTL, from the fixed model (tests fail when they are stale).
+vectors: $(STAMP)
+	$(VENV)/bin/evclust vectors -o vectors
 
 # Task accuracy on the built-in scenes: docs/RESULTS.md and its figures.
 results: $(STAMP)

@@ -454,8 +454,14 @@ def _filter_step(S, H, G, t, k, table, palette, inv_ww, background_mask, out, n_
     return n_out
 
 
+# Trace actions (golden vectors): what each event did, and to which slot.
+TRACE_UPDATE, TRACE_CREATE, TRACE_EVICT, TRACE_DROP = range(4)
+
+
 @numba.njit(cache=True, nogil=True)
-def run_events(S, H, G, k, table, palette, inv_ww, background_mask, t_us, xs, ys, lums, cbs, crs, out, log, ranges):
+def run_events(S, H, G, k, table, palette, inv_ww, background_mask, t_us, xs, ys, lums, cbs, crs, out, log, ranges, trace=None):
+    """Feed events; write records into `out`; with `trace` (an int64 array), write each event's
+    action << 16 | slot there (a None trace compiles without it)."""
     n_out = 0
     fb = k[C_FB]
     for i in range(t_us.size):
@@ -469,15 +475,21 @@ def run_events(S, H, G, k, table, palette, inv_ww, background_mask, t_us, xs, ys
         G[EVENTS] += 1
         s = _seek(S, ex << k[C_FP], ey << k[C_FP], k)
         updated_reported = False
+        action = TRACE_UPDATE
         if s < 0:
+            evicted_before = G[EVICTED]
             s = _slot_for_new(S, G, t, k, table)
             if s >= 0:
                 _create(S, H, G, s, t, ex, ey, lum, cb, cr, k)
+                action = TRACE_EVICT if G[EVICTED] > evicted_before else TRACE_CREATE
             else:
                 G[DROPPED] += 1
+                action = TRACE_DROP
         else:
             _update(S, H, G, s, t, ex, ey, lum, cb, cr, k, table, palette, inv_ww, background_mask, log, ranges)
             updated_reported = S[s, REPORTED] != 0
+        if trace is not None:
+            trace[i] = (action << 16) | max(s, 0)
         if k[C_COLOUR] != 0 and k[C_BG_FIXED] == 0 and not updated_reported:
             G[BG_Y] = _seen(alpha_step_nb(G[BG_Y], lum, k[C_B_BG], k[C_BB_BG], fb, FLOOR), S_BG, ranges)
             G[BG_CB] = _seen(alpha_step_nb(G[BG_CB], cb, k[C_B_BG], k[C_BB_BG], fb, FLOOR), S_BG, ranges)

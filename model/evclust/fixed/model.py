@@ -41,12 +41,15 @@ class FixedClusterer:
             self.ranges = np.zeros((len(fixed_model.SIGNALS), 2), dtype=np.int64)
             self.ranges[:, 0], self.ranges[:, 1] = np.iinfo(np.int64).max, np.iinfo(np.int64).min
 
-    def feed(self, events: np.ndarray) -> np.ndarray:
+    def feed(self, events: np.ndarray, trace: np.ndarray | None = None) -> np.ndarray:
+        """Records of the filter steps these events complete; with `trace` (int64, one per event),
+        each event's action << 16 | slot (fixed_model.TRACE_*)."""
         every = self.params.filter_every
         out = np.empty(((events.size // every + 1) * self.params.n_clusters, RECORD_COLUMNS))
         n = fixed_model.run_events(
             self.slots, self.hist, self.globals, self.k, self.decay, self.palette, self.inv_ww, self.background_mask,
             events["t"], events["x"], events["y"], events["Y"], events["Cb"], events["Cr"], out, self.overflow, self.ranges,
+            trace,
         )  # fmt: skip
         return out[:n]
 

@@ -1,0 +1,88 @@
+"""Packing events, track records and trace entries into fixed-width hex words, MSB first."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from evclust.fixed.formats import FormatTable
+from evclust.tracks import TRACK_DTYPE
+
+# (name, width, signed) per field; events and trace have fixed layouts apart from the coordinates.
+TRACE_FIELDS = (("action", 2, False), ("slot", 8, False))  # action: 0 update, 1 create, 2 evict, 3 drop
+
+
+def event_fields(table: FormatTable):
+    xy = table["ev_xy"].word_bits
+    return (("t", 32, False), ("x", xy, False), ("y", xy, False), ("on", 1, False), ("Y", 8, False), ("Cb", 8, False), ("Cr", 8, False))
+
+
+EVENT_FIELDS = event_fields  # the layout depends on the sensor: call with the table
+
+
+def record_fields(table: FormatTable):
+    """The track record as the RTL emits it: raw values in their formats."""
+    f = table.formats
+    slot_bits = max(1, math.ceil(math.log2(table.n_clusters)))
+    return (
+        ("t_us", 32, False, 0), ("step", 32, False, 0), ("slot", slot_bits, False, 0), ("id", 32, False, 0),
+        ("x", f["centre"].word_bits, False, f["centre"].frac_bits), ("y", f["centre"].word_bits, False, f["centre"].frac_bits),
+        ("rx", f["half_size"].word_bits, False, f["half_size"].frac_bits), ("ry", f["half_size"].word_bits, False, f["half_size"].frac_bits),
+        ("activity", f["activity"].word_bits, False, f["activity"].frac_bits),
+        ("vx_mcm", f["v_mcm"].word_bits, True, f["v_mcm"].frac_bits), ("vy_mcm", f["v_mcm"].word_bits, True, f["v_mcm"].frac_bits),
+        ("vx_int", f["v_int"].word_bits, True, f["v_int"].frac_bits), ("vy_int", f["v_int"].word_bits, True, f["v_int"].frac_bits),
+        ("Y", f["colour"].word_bits, False, f["colour"].frac_bits), ("Cb", f["colour"].word_bits, False, f["colour"].frac_bits),
+        ("Cr", f["colour"].word_bits, False, f["colour"].frac_bits),
+        ("class", 8, True, 0), ("flags", 4, False, 0),
+    )  # fmt: skip
+
+
+def pack(values, fields) -> int:
+    """Concatenate field values (ints), MSB first; signed fields in two's complement."""
+    word = 0
+    for value, (name, width, signed, *_) in zip(values, fields):
+        value = int(value)
+        lo, hi = (-(1 << (width - 1)), (1 << (width - 1)) - 1) if signed else (0, (1 << width) - 1)
+        if not lo <= value <= hi:
+            raise ValueError(f"field {name}={value} does not fit {width} bits{' signed' if signed else ''}")
+        word = (word << width) | (value & ((1 << width) - 1))
+    return word
+
+
+def unpack(word: int, fields) -> list[int]:
+    values = []
+    for name, width, signed, *_ in reversed(fields):
+        v = word & ((1 << width) - 1)
+        word >>= width
+        if signed and v >> (width - 1):
+            v -= 1 << width
+        values.append(v)
+    return values[::-1]
+
+
+def hex_lines(words, fields) -> str:
+    digits = math.ceil(sum(f[1] for f in fields) / 4)
+    return "".join(f"{w:0{digits}x}\n" for w in words)
+
+
+def event_words(events: np.ndarray, table: FormatTable) -> list[int]:
+    fields = event_fields(table)
+    t = (events["t"] & np.uint64(0xFFFFFFFF)).tolist()
+    cols = zip(t, events["x"].tolist(), events["y"].tolist(), (events["p"] > 0).astype(int).tolist(),
+               events["Y"].tolist(), events["Cb"].tolist(), events["Cr"].tolist())  # fmt: skip
+    return [pack(row, fields) for row in cols]
+
+
+def record_words(tracks: np.ndarray, table: FormatTable) -> list[int]:
+    """Track records (values converted from their formats) back to raw integers, exactly."""
+    fields = record_fields(table)
+    assert tuple(f[0] for f in fields) == TRACK_DTYPE.names
+    raws = []
+    for name, _, _, frac in fields:
+        column = tracks[name].astype(np.float64) * 2.0**frac
+        raw = np.rint(column)
+        if not np.array_equal(raw, column):
+            raise ValueError(f"record field {name} is not a whole number of LSBs")
+        raws.append(raw.astype(np.int64).tolist())
+    return [pack(row, fields) for row in zip(*raws)]

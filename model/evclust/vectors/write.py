@@ -1,0 +1,81 @@
+"""Writing the vector cases, and checking the committed ones are what the model makes now."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from evclust import __version__
+from evclust.clusterer.run import records_to_tracks
+from evclust.fixed.model import FixedClusterer
+from evclust.vectors.cases import CASES
+from evclust.vectors.pack import TRACE_FIELDS, event_fields, event_words, hex_lines, pack, record_fields, record_words
+
+FILES = ("events.hex", "expected.hex", "trace.hex")
+
+
+def _layout(fields) -> list[dict]:
+    """Field name, width, signedness and LSB position (bit 0 = the word's last bit)."""
+    out, lsb = [], sum(f[1] for f in fields)
+    for name, width, signed, *rest in fields:
+        lsb -= width
+        out.append({"name": name, "bits": width, "signed": signed, "lsb": lsb} | ({"frac_bits": rest[0]} if rest else {}))
+    return out
+
+
+def write_case(name: str, folder: Path) -> dict:
+    case = CASES[name]()
+    model = FixedClusterer(case.params, case.width, case.height, case.t_frame_us)
+    trace = np.zeros(case.events.size, np.int64)
+    tracks = records_to_tracks(model.feed(case.events, trace))
+    table = model.table
+    contents = {
+        "events.hex": hex_lines(event_words(case.events, table), event_fields(table)),
+        "expected.hex": hex_lines(record_words(tracks, table), record_fields(table)),
+        "trace.hex": hex_lines([pack((int(v) >> 16, int(v) & 0xFFFF), TRACE_FIELDS) for v in trace], TRACE_FIELDS),
+    }
+    folder.mkdir(parents=True, exist_ok=True)
+    for file, text in contents.items():
+        (folder / file).write_text(text)
+    manifest = {
+        "case": name,
+        "description": case.description,
+        "source": case.source,
+        "seed": case.seed,
+        "model": f"evclust {__version__}, fixed-point model",
+        "sensor": {"width": case.width, "height": case.height},
+        "t_frame_us": case.t_frame_us,
+        "n_clusters": case.params.n_clusters,
+        "palette_size": len(case.params.palette),
+        "parameters": case.params.model_dump(mode="json", exclude_none=True),
+        "constants": {c.name: c.raw for c in table.constants.values()},
+        "formats": {f.name: {"q": f.q, "signed": f.signed, "int_bits": f.int_bits, "frac_bits": f.frac_bits,
+                             "rounding": f.rounding, "overflow": f.overflow} for f in table.formats.values()},  # fmt: skip
+        "layouts": {"events.hex": _layout(event_fields(table)), "expected.hex": _layout(record_fields(table)),
+                    "trace.hex": _layout(TRACE_FIELDS)},  # fmt: skip
+        "counts": {"events": int(case.events.size), "records": int(tracks.size), **model.stats()},
+        "sha256": {file: hashlib.sha256(text.encode()).hexdigest() for file, text in contents.items()},
+    }
+    (folder / "manifest.json").write_text(json.dumps(manifest, indent=1, sort_keys=False) + "\n")
+    return manifest
+
+
+def write_vectors(root: Path, names=None) -> dict[str, dict]:
+    return {name: write_case(name, Path(root) / name) for name in (names or CASES)}
+
+
+def check_vectors(root: Path) -> list[str]:
+    """Cases whose committed files differ from a fresh generation (empty: all up to date)."""
+    stale = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for name in CASES:
+            write_case(name, Path(tmp) / name)
+            for file in (*FILES, "manifest.json"):
+                committed = Path(root) / name / file
+                if not committed.is_file() or committed.read_bytes() != (Path(tmp) / name / file).read_bytes():
+                    stale.append(f"{name}/{file}")
+    return stale
