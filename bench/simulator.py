@@ -414,7 +414,7 @@ def report(cases: list[Case], costs: list[EffectCost], video_note: str, repeat: 
     lines += cost_model(cases)
     lines += [
         "",
-        "For scale: a C++ DVS simulator (no colour) manages about 76 Mpx-frames/s and 1.5 Mev/s on this class of machine. "
+        "For scale, the project's brief quotes a C++ DVS simulator (no colour) at about 76 Mpx-frames/s and 1.5 Mev/s on this class of machine; that simulator is not run here. "
         "Mev/s depends on how many events a scene makes per pixel, so it is reported per scene.",
         "",
         "### Per case",

@@ -640,3 +640,21 @@ def test_every_numba_variant_compiles_in_njit():
         A.decay(1000, 4096, 1, 12, table, 6, 16, NEAREST),
     )
     assert got == want == (-(2**15), 2**15 - 1, 2**15 - 1, -(2**15), True, -56, -3, -7, 3, 100, 100, 500)
+
+
+@SOME
+@given(st.lists(st.integers(0, 5000), min_size=1, max_size=40), st.integers(1, 2**20), st.integers(20, 40))
+def test_decay_steps_carrying_the_residual_lose_no_time(pieces, inv, frac):
+    # Cutting Δt into pieces and carrying the residual gives exactly the steps of the whole Δt,
+    # in both families; flooring each piece afresh would lose up to one step per piece.
+    whole, whole_rest = A.decay_steps(sum(pieces), 0, inv, frac, 6)
+    steps, rest = 0, 0
+    for dt in pieces:
+        m, rest = A.decay_steps(dt, rest, inv, frac, 6)
+        steps += m
+    assert (steps, rest) == (whole, whole_rest)
+    m_nb, rest_nb, total = 0, 0, 0
+    for dt in pieces:
+        m_nb, rest_nb = A.decay_steps_nb(dt, rest_nb, inv, frac, 6)
+        total += m_nb
+    assert (total, rest_nb) == (whole, whole_rest)

@@ -418,10 +418,27 @@ def decay(a_raw, dt, inv_t_half_raw, inv_frac_bits, table, table_bits, table_fra
     if dt < 0 or a_raw < 0:
         raise ValueError("decay: a_raw and dt must be >= 0")
     m = shift_round(dt * inv_t_half_raw, inv_frac_bits - table_bits, mode)
+    return decay_apply(a_raw, m, table, table_bits, table_frac_bits, mode)
+
+
+def decay_apply(a_raw, m, table, table_bits, table_frac_bits, mode):
+    """``a · 2^-(m / 2^L)``: the integer part of ``m / 2^L`` is a shift, its fraction the table
+    entry ``T[m mod 2^L]``; one product, one rounding. 0 when the shift passes 62 bits (exact)."""
     total = (m >> table_bits) + table_frac_bits
     if total > 62:
         return 0
     return shift_round(a_raw * int(table[m & ((1 << table_bits) - 1)]), total, mode)
+
+
+def decay_steps(dt, residual, inv_t_half_raw, inv_frac_bits, table_bits):
+    """Δt/T_half as whole table steps (2^-L half-lives) and the residual below one step.
+
+    ``n = dt·inv_t_half_raw + residual`` (a multiply); the bits below one step are returned, to be
+    passed back next time. A stateful decay that floors ``dt·(1/T_half)`` afresh at every event
+    loses every decay between events closer than one step; carrying the residual loses none."""
+    n = dt * inv_t_half_raw + residual
+    drop = inv_frac_bits - table_bits
+    return n >> drop, n & ((1 << drop) - 1)
 
 
 @njit(cache=True)
@@ -430,10 +447,24 @@ def decay_nb(a_raw, dt, inv_t_half_raw, inv_frac_bits, table, table_bits, table_
     if dt < 0 or a_raw < 0:
         raise ValueError("decay: a_raw and dt must be >= 0")
     m = shift_round_nb(dt * inv_t_half_raw, inv_frac_bits - table_bits, mode)
+    return decay_apply_nb(a_raw, m, table, table_bits, table_frac_bits, mode)
+
+
+@njit(cache=True, inline="always")
+def decay_apply_nb(a_raw, m, table, table_bits, table_frac_bits, mode):
+    """numba twin of `decay_apply`; ``table`` an int64 array."""
     total = (m >> table_bits) + table_frac_bits
     if total > 62:
-        return 0
+        return np.int64(0)
     return shift_round_nb(a_raw * table[m & ((1 << table_bits) - 1)], total, mode)
+
+
+@njit(cache=True, inline="always")
+def decay_steps_nb(dt, residual, inv_t_half_raw, inv_frac_bits, table_bits):
+    """numba twin of `decay_steps`."""
+    n = dt * inv_t_half_raw + residual
+    drop = inv_frac_bits - table_bits
+    return n >> drop, n & ((np.int64(1) << drop) - 1)
 
 
 def decay_error_bound(a_raw, dt, t_half, inv_t_half_raw, inv_frac_bits, table_bits, table_frac_bits, mode) -> float:

@@ -17,7 +17,8 @@ from evclust.clusterer.layout import (
     NEXT_ID, NOISE, PPX, PPY, PX, PY, RECORD_COLUMNS, REPORTED, RX, RY, SINCE_FILTER, STEP, T_FILTER,
     T_LAST, VALID, VI_COUNT, VIX, VIY, VMX, VMY,
 )  # fmt: skip
-from evclust.fixed.arith import FLOOR, NEAREST, alpha_step_nb, shift_round_nb
+from evclust.fixed.arith import FLOOR, NEAREST, alpha_step_nb, decay_apply_nb, decay_nb, decay_steps_nb
+from evclust.fixed.formats import DECAY_FRAC_BITS, DECAY_TABLE_BITS
 
 TIME_MASK = (1 << 32) - 1
 # Globals beyond the float model's: the τ phase (µs since the last boundary).
@@ -45,10 +46,10 @@ SIGNALS = (
     C_INV_P, C_INV_P_F, C_BG_FIXED, C_LUMA_W, C_LUMA_W_F, C_H_MAX,
     C_V_MIN_SQ, C_V_EXIT_SQ, C_SQ_F, C_COS_SQ, C_COS_SQ_F, C_EXIT_M,
     C_WIDTH, C_HEIGHT, C_COLOUR, C_WARM, C_MCM_CORRECT, C_VOTE_CONTRAST, C_MIXING, C_MIX_TOL,
-    C_MAX_CENTRE, C_MAX_ACT, C_MAX_V, C_MIN_V, C_MAX_VI, C_MIN_VI, C_MAX_W, C_MAX_GAMMA, C_MAX_COLOUR,
-    C_MAX_BG, C_MAX_EVCOUNT, C_MAX_HALF, C_MAX_SIZE_TARGET, C_V_FULL_BITS, C_MAX_SPEED_SQ,
-) = range(76)  # fmt: skip
-N_CONSTANTS = 76
+    C_MAX_ACT, C_MAX_V, C_MIN_V, C_MAX_VI, C_MIN_VI, C_MAX_GAMMA,
+    C_MAX_EVCOUNT, C_MAX_SIZE_TARGET, C_V_FULL_BITS, C_MAX_SPEED_SQ,
+) = range(71)  # fmt: skip
+N_CONSTANTS = 71
 
 
 def constant_vector(table, params, has_colour: bool) -> np.ndarray:
@@ -87,13 +88,12 @@ def constant_vector(table, params, has_colour: bool) -> np.ndarray:
     k[C_WIDTH], k[C_HEIGHT], k[C_COLOUR] = table.width, table.height, has_colour
     k[C_WARM], k[C_MCM_CORRECT] = params.velocity_warm_start, params.mcm_bias_correction
     k[C_VOTE_CONTRAST], k[C_MIXING], k[C_MIX_TOL] = params.palette_vote == "contrast", params.palette_assign == "mixing", raw("mixing_tolerance")
-    k[C_MAX_CENTRE], k[C_MAX_ACT], k[C_MAX_HALF] = f["centre"].raw_max, f["activity"].raw_max, f["half_size"].raw_max
+    k[C_MAX_ACT] = f["activity"].raw_max
     k[C_MAX_SIZE_TARGET] = f["size_target"].raw_max
     k[C_V_FULL_BITS], k[C_MAX_SPEED_SQ] = f["v_int"].int_bits, f["speed_sq"].raw_max
     k[C_MAX_V], k[C_MIN_V] = f["v_mcm"].raw_max, f["v_mcm"].raw_min
     k[C_MAX_VI], k[C_MIN_VI] = f["v_int"].raw_max, f["v_int"].raw_min
-    k[C_MAX_W], k[C_MAX_GAMMA], k[C_MAX_COLOUR] = f["mcm_norm"].raw_max, f["gamma"].raw_max, f["colour"].raw_max
-    k[C_MAX_BG], k[C_MAX_EVCOUNT] = f["background"].raw_max, f["events_in_interval"].raw_max
+    k[C_MAX_GAMMA], k[C_MAX_EVCOUNT] = f["gamma"].raw_max, f["events_in_interval"].raw_max
     return k
 
 
@@ -136,41 +136,17 @@ def _align(raw, from_frac, to_frac):
     return raw >> (from_frac - to_frac)
 
 
-DECAY_TABLE_BITS, DECAY_FRAC_BITS = 6, 16
-
-
-@numba.njit(cache=True, nogil=True, inline="always")
-def _decay_steps(dt, residual, k):
-    """Δt/T_half as whole table steps (2^-6 half-lives) and the residual left below one step.
-
-    Δt·(1/T_half) is a multiply; the bits below one table step are kept for the next time,
-    so events microseconds apart still decay (a per-event floor would lose it all)."""
-    n = dt * k[C_INV_TH] + residual
-    drop = k[C_INV_TH_F] - DECAY_TABLE_BITS
-    return n >> drop, n & ((np.int64(1) << drop) - 1)
-
-
-@numba.njit(cache=True, nogil=True, inline="always")
-def _apply_decay(a, m, table):
-    """a · 2^-(m / 64): the integer part of m/64 is a shift, its fraction a table entry."""
-    total = (m >> DECAY_TABLE_BITS) + DECAY_FRAC_BITS
-    if total > 62:
-        return np.int64(0)
-    return shift_round_nb(a * table[m & ((1 << DECAY_TABLE_BITS) - 1)], total, FLOOR)
-
-
 @numba.njit(cache=True, nogil=True, inline="always")
 def _decayed(a, dt, k, table):
     """For comparisons only (eviction): the activity decayed to now, the slot left unchanged."""
-    m, _ = _decay_steps(dt, 0, k)
-    return _apply_decay(a, m, table)
+    return decay_nb(a, dt, k[C_INV_TH], k[C_INV_TH_F], table, DECAY_TABLE_BITS, DECAY_FRAC_BITS, FLOOR)
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
 def _decay_slot(S, s, t, k, table):
     """Decay the slot's activity to t, carrying the residual; t becomes its reference time."""
-    m, S[s, DECAY_RESIDUAL] = _decay_steps((t - S[s, T_LAST]) & TIME_MASK, S[s, DECAY_RESIDUAL], k)
-    S[s, ACT] = _apply_decay(S[s, ACT], m, table)
+    m, S[s, DECAY_RESIDUAL] = decay_steps_nb((t - S[s, T_LAST]) & TIME_MASK, S[s, DECAY_RESIDUAL], k[C_INV_TH], k[C_INV_TH_F], DECAY_TABLE_BITS)
+    S[s, ACT] = decay_apply_nb(S[s, ACT], m, table, DECAY_TABLE_BITS, DECAY_FRAC_BITS, FLOOR)
     S[s, T_LAST] = t
 
 

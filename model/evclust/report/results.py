@@ -53,16 +53,32 @@ AGREEMENT_METRICS = (
 )  # fmt: skip
 
 
-def model_agreement(name: str) -> dict:
+@dataclasses.dataclass
+class PreparedScene:
+    """A built-in scene simulated once, its ground truth, its preset and the float model's run."""
+
+    name: str
+    sim: object
+    truth: np.ndarray
+    params: object
+    origin: str
+    float_run: object
+
+
+def prepare_scene(name: str) -> PreparedScene:
+    scene = load_scene(name)
+    sim = simulate_scene(scene)
+    params, origin = load_params(None, sim.meta.source)
+    return PreparedScene(name, sim, truth_array(scene.source.truth()), params, origin, track_events(sim.events, sim.meta, params))
+
+
+def model_agreement(p: PreparedScene) -> dict:
     """Fixed against float on one scene: each metric's relative difference, the filter steps
     reporting the same objects (records paired by position within 2 px), the centre difference."""
     from scipy.optimize import linear_sum_assignment
 
-    scene = load_scene(name)
-    sim = simulate_scene(scene)
-    truth = truth_array(scene.source.truth())
-    params, _ = load_params(None, sim.meta.source)
-    runs = {m: track_events(sim.events, sim.meta, params, model=m) for m in ("float", "fixed")}
+    truth = p.truth
+    runs = {"float": p.float_run, "fixed": track_events(p.sim.events, p.sim.meta, p.params, model="fixed")}
     scores = {m: scores_from_matches(*match_with_counts(r.tracks, r.meta, truth), r.meta, DEFAULT_GATE_PX, False).to_dict() for m, r in runs.items()}
     rows = []
     for label, path in AGREEMENT_METRICS:
@@ -91,8 +107,9 @@ def model_agreement(name: str) -> dict:
             "centre_max": float(np.max(dist)) if dist else None, "saturations": runs["fixed"].stats["saturations"]}  # fmt: skip
 
 
-def agreement_table(names) -> list[str]:
-    results = {name: model_agreement(name) for name in names}
+def agreement_table(prepared: list[PreparedScene]) -> list[str]:
+    names = [p.name for p in prepared]
+    results = {p.name: model_agreement(p) for p in prepared}
     lines = ["## Fixed-point model against the float model", "",
              "The same events, the same preset; the fixed model's figures relative to the float model's "
              "(issue 4's target: every task metric within 1 %).", "",
@@ -148,12 +165,8 @@ def label_accuracy(matches, palette) -> dict:
             for label in np.unique(matches["gt_label"])}  # fmt: skip
 
 
-def scene_results(name: str, figures: Path | None = None) -> SceneResult:
-    scene = load_scene(name)
-    sim = simulate_scene(scene)
-    truth = truth_array(scene.source.truth())
-    params, origin = load_params(None, sim.meta.source)
-    run = track_events(sim.events, sim.meta, params)
+def scene_results(p: PreparedScene, figures: Path | None = None) -> SceneResult:
+    name, sim, truth, origin, run = p.name, p.sim, p.truth, p.origin, p.float_run
     matches, counts = match_with_counts(run.tracks, run.meta, truth)
     if figures is not None:
         figures.mkdir(parents=True, exist_ok=True)
@@ -236,7 +249,8 @@ def target_table(results: list[SceneResult]) -> list[str]:
 def write_results(
     path: Path, scenes=("pedestrian", "traffic"), figures: Path | None = None, preamble: str = "", epilogue: str = ""
 ) -> list[SceneResult]:
-    results = [scene_results(name, figures) for name in scenes]
+    prepared = [prepare_scene(name) for name in scenes]
+    results = [scene_results(p, figures) for p in prepared]
     lines = [preamble.rstrip(), "", "## Targets", "", *target_table(results), "", "## Tables 5 and 7, per scene", ""]
     for r in results:
         lines += scene_table(r)
@@ -244,7 +258,7 @@ def write_results(
             rel = Path("img")
             lines += [f"![{r.name}: velocity against ground truth]({rel}/results_{r.name}_velocity.png)", "",
                       f"![{r.name}: colour against ground truth]({rel}/results_{r.name}_colour.png)", ""]  # fmt: skip
-    lines += agreement_table(scenes)
+    lines += agreement_table(prepared)
     lines.append(epilogue)
     with atomic_output(path) as tmp:
         tmp.write_text("\n".join(lines).lstrip() + "\n")

@@ -112,7 +112,7 @@ class Simulator:
         while pixel < l0.size:
             n, pixel = detect_interval(
                 l0, l1, rgb0, rgb1, ref, self.th_on, self.th_off, self.th_stride, self.geometry.width,
-                t0_us, self.geometry.t_frame_us, pixel, buf.words, buf.keys, RGB_TO_YCBCR,
+                t0_us, self.geometry.t_sample_us, pixel, buf.words, buf.keys, RGB_TO_YCBCR,
             )  # fmt: skip
             if n == 0 and pixel < l0.size:  # one pixel crosses more levels than the buffer holds
                 self.buffer = buf = EventBuffer(2 * buf.keys.size)
@@ -131,7 +131,7 @@ class Simulator:
         progress: bool = False,
         frame_period_us: float | None = None,
     ) -> Simulation:
-        """Simulate the sensor over `frames`, sampled every geometry.t_frame_us. `frame_period_us`
+        """Simulate the sensor over `frames`, sampled every geometry.t_sample_us. `frame_period_us`
         is the scene's frame period recorded in the metadata (velocities are per frame); by
         default the sampling period."""
         start = time.perf_counter()
@@ -150,10 +150,10 @@ class Simulator:
             if ref is None:
                 ref = level.astype(np.float64)  # the reference starts at the first frame: no events
             else:
-                t0 = (k - 1) * g.t_frame_us
+                t0 = (k - 1) * g.t_sample_us
                 events = self._detect(l_prev, level, rgb_prev, colour, ref, t0)
                 for effect in self.interval_effects:
-                    events = effect.interval(events, Interval(k, t0, t0 + g.t_frame_us, rgb_prev.reshape(shape), colour.reshape(shape)))
+                    events = effect.interval(events, Interval(k, t0, t0 + g.t_sample_us, rgb_prev.reshape(shape), colour.reshape(shape)))
                 if chunks:
                     _join_at_boundary(chunks[-1], events)
                 chunks.append(events)
@@ -161,5 +161,5 @@ class Simulator:
         events = concat_events(chunks)
         for effect in self.stream_effects:
             events = effect.stream(events)
-        meta = EventMeta(width=g.width, height=g.height, source=source, t_frame_us=frame_period_us or g.t_frame_us)
-        return Simulation(events, meta, k + 1, g.t_frame_us, time.perf_counter() - start)
+        meta = EventMeta(width=g.width, height=g.height, source=source, t_frame_us=frame_period_us or g.t_sample_us)
+        return Simulation(events, meta, k + 1, g.t_sample_us, time.perf_counter() - start)

@@ -18,9 +18,6 @@ def event_fields(table: FormatTable):
     return (("t", 32, False), ("x", xy, False), ("y", xy, False), ("on", 1, False), ("Y", 8, False), ("Cb", 8, False), ("Cr", 8, False))
 
 
-EVENT_FIELDS = event_fields  # the layout depends on the sensor: call with the table
-
-
 def record_fields(table: FormatTable):
     """The track record as the RTL emits it: raw values in their formats."""
     f = table.formats

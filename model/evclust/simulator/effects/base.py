@@ -29,7 +29,7 @@ class EffectParams(BaseModel):
 class SensorGeometry:
     width: int
     height: int
-    t_frame_us: float
+    t_sample_us: float  # the period of the frames the sensor sees: a frame, or a sub-step of one
 
 
 @dataclasses.dataclass
