@@ -27,16 +27,24 @@ def _layout(fields) -> list[dict]:
     return out
 
 
+def model_words(model: FixedClusterer, events: np.ndarray) -> tuple[list[int], list[int], list[int]]:
+    """Feed events to the fixed model: (event words, record words, trace words), packed as the
+    RTL's streams carry them. The model keeps its state, so a stream can be fed in pieces."""
+    trace = np.zeros(events.size, np.int64)
+    tracks = records_to_tracks(model.feed(events, trace))
+    words = [pack((int(v) >> 16, int(v) & 0xFFFF), TRACE_FIELDS) for v in trace]
+    return event_words(events, model.table), record_words(tracks, model.table), words
+
+
 def write_case(name: str, folder: Path) -> dict:
     case = CASES[name]()
     model = FixedClusterer(case.params, case.width, case.height, case.t_frame_us)
-    trace = np.zeros(case.events.size, np.int64)
-    tracks = records_to_tracks(model.feed(case.events, trace))
+    event_list, record_list, trace_list = model_words(model, case.events)
     table = model.table
     contents = {
-        "events.hex": hex_lines(event_words(case.events, table), event_fields(table)),
-        "expected.hex": hex_lines(record_words(tracks, table), record_fields(table)),
-        "trace.hex": hex_lines([pack((int(v) >> 16, int(v) & 0xFFFF), TRACE_FIELDS) for v in trace], TRACE_FIELDS),
+        "events.hex": hex_lines(event_list, event_fields(table)),
+        "expected.hex": hex_lines(record_list, record_fields(table)),
+        "trace.hex": hex_lines(trace_list, TRACE_FIELDS),
     }
     folder.mkdir(parents=True, exist_ok=True)
     for file, text in contents.items():
@@ -57,7 +65,7 @@ def write_case(name: str, folder: Path) -> dict:
                              "rounding": f.rounding, "overflow": f.overflow} for f in table.formats.values()},  # fmt: skip
         "layouts": {"events.hex": _layout(event_fields(table)), "expected.hex": _layout(record_fields(table)),
                     "trace.hex": _layout(TRACE_FIELDS)},  # fmt: skip
-        "counts": {"events": int(case.events.size), "records": int(tracks.size), **model.stats()},
+        "counts": {"events": int(case.events.size), "records": len(record_list), **model.stats()},
         "sha256": {file: hashlib.sha256(text.encode()).hexdigest() for file, text in contents.items()},
     }
     (folder / "manifest.json").write_text(json.dumps(manifest, indent=1, sort_keys=False) + "\n")

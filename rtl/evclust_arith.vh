@@ -1,0 +1,58 @@
+// Arithmetic primitives of the datapath, one per function of model/evclust/fixed/arith.py.
+// Every intermediate is a 64-bit two's-complement word: the model's int64. Synthesis trims
+// the words to the bits the operands actually carry (Yosys wreduce). Included inside each
+// module body, as functions are module-scoped.
+
+// x + round(((u << guard) - x) * beta * 2^-beta_frac): an alpha filter step (arith.alpha_step).
+// Floor, or round half up when `nearest`.
+function automatic signed [63:0] alpha_step;
+    input signed [63:0] x;
+    input signed [63:0] u;
+    input signed [63:0] beta;
+    input integer beta_frac;
+    input integer guard;
+    input nearest;
+    reg signed [63:0] product;
+    begin
+        product = ((u <<< guard) - x) * beta;
+        if (nearest)
+            product = product + (64'sd1 <<< (beta_frac - 1));
+        alpha_step = x + (product >>> beta_frac);
+    end
+endfunction
+
+// v clipped to [lo, hi] (arith.saturate).
+function automatic signed [63:0] saturate;
+    input signed [63:0] v;
+    input signed [63:0] lo;
+    input signed [63:0] hi;
+    begin
+        saturate = v < lo ? lo : (v > hi ? hi : v);
+    end
+endfunction
+
+// A raw value moved from from_frac to to_frac fraction bits, floor when dropping.
+function automatic signed [63:0] align;
+    input signed [63:0] v;
+    input integer from_frac;
+    input integer to_frac;
+    begin
+        align = to_frac >= from_frac ? v <<< (to_frac - from_frac) : v >>> (from_frac - to_frac);
+    end
+endfunction
+
+function automatic signed [63:0] abs64;
+    input signed [63:0] v;
+    begin
+        abs64 = v < 0 ? -v : v;
+    end
+endfunction
+
+function automatic signed [63:0] min64;
+    input signed [63:0] a;
+    input signed [63:0] b;
+    begin
+        min64 = a < b ? a : b;
+    end
+endfunction
+

@@ -1,0 +1,636 @@
+// evclust_core: the event-by-event colour clusterer, bit for bit the fixed-point model
+// (model/evclust/fixed/fixed_model.py; docs/RTL.md walks through the datapath).
+//
+// Streams: events in (valid/ready, the word of vectors/*/events.hex), track records out
+// (valid/ready, the word of expected.hex) and a trace of each event's action (a monitor port
+// without back-pressure, the word of trace.hex). Reset is synchronous and active high.
+//
+// Schedule: an event is accepted in IDLE together with the parallel nearest-cluster search
+// over all N slots, and applied in EXEC: 2 cycles per event. An event that finds no slot
+// and no free one scans the N slots for the weakest (N + 1 cycles more). Every FILTER_EVERY
+// events the filter step sweeps the table, one slot per cycle, while the mixing palette's
+// 1/|w|^2 entries are refreshed alongside: max(N, PALETTE_SIZE) cycles plus output stalls.
+//
+// N, every width and every constant come from evclust_params.vh, generated from the model's
+// formats table (`evclust formats --verilog`).
+module evclust_core (
+    clk,
+    rst,
+    ev_valid,
+    ev_ready,
+    ev_data,
+    rec_valid,
+    rec_ready,
+    rec_data,
+    trace_valid,
+    trace_data,
+    filter_active
+);
+`include "evclust_params.vh"
+`include "evclust_arith.vh"
+
+    localparam integer N = N_CLUSTERS;
+    localparam integer P = PALETTE_SIZE;
+    localparam integer SLOT_W = N > 1 ? $clog2(N) : 1;
+    localparam integer CLASS_W = P > 1 ? $clog2(P) : 1;
+    localparam integer EV_W = 32 + 2 * EV_XY_W + 1 + 24;
+    localparam integer REC_W = 32 + 32 + SLOT_W + 32 + 2 * CENTRE_W + 2 * HALF_SIZE_W + ACTIVITY_W
+                             + 2 * V_MCM_W + 2 * V_INT_W + 3 * COLOUR_W + 8 + 4;
+    localparam integer TRACE_W = 10;
+    localparam integer SWEEP_LEN = N > P ? N : P;
+    localparam integer SWEEP_W = $clog2(SWEEP_LEN + 1);
+    localparam integer EVERY_W = $clog2(FILTER_EVERY + 1);
+
+    input  wire               clk;
+    input  wire               rst;
+    input  wire               ev_valid;
+    output wire               ev_ready;
+    input  wire [EV_W-1:0]    ev_data;
+    output reg                rec_valid;
+    input  wire               rec_ready;
+    output reg  [REC_W-1:0]   rec_data;
+    output reg                trace_valid;
+    output reg  [TRACE_W-1:0] trace_data;
+    output wire               filter_active;  // the filter step is sweeping the table
+
+    // ---------------------------------------------------------------- formats and constants
+    localparam integer FP = CENTRE_FRAC, FR = HALF_SIZE_FRAC, FA = ACTIVITY_FRAC, FV = V_MCM_FRAC;
+    localparam integer FW = MCM_NORM_FRAC, FI = V_INT_FRAC, FC = COLOUR_FRAC, FB = BACKGROUND_FRAC;
+    localparam integer FG = GAMMA_FRAC, FPT_F = FRAME_PER_TAU_FRAC, SQ_F = SPEED_SQ_FRAC;
+    localparam integer V_FULL_BITS = V_INT_W - 1 - FI;  // v_int's integer bits: full-scale speed
+    localparam signed [63:0] ONE_A = 64'sd1 <<< FA;
+    localparam signed [63:0] MAX_ACT = (64'sd1 <<< ACTIVITY_W) - 1;
+    localparam signed [63:0] MAX_GAMMA = (64'sd1 <<< GAMMA_W) - 1;
+    localparam signed [63:0] MAX_EVCOUNT = (64'sd1 <<< EVENTS_IN_INTERVAL_W) - 1;
+    localparam signed [63:0] MAX_SIZE_TARGET = (64'sd1 <<< SIZE_TARGET_W) - 1;
+    localparam signed [63:0] MAX_SPEED_SQ = (64'sd1 <<< SPEED_SQ_W) - 1;
+    localparam signed [63:0] MAX_V = (64'sd1 <<< (V_MCM_W - 1)) - 1, MIN_V = -(64'sd1 <<< (V_MCM_W - 1));
+    localparam signed [63:0] MAX_VI = (64'sd1 <<< (V_INT_W - 1)) - 1, MIN_VI = -(64'sd1 <<< (V_INT_W - 1));
+    localparam signed [63:0] MAX_STEP = (64'sd1 <<< (4 + FP)) - 1, MIN_STEP = -(64'sd1 <<< (4 + FP));
+    localparam signed [63:0] H_MAX = (64'sd1 <<< HIST_W) - 1;
+    localparam signed [63:0] K_B_POS = $signed({1'b0, BETA_POS}), K_B_SIZE = $signed({1'b0, BETA_SIZE});
+    localparam signed [63:0] K_B_VM = $signed({1'b0, BETA_VEL_MCM}), K_B_VI = $signed({1'b0, BETA_VEL_INT});
+    localparam signed [63:0] K_B_LUM = $signed({1'b0, BETA_LUM}), K_B_CHRO = $signed({1'b0, BETA_CHRO});
+    localparam signed [63:0] K_B_BG = $signed({1'b0, BETA_BG}), K_GAIN = $signed({1'b0, SIZE_GAIN});
+    localparam signed [63:0] K_GAMMA_GLOBAL = $signed({1'b0, GAMMA_GLOBAL}), K_GPA = $signed({1'b0, GAMMA_PER_ACTIVITY});
+    localparam signed [63:0] K_FPT = $signed({1'b0, FRAME_PER_TAU}), K_INV_P = $signed({1'b0, INV_P});
+    localparam signed [63:0] K_R_INIT = $signed({1'b0, R_INIT}), K_R_MIN = $signed({1'b0, R_MIN});
+    localparam signed [63:0] K_R_MAX = $signed({1'b0, R_MAX}), K_SEEK = $signed({1'b0, SEEK_MARGIN});
+    localparam signed [63:0] K_EXIT_M = $signed({1'b0, EXIT_MARGIN}), K_A_MIN = $signed({1'b0, A_MIN});
+    localparam signed [63:0] K_A_VALID = $signed({1'b0, A_VALID}), K_V_MIN_SQ = $signed({1'b0, V_MIN_SQ});
+    localparam signed [63:0] K_V_EXIT_SQ = $signed({1'b0, V_EXIT_SQ}), K_COS_SQ = $signed({1'b0, COS_SQ_EXIT});
+    localparam signed [63:0] HI_X = ((SENSOR_WIDTH - 64'sd1) <<< FP) - K_EXIT_M;
+    localparam signed [63:0] HI_Y = ((SENSOR_HEIGHT - 64'sd1) <<< FP) - K_EXIT_M;
+    localparam integer COS_SQ_F = 16;
+    localparam integer W20_W = MCM_NORM_W - (FW - 20);  // w with 20 fraction bits: the divisor
+
+    localparam [1:0] TRACE_UPDATE = 2'd0, TRACE_CREATE = 2'd1, TRACE_EVICT = 2'd2, TRACE_DROP = 2'd3;
+    localparam [3:0] FLAG_NEW = 4'd1, FLAG_BORDER = 4'd2, FLAG_MOVING_MCM = 4'd4, FLAG_MOVING_INT = 4'd8;
+
+    // Words of the 64-bit datapath from unsigned and signed fields.
+    function automatic signed [63:0] u64;
+        input [62:0] v;
+        begin
+            u64 = {1'b0, v};
+        end
+    endfunction
+
+    // |V|^2 in speed_sq's format, each component first clamped to full scale (model: _speed_sq).
+    function automatic signed [63:0] speed_sq;
+        input signed [63:0] vx;
+        input signed [63:0] vy;
+        input integer frac;
+        reg signed [63:0] full, cx, cy;
+        begin
+            full = (64'sd1 <<< (V_FULL_BITS + frac)) - 1;
+            cx = saturate(vx, -full, full);
+            cy = saturate(vy, -full, full);
+            speed_sq = align(cx * cx + cy * cy, 2 * frac, SQ_F);
+        end
+    endfunction
+
+    // Eq. (11): BG + (C - BG) / p in C's format, clamped to the byte range (model: _corrected).
+    function automatic signed [63:0] corrected;
+        input signed [63:0] colour;
+        input signed [63:0] background;
+        reg signed [63:0] bg, obj;
+        begin
+            bg = align(background, FB, FC);
+            obj = bg + (((colour - bg) * K_INV_P) >>> INV_P_FRAC);
+            corrected = saturate(obj, 0, 64'sd255 <<< FC);
+        end
+    endfunction
+
+    function automatic signed [63:0] gamma_from_activity;
+        input signed [63:0] a;
+        begin
+            gamma_from_activity = GAMMA_MODE == 0 ? K_GAMMA_GLOBAL : (a * K_GPA) >>> (FA + GAMMA_PER_ACTIVITY_FRAC - FG);
+        end
+    endfunction
+
+    // floor(a / b) for b > 0, as Python's // (the model's MCM bias correction).
+    function automatic signed [63:0] floor_div;
+        input signed [63:0] a;
+        input [W20_W-1:0] b;
+        reg [63:0] magnitude, quotient;
+        begin
+            magnitude = a < 0 ? -a : a;
+            quotient = magnitude / {{(64 - W20_W){1'b0}}, b};
+            floor_div = a >= 0 ? $signed(quotient)
+                      : -$signed(quotient) - ((quotient * {{(64 - W20_W){1'b0}}, b} != magnitude) ? 64'sd1 : 64'sd0);
+        end
+    endfunction
+
+    // ---------------------------------------------------------------- the cluster table
+    reg                            valid         [0:N-1];
+    reg [31:0]                     id            [0:N-1];
+    reg [CENTRE_W-1:0]             px            [0:N-1];
+    reg [CENTRE_W-1:0]             py            [0:N-1];
+    reg [CENTRE_W-1:0]             ppx           [0:N-1];
+    reg [CENTRE_W-1:0]             ppy           [0:N-1];
+    reg [HALF_SIZE_W-1:0]          rx            [0:N-1];
+    reg [HALF_SIZE_W-1:0]          ry            [0:N-1];
+    reg [ACTIVITY_W-1:0]           act           [0:N-1];
+    reg [DECAY_RESIDUAL_W-1:0]     residual      [0:N-1];
+    reg [31:0]                     t_last        [0:N-1];
+    reg [GAMMA_W-1:0]              gamma         [0:N-1];
+    reg [V_MCM_W-1:0]              vmx           [0:N-1];
+    reg [V_MCM_W-1:0]              vmy           [0:N-1];
+    reg [MCM_NORM_W-1:0]           norm          [0:N-1];
+    reg [V_INT_W-1:0]              vix           [0:N-1];
+    reg [V_INT_W-1:0]              viy           [0:N-1];
+    reg [1:0]                      vi_count      [0:N-1];
+    reg [EVENTS_IN_INTERVAL_W-1:0] ev_count      [0:N-1];
+    reg [COLOUR_W-1:0]             col_y         [0:N-1];
+    reg [COLOUR_W-1:0]             col_cb        [0:N-1];
+    reg [COLOUR_W-1:0]             col_cr        [0:N-1];
+    reg                            reported      [0:N-1];
+    reg                            ever_reported [0:N-1];
+    reg [HIST_W-1:0]               hist          [0:N*P-1];
+
+    // ---------------------------------------------------------------- globals
+    reg [BACKGROUND_W-1:0]     bg_y, bg_cb, bg_cr;
+    reg [P*INV_WW_W-1:0]       inv_ww;
+    reg [31:0]                 next_id;
+    reg [31:0]                 step;
+    reg [31:0]                 t_filter;
+    reg [TAU_PHASE_W-1:0]      tau_phase;
+    reg [EVERY_W-1:0]          since_filter;
+    reg                        started;
+
+    // ---------------------------------------------------------------- control
+    localparam [2:0] ST_INIT = 3'd0, ST_IDLE = 3'd1, ST_EXEC = 3'd2, ST_SCAN = 3'd3, ST_EVICT = 3'd4, ST_SWEEP = 3'd5;
+    reg [2:0]              state;
+    reg [SWEEP_W-1:0]      index;        // INIT: palette entry; SCAN: slot; SWEEP: slot and palette entry
+    reg [31:0]             e_t;
+    reg [EV_XY_W-1:0]      e_x, e_y;
+    reg [7:0]              e_lum, e_cb, e_cr;
+    reg                    e_hit, e_free;
+    reg [SLOT_W-1:0]       e_slot, e_free_slot;
+    reg [SLOT_W-1:0]       weakest;
+    reg [ACTIVITY_W-1:0]   weakest_a;
+    reg [63:0]             boundaries;   // tau boundaries since the last filter step
+    reg [FRAME_PER_TAU_W-1:0] per_frame; // T_frame / (boundaries * tau)
+
+    assign ev_ready = state == ST_IDLE;
+    assign filter_active = state == ST_SWEEP;
+
+    // ---------------------------------------------------------------- step 1: the seek
+    // Every slot compares the event against its window in parallel; a priority tree keeps the
+    // nearest in L1, ties to the lower slot. The event is taken straight from the input port.
+    wire [31:0]        in_t = ev_data[EV_W-1 -: 32];
+    wire [EV_XY_W-1:0] in_x = ev_data[EV_W-33 -: EV_XY_W];
+    wire [EV_XY_W-1:0] in_y = ev_data[EV_W-33-EV_XY_W -: EV_XY_W];
+    wire [7:0]         in_lum = ev_data[23:16];
+    wire [7:0]         in_cb = ev_data[15:8];
+    wire [7:0]         in_cr = ev_data[7:0];
+
+    integer s;
+    reg signed [63:0] seek_x, seek_y, seek_dx, seek_dy, seek_best_d;
+    reg               seek_hit, seek_free;
+    reg [SLOT_W-1:0]  seek_slot, seek_free_slot;
+    always @* begin
+        seek_x = u64({{(63 - EV_XY_W){1'b0}}, in_x}) <<< FP;
+        seek_y = u64({{(63 - EV_XY_W){1'b0}}, in_y}) <<< FP;
+        seek_hit = 1'b0;
+        seek_slot = {SLOT_W{1'b0}};
+        seek_best_d = 64'sd1 <<< 62;
+        seek_free = 1'b0;
+        seek_free_slot = {SLOT_W{1'b0}};
+        for (s = N - 1; s >= 0; s = s - 1) begin
+            if (!valid[s]) begin
+                seek_free = 1'b1;
+                seek_free_slot = s[SLOT_W-1:0];
+            end
+        end
+        for (s = 0; s < N; s = s + 1) begin
+            seek_dx = abs64(seek_x - u64({{(63 - CENTRE_W){1'b0}}, px[s]}));
+            seek_dy = abs64(seek_y - u64({{(63 - CENTRE_W){1'b0}}, py[s]}));
+            if (valid[s]
+                    && seek_dx <= (u64({{(63 - HALF_SIZE_W){1'b0}}, rx[s]}) <<< (FP - FR)) + K_SEEK
+                    && seek_dy <= (u64({{(63 - HALF_SIZE_W){1'b0}}, ry[s]}) <<< (FP - FR)) + K_SEEK
+                    && seek_dx + seek_dy < seek_best_d) begin
+                seek_hit = 1'b1;
+                seek_slot = s[SLOT_W-1:0];
+                seek_best_d = seek_dx + seek_dy;
+            end
+        end
+    end
+
+    // ---------------------------------------------------------------- the decay unit
+    // Shared: the updated slot (EXEC), the scanned slot (SCAN, without the residual, as the
+    // model's eviction compares), the swept slot (SWEEP).
+    wire [SLOT_W-1:0] dec_slot = state == ST_EXEC ? e_slot : index[SLOT_W-1:0];
+    wire [ACTIVITY_W-1:0] dec_a;
+    wire [DECAY_RESIDUAL_W-1:0] dec_residual;
+    evclust_decay decay_unit (
+        .activity(act[dec_slot]),
+        .dt(e_t - t_last[dec_slot]),
+        .residual(residual[dec_slot]),
+        .use_residual(state != ST_SCAN),
+        .decayed(dec_a),
+        .residual_out(dec_residual)
+    );
+    wire signed [63:0] a_decayed = u64({{(63 - ACTIVITY_W){1'b0}}, dec_a});
+
+    // ---------------------------------------------------------------- step 3: the update
+    wire [CLASS_W-1:0] vote_class;
+    wire [VOTE_W-1:0]  vote;
+    evclust_palette palette (
+        .lum(e_lum), .cb(e_cb), .cr(e_cr),
+        .bg_y(bg_y), .bg_cb(bg_cb), .bg_cr(bg_cr),
+        .inv_ww(inv_ww),
+        .class_index(vote_class),
+        .vote(vote)
+    );
+
+    reg signed [63:0] ex, ey, u_px, u_py, u_px_new, u_py_new, u_gx, u_gy, u_rx, u_ry, u_step_x, u_step_y;
+    reg signed [63:0] u_ux, u_uy, u_vmx, u_vmy, u_norm, u_act, u_cy, u_ccb, u_ccr, u_evc, u_gamma;
+    reg signed [63:0] u_hist [0:P-1];
+    reg               u_halve;
+    integer c;
+    always @* begin
+        ex = u64({{(63 - EV_XY_W){1'b0}}, e_x});
+        ey = u64({{(63 - EV_XY_W){1'b0}}, e_y});
+        // 3a. Activity: decay to t, then count the event.
+        u_act = saturate(a_decayed + ONE_A, 0, MAX_ACT);
+        // 3b. Centre.
+        u_px = u64({{(63 - CENTRE_W){1'b0}}, px[e_slot]});
+        u_py = u64({{(63 - CENTRE_W){1'b0}}, py[e_slot]});
+        u_px_new = alpha_step(u_px, ex, K_B_POS, BETA_POS_FRAC, FP, 1'b0);
+        u_py_new = alpha_step(u_py, ey, K_B_POS, BETA_POS_FRAC, FP, 1'b0);
+        // 3c. Size.
+        u_gx = saturate((abs64((ex <<< FP) - u_px) * K_GAIN) >>> (SIZE_GAIN_FRAC + FP - FR), 0, MAX_SIZE_TARGET);
+        u_gy = saturate((abs64((ey <<< FP) - u_py) * K_GAIN) >>> (SIZE_GAIN_FRAC + FP - FR), 0, MAX_SIZE_TARGET);
+        u_rx = saturate(alpha_step(u64({{(63 - HALF_SIZE_W){1'b0}}, rx[e_slot]}), u_gx, K_B_SIZE, BETA_SIZE_FRAC, 0, 1'b0), K_R_MIN, K_R_MAX);
+        u_ry = saturate(alpha_step(u64({{(63 - HALF_SIZE_W){1'b0}}, ry[e_slot]}), u_gy, K_B_SIZE, BETA_SIZE_FRAC, 0, 1'b0), K_R_MIN, K_R_MAX);
+        // 3d. MCM velocity and its bias-correction weight.
+        u_gamma = u64({{(63 - GAMMA_W){1'b0}}, gamma[e_slot]});
+        u_step_x = saturate(u_px_new - u_px, MIN_STEP, MAX_STEP);
+        u_step_y = saturate(u_py_new - u_py, MIN_STEP, MAX_STEP);
+        u_ux = saturate(align(u_gamma * u_step_x, FG + FP, FV), MIN_V, MAX_V);
+        u_uy = saturate(align(u_gamma * u_step_y, FG + FP, FV), MIN_V, MAX_V);
+        u_vmx = alpha_step($signed({{(64 - V_MCM_W){vmx[e_slot][V_MCM_W-1]}}, vmx[e_slot]}), u_ux, K_B_VM, BETA_VEL_MCM_FRAC, 0, 1'b1);
+        u_vmy = alpha_step($signed({{(64 - V_MCM_W){vmy[e_slot][V_MCM_W-1]}}, vmy[e_slot]}), u_uy, K_B_VM, BETA_VEL_MCM_FRAC, 0, 1'b1);
+        u_norm = alpha_step(u64({{(63 - MCM_NORM_W){1'b0}}, norm[e_slot]}), 64'sd1, K_B_VM, BETA_VEL_MCM_FRAC, FW, 1'b1);
+        // 3e. Colour.
+        u_cy = alpha_step(u64({{(63 - COLOUR_W){1'b0}}, col_y[e_slot]}), u64({55'd0, e_lum}), K_B_LUM, BETA_LUM_FRAC, FC, 1'b0);
+        u_ccb = alpha_step(u64({{(63 - COLOUR_W){1'b0}}, col_cb[e_slot]}), u64({55'd0, e_cb}), K_B_CHRO, BETA_CHRO_FRAC, FC, 1'b0);
+        u_ccr = alpha_step(u64({{(63 - COLOUR_W){1'b0}}, col_cr[e_slot]}), u64({55'd0, e_cr}), K_B_CHRO, BETA_CHRO_FRAC, FC, 1'b0);
+        // 3f. Palette histogram: a saturating counter; reaching the top halves the row.
+        for (c = 0; c < P; c = c + 1)
+            u_hist[c] = u64({{(63 - HIST_W){1'b0}}, hist[e_slot * P + c]});
+        u_hist[vote_class] = min64(u_hist[vote_class] + u64({{(63 - VOTE_W){1'b0}}, vote}), H_MAX);
+        u_halve = u_hist[vote_class] >= H_MAX;
+        for (c = 0; c < P; c = c + 1)
+            if (u_halve)
+                u_hist[c] = u_hist[c] >>> 1;
+        u_evc = saturate(u64({{(63 - EVENTS_IN_INTERVAL_W){1'b0}}, ev_count[e_slot]}) + 1, 0, MAX_EVCOUNT);
+    end
+
+    // ---------------------------------------------------------------- the filter sweep
+    // One slot per cycle: decay, expiry, gamma, the interval velocity at tau boundaries,
+    // the MCM bias correction (the sweep's divider), exit prediction, the record.
+    wire [SLOT_W-1:0] k = index[SLOT_W-1:0];
+    reg signed [63:0] f_gamma, f_mx, f_my, f_vix, f_viy, f_vmx, f_vmy, f_vmx_raw, f_vmy_raw, f_px, f_py;
+    reg signed [63:0] f_speed_sq, f_limit, f_per_frame, f_evc;
+    reg [W20_W-1:0]   f_w20;
+    reg [1:0]         f_vi_count;
+    reg               f_expire, f_exit, f_left, f_right, f_top, f_bottom, f_moving_mcm, f_moving_int, f_report;
+    reg signed [63:0] f_best;
+    reg [7:0]         f_class;
+    reg [3:0]         f_flags;
+    always @* begin
+        f_per_frame = u64({{(63 - FRAME_PER_TAU_W){1'b0}}, per_frame});
+        f_expire = a_decayed < K_A_MIN;
+        f_vi_count = vi_count[k];
+        f_gamma = u64({{(63 - GAMMA_W){1'b0}}, gamma[k]});
+        if (GAMMA_MODE != 2 || vi_count[k] == 2'd0)
+            f_gamma = saturate(gamma_from_activity(a_decayed), 0, MAX_GAMMA);
+        f_px = u64({{(63 - CENTRE_W){1'b0}}, px[k]});
+        f_py = u64({{(63 - CENTRE_W){1'b0}}, py[k]});
+        f_evc = u64({{(63 - EVENTS_IN_INTERVAL_W){1'b0}}, ev_count[k]});
+        f_vix = $signed({{(64 - V_INT_W){vix[k][V_INT_W-1]}}, vix[k]});
+        f_viy = $signed({{(64 - V_INT_W){viy[k][V_INT_W-1]}}, viy[k]});
+        f_mx = saturate(align((f_px - u64({{(63 - CENTRE_W){1'b0}}, ppx[k]})) * f_per_frame, FP + FPT_F, FI), MIN_VI, MAX_VI);
+        f_my = saturate(align((f_py - u64({{(63 - CENTRE_W){1'b0}}, ppy[k]})) * f_per_frame, FP + FPT_F, FI), MIN_VI, MAX_VI);
+        if (boundaries != 64'd0) begin
+            if (GAMMA_MODE == 2 && vi_count[k] != 2'd0)
+                f_gamma = saturate((f_evc * f_per_frame) >>> (FPT_F - FG), 0, MAX_GAMMA);
+            f_evc = 0;
+            if (WARM_START == 0 || vi_count[k] == 2'd2) begin
+                f_vix = alpha_step(f_vix, f_mx, K_B_VI, BETA_VEL_INT_FRAC, 0, 1'b0);
+                f_viy = alpha_step(f_viy, f_my, K_B_VI, BETA_VEL_INT_FRAC, 0, 1'b0);
+            end else if (vi_count[k] == 2'd1) begin
+                f_vix = f_mx;
+                f_viy = f_my;
+            end
+            f_vi_count = vi_count[k] == 2'd2 ? 2'd2 : vi_count[k] + 2'd1;
+        end
+        // The reported MCM velocity: V / w.
+        f_vmx_raw = $signed({{(64 - V_MCM_W){vmx[k][V_MCM_W-1]}}, vmx[k]});
+        f_vmy_raw = $signed({{(64 - V_MCM_W){vmy[k][V_MCM_W-1]}}, vmy[k]});
+        f_w20 = norm[k][MCM_NORM_W-1 -: W20_W];
+        f_vmx = f_vmx_raw;
+        f_vmy = f_vmy_raw;
+        if (MCM_CORRECT != 0 && f_w20 != {W20_W{1'b0}}) begin
+            f_vmx = floor_div(f_vmx_raw <<< 20, f_w20);
+            f_vmy = floor_div(f_vmy_raw <<< 20, f_w20);
+        end
+        // Exit prediction on the squared speed.
+        f_speed_sq = saturate(speed_sq(f_vmx, f_vmy, FV), 0, MAX_SPEED_SQ);
+        f_left = f_px < K_EXIT_M;
+        f_right = f_px > HI_X;
+        f_top = f_py < K_EXIT_M;
+        f_bottom = f_py > HI_Y;
+        f_limit = (f_speed_sq * K_COS_SQ) >>> COS_SQ_F;
+        f_exit = f_speed_sq >= K_V_EXIT_SQ && f_speed_sq > 0
+              && ((f_left && f_vmx < 0 && speed_sq(f_vmx, 0, FV) >= f_limit)
+               || (f_right && f_vmx > 0 && speed_sq(f_vmx, 0, FV) >= f_limit)
+               || (f_top && f_vmy < 0 && speed_sq(0, f_vmy, FV) >= f_limit)
+               || (f_bottom && f_vmy > 0 && speed_sq(0, f_vmy, FV) >= f_limit));
+        f_moving_mcm = speed_sq(f_vmx_raw, f_vmy_raw, FV) >= K_V_MIN_SQ;
+        f_moving_int = speed_sq(f_vix, f_viy, FI) >= K_V_MIN_SQ;
+        f_report = a_decayed >= K_A_VALID && (f_moving_mcm || f_moving_int);
+        // The class: the strongest non-background histogram entry, none while all are zero.
+        f_class = 8'hff;
+        f_best = 0;
+        for (c = 0; c < P; c = c + 1) begin
+            if (!BACKGROUND_MASK[c] && u64({{(63 - HIST_W){1'b0}}, hist[k * P + c]}) > f_best) begin
+                f_best = u64({{(63 - HIST_W){1'b0}}, hist[k * P + c]});
+                f_class = c[7:0];
+            end
+        end
+        f_flags = (ever_reported[k] ? 4'd0 : FLAG_NEW) | ((f_left || f_right || f_top || f_bottom) ? FLAG_BORDER : 4'd0)
+                | (f_moving_mcm ? FLAG_MOVING_MCM : 4'd0) | (f_moving_int ? FLAG_MOVING_INT : 4'd0);
+    end
+
+    // The record of the swept slot, in the layout of expected.hex.
+    wire signed [63:0] r_cy = corrected(u64({{(63 - COLOUR_W){1'b0}}, col_y[k]}), u64({{(63 - BACKGROUND_W){1'b0}}, bg_y}));
+    wire signed [63:0] r_cb = corrected(u64({{(63 - COLOUR_W){1'b0}}, col_cb[k]}), u64({{(63 - BACKGROUND_W){1'b0}}, bg_cb}));
+    wire signed [63:0] r_cr = corrected(u64({{(63 - COLOUR_W){1'b0}}, col_cr[k]}), u64({{(63 - BACKGROUND_W){1'b0}}, bg_cr}));
+    wire [REC_W-1:0] record = {
+        e_t, step, k, id[k], px[k], py[k], rx[k], ry[k], dec_a,
+        f_vmx[V_MCM_W-1:0], f_vmy[V_MCM_W-1:0], f_vix[V_INT_W-1:0], f_viy[V_INT_W-1:0],
+        r_cy[COLOUR_W-1:0], r_cb[COLOUR_W-1:0], r_cr[COLOUR_W-1:0], f_class, f_flags
+    };
+
+    // tau boundaries since the last filter step, from the phase counter; T_frame/(n tau).
+    wire [63:0] phase = {{(64 - TAU_PHASE_W){1'b0}}, tau_phase} + {32'd0, e_t - t_filter};
+    wire [63:0] phase_boundaries = phase / TAU_US;
+    wire [63:0] phase_left = phase - phase_boundaries * TAU_US;
+    wire [63:0] frame_per_boundary = {{(64 - FRAME_PER_TAU_W){1'b0}}, FRAME_PER_TAU}
+                                   / (phase_boundaries == 64'd0 ? 64'd1 : phase_boundaries);
+
+    // 1/|palette_j - BG|^2 for the mixing rule (model: refresh_mixing), one entry per cycle.
+    wire [CLASS_W-1:0] refresh_j = index[CLASS_W-1:0];
+    wire signed [63:0] w_y = u64({55'd0, PALETTE_Y[refresh_j * 8 +: 8]}) - (u64({{(63 - BACKGROUND_W){1'b0}}, bg_y}) >>> FB);
+    wire signed [63:0] w_cb = u64({55'd0, PALETTE_CB[refresh_j * 8 +: 8]}) - (u64({{(63 - BACKGROUND_W){1'b0}}, bg_cb}) >>> FB);
+    wire signed [63:0] w_cr = u64({55'd0, PALETTE_CR[refresh_j * 8 +: 8]}) - (u64({{(63 - BACKGROUND_W){1'b0}}, bg_cr}) >>> FB);
+    wire [63:0] ww = w_y * w_y + w_cb * w_cb + w_cr * w_cr;
+    wire [INV_WW_W-1:0] refreshed = ww == 64'd0 ? {INV_WW_W{1'b0}} : (64'd1 << 32) / ww;
+
+    // ---------------------------------------------------------------- the event's decision
+    // EXEC: update the slot found, or create in a free one; SCAN finds the weakest; EVICT
+    // creates there if it is weak enough, else drops the event.
+    wire scan_last = index == N - 1;
+    wire scan_weaker = dec_a < weakest_a || index == 0;
+    wire evict = weakest_a < A_VALID;
+    reg              do_update, do_create, finish;
+    reg [SLOT_W-1:0] create_slot;
+    reg [1:0]        action;
+    reg [SLOT_W-1:0] action_slot;
+    always @* begin
+        do_update = 1'b0;
+        do_create = 1'b0;
+        finish = 1'b0;
+        create_slot = e_free_slot;
+        action = TRACE_UPDATE;
+        action_slot = e_slot;
+        if (state == ST_EXEC) begin
+            if (e_hit) begin
+                do_update = 1'b1;
+                finish = 1'b1;
+            end else if (e_free) begin
+                do_create = 1'b1;
+                finish = 1'b1;
+                action = TRACE_CREATE;
+                action_slot = e_free_slot;
+            end
+        end else if (state == ST_EVICT) begin
+            finish = 1'b1;
+            do_create = evict;
+            create_slot = weakest;
+            action = evict ? TRACE_EVICT : TRACE_DROP;
+            action_slot = evict ? weakest : {SLOT_W{1'b0}};
+        end
+    end
+    wire sweep_due = {{(32 - EVERY_W){1'b0}}, since_filter} + 32'd1 >= FILTER_EVERY;
+    // An update of a reported cluster is the object's colour, not the background's.
+    wire bg_learns = finish && BG_FIXED == 0 && !(do_update && reported[e_slot]);
+    wire sweep_advance = state == ST_SWEEP && (!rec_valid || rec_ready);
+    wire sweep_slot = sweep_advance && index < N && valid[k];
+
+    integer i;
+    always @(posedge clk) begin
+        trace_valid <= 1'b0;
+        if (rec_valid && rec_ready)
+            rec_valid <= 1'b0;
+        if (rst) begin
+            state <= ST_INIT;
+            index <= {SWEEP_W{1'b0}};
+            rec_valid <= 1'b0;
+            rec_data <= {REC_W{1'b0}};
+            trace_data <= {TRACE_W{1'b0}};
+            bg_y <= BG_INIT_Y[BACKGROUND_W-1:0];
+            bg_cb <= BG_INIT_CB[BACKGROUND_W-1:0];
+            bg_cr <= BG_INIT_CR[BACKGROUND_W-1:0];
+            inv_ww <= {(P * INV_WW_W){1'b0}};
+            next_id <= 32'd0;
+            step <= 32'd0;
+            t_filter <= 32'd0;
+            tau_phase <= {TAU_PHASE_W{1'b0}};
+            since_filter <= {EVERY_W{1'b0}};
+            started <= 1'b0;
+            boundaries <= 64'd0;
+            per_frame <= {FRAME_PER_TAU_W{1'b0}};
+            for (i = 0; i < N; i = i + 1) begin
+                valid[i] <= 1'b0;
+                reported[i] <= 1'b0;
+            end
+        end else begin
+            case (state)
+                ST_INIT: begin  // the mixing rule's table for the initial background
+                    inv_ww[refresh_j * INV_WW_W +: INV_WW_W] <= refreshed;
+                    index <= index + 1'b1;
+                    if (index == P - 1) begin
+                        index <= {SWEEP_W{1'b0}};
+                        state <= ST_IDLE;
+                    end
+                end
+                ST_IDLE: if (ev_valid) begin
+                    e_t <= in_t;
+                    e_x <= in_x;
+                    e_y <= in_y;
+                    e_lum <= in_lum;
+                    e_cb <= in_cb;
+                    e_cr <= in_cr;
+                    e_hit <= seek_hit;
+                    e_slot <= seek_slot;
+                    e_free <= seek_free;
+                    e_free_slot <= seek_free_slot;
+                    if (!started) begin  // tau boundaries count from the first event
+                        started <= 1'b1;
+                        t_filter <= in_t;
+                        tau_phase <= {TAU_PHASE_W{1'b0}};
+                    end
+                    state <= ST_EXEC;
+                end
+                ST_EXEC: if (!finish) begin
+                    index <= {SWEEP_W{1'b0}};
+                    state <= ST_SCAN;
+                end
+                ST_SCAN: begin
+                    if (scan_weaker) begin
+                        weakest <= k;
+                        weakest_a <= dec_a;
+                    end
+                    index <= index + 1'b1;
+                    if (scan_last)
+                        state <= ST_EVICT;
+                end
+                ST_SWEEP: if (sweep_advance) begin
+                    if (index < P && MIXING != 0 && BG_FIXED == 0)
+                        inv_ww[refresh_j * INV_WW_W +: INV_WW_W] <= refreshed;
+                    index <= index + 1'b1;
+                    if (index == SWEEP_LEN - 1) begin
+                        step <= step + 32'd1;
+                        t_filter <= e_t;
+                        state <= ST_IDLE;
+                    end
+                end
+                default: ;
+            endcase
+
+            // The end of an event: trace, background, the filter-step counter.
+            if (finish) begin
+                trace_valid <= 1'b1;
+                trace_data <= {action, {(8 - SLOT_W){1'b0}}, action_slot};
+                if (bg_learns) begin
+                    bg_y <= alpha_step(u64({{(63 - BACKGROUND_W){1'b0}}, bg_y}), u64({55'd0, e_lum}), K_B_BG, BETA_BG_FRAC, FB, 1'b0);
+                    bg_cb <= alpha_step(u64({{(63 - BACKGROUND_W){1'b0}}, bg_cb}), u64({55'd0, e_cb}), K_B_BG, BETA_BG_FRAC, FB, 1'b0);
+                    bg_cr <= alpha_step(u64({{(63 - BACKGROUND_W){1'b0}}, bg_cr}), u64({55'd0, e_cr}), K_B_BG, BETA_BG_FRAC, FB, 1'b0);
+                end
+                if (sweep_due) begin
+                    since_filter <= {EVERY_W{1'b0}};
+                    boundaries <= phase_boundaries;
+                    tau_phase <= phase_left[TAU_PHASE_W-1:0];
+                    per_frame <= frame_per_boundary[FRAME_PER_TAU_W-1:0];
+                    index <= {SWEEP_W{1'b0}};
+                    state <= ST_SWEEP;
+                end else begin
+                    since_filter <= since_filter + 1'b1;
+                    state <= ST_IDLE;
+                end
+            end
+
+            if (do_update) begin
+                act[e_slot] <= u_act[ACTIVITY_W-1:0];
+                residual[e_slot] <= dec_residual;
+                t_last[e_slot] <= e_t;
+                px[e_slot] <= u_px_new[CENTRE_W-1:0];
+                py[e_slot] <= u_py_new[CENTRE_W-1:0];
+                rx[e_slot] <= u_rx[HALF_SIZE_W-1:0];
+                ry[e_slot] <= u_ry[HALF_SIZE_W-1:0];
+                vmx[e_slot] <= u_vmx[V_MCM_W-1:0];
+                vmy[e_slot] <= u_vmy[V_MCM_W-1:0];
+                norm[e_slot] <= u_norm[MCM_NORM_W-1:0];
+                col_y[e_slot] <= u_cy[COLOUR_W-1:0];
+                col_cb[e_slot] <= u_ccb[COLOUR_W-1:0];
+                col_cr[e_slot] <= u_ccr[COLOUR_W-1:0];
+                for (i = 0; i < P; i = i + 1)
+                    hist[e_slot * P + i] <= u_hist[i][HIST_W-1:0];
+                ev_count[e_slot] <= u_evc[EVENTS_IN_INTERVAL_W-1:0];
+            end
+
+            if (do_create) begin
+                valid[create_slot] <= 1'b1;
+                id[create_slot] <= next_id;
+                next_id <= next_id + 32'd1;
+                px[create_slot] <= {{(CENTRE_W - EV_XY_W - FP){1'b0}}, e_x, {FP{1'b0}}};
+                py[create_slot] <= {{(CENTRE_W - EV_XY_W - FP){1'b0}}, e_y, {FP{1'b0}}};
+                ppx[create_slot] <= {{(CENTRE_W - EV_XY_W - FP){1'b0}}, e_x, {FP{1'b0}}};
+                ppy[create_slot] <= {{(CENTRE_W - EV_XY_W - FP){1'b0}}, e_y, {FP{1'b0}}};
+                rx[create_slot] <= R_INIT;
+                ry[create_slot] <= R_INIT;
+                act[create_slot] <= ONE_A[ACTIVITY_W-1:0];
+                residual[create_slot] <= {DECAY_RESIDUAL_W{1'b0}};
+                gamma[create_slot] <= gamma_from_activity(ONE_A);
+                t_last[create_slot] <= e_t;
+                vmx[create_slot] <= {V_MCM_W{1'b0}};
+                vmy[create_slot] <= {V_MCM_W{1'b0}};
+                norm[create_slot] <= {MCM_NORM_W{1'b0}};
+                vix[create_slot] <= {V_INT_W{1'b0}};
+                viy[create_slot] <= {V_INT_W{1'b0}};
+                vi_count[create_slot] <= 2'd0;
+                ev_count[create_slot] <= {EVENTS_IN_INTERVAL_W{1'b0}};
+                col_y[create_slot] <= {e_lum, {FC{1'b0}}};
+                col_cb[create_slot] <= {e_cb, {FC{1'b0}}};
+                col_cr[create_slot] <= {e_cr, {FC{1'b0}}};
+                reported[create_slot] <= 1'b0;
+                ever_reported[create_slot] <= 1'b0;
+                for (i = 0; i < P; i = i + 1)
+                    hist[create_slot * P + i] <= {HIST_W{1'b0}};
+            end
+
+            if (sweep_slot) begin
+                act[k] <= dec_a;
+                residual[k] <= dec_residual;
+                t_last[k] <= e_t;
+                if (f_expire) begin
+                    valid[k] <= 1'b0;
+                end else begin
+                    gamma[k] <= f_gamma[GAMMA_W-1:0];
+                    ev_count[k] <= f_evc[EVENTS_IN_INTERVAL_W-1:0];
+                    vix[k] <= f_vix[V_INT_W-1:0];
+                    viy[k] <= f_viy[V_INT_W-1:0];
+                    vi_count[k] <= f_vi_count;
+                    if (boundaries != 64'd0) begin
+                        ppx[k] <= px[k];
+                        ppy[k] <= py[k];
+                    end
+                    if (f_exit) begin
+                        valid[k] <= 1'b0;
+                    end else begin
+                        reported[k] <= f_report;
+                        if (f_report) begin
+                            ever_reported[k] <= 1'b1;
+                            rec_valid <= 1'b1;
+                            rec_data <= record;
+                        end
+                    end
+                end
+            end
+        end
+    end
+endmodule

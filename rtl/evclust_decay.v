@@ -1,0 +1,39 @@
+// Activity decay A * 2^(-dt/T_half) (model: arith.decay_steps + arith.decay_apply).
+// n = dt * (1/T_half) + residual counts 1/64 half-lives; its bits below one step are handed
+// back as the new residual, so many short decays add up to one long one. The integer part
+// of m = n / 2^DROP shifts, its low 6 bits index the 2^-(i/64) table: one multiplier, one
+// barrel shifter, no exponential. Without the residual (eviction's comparison) it is arith.decay.
+module evclust_decay (
+    activity,
+    dt,
+    residual,
+    use_residual,
+    decayed,
+    residual_out
+);
+`include "evclust_params.vh"
+
+    input  wire [ACTIVITY_W-1:0]       activity;
+    input  wire [31:0]                 dt;
+    input  wire [DECAY_RESIDUAL_W-1:0] residual;
+    input  wire                        use_residual;
+    output wire [ACTIVITY_W-1:0]       decayed;
+    output wire [DECAY_RESIDUAL_W-1:0] residual_out;
+
+    localparam integer DROP = INV_T_HALF_FRAC - DECAY_TABLE_BITS;  // n's bits below one table step
+    localparam integer ENTRY_W = DECAY_TABLE_W;
+    // A shift beyond this leaves nothing of A (the model's `total > 62` test).
+    localparam integer MAX_SHIFT = 62 - DECAY_TABLE_FRAC;
+
+    wire [63:0] steps = {32'd0, dt} * {{(64 - INV_T_HALF_W){1'b0}}, INV_T_HALF}
+                      + (use_residual ? {{(64 - DECAY_RESIDUAL_W){1'b0}}, residual} : 64'd0);
+    wire [63:0] m = steps >> DROP;
+    wire [63:0] halvings = m >> DECAY_TABLE_BITS;
+    wire [DECAY_TABLE_BITS-1:0] index = m[DECAY_TABLE_BITS-1:0];
+    wire [ENTRY_W-1:0] fraction = DECAY_TABLE[index * ENTRY_W +: ENTRY_W];
+    wire [ACTIVITY_W+ENTRY_W-1:0] scaled = activity * fraction;
+    wire [ACTIVITY_W+ENTRY_W-1:0] shifted = scaled >> (halvings[5:0] + DECAY_TABLE_FRAC);
+
+    assign decayed = halvings > MAX_SHIFT ? {ACTIVITY_W{1'b0}} : shifted[ACTIVITY_W-1:0];
+    assign residual_out = steps[DECAY_RESIDUAL_W-1:0];  // DECAY_RESIDUAL_W == DROP
+endmodule

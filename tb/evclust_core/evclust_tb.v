@@ -1,0 +1,133 @@
+// Harness for the cocotb testbench (test_evclust_core.py): cocotb loads a batch of events into
+// ev_mem and pulses start; the harness streams them into evclust_core at full speed, with random
+// input gaps and random output back-pressure from a xorshift generator, and captures every
+// record (tagged with the number of events traced before it) and every trace word. Python thus
+// touches each event twice, not each clock cycle, which keeps co-simulation fast.
+module evclust_tb #(
+    parameter integer DEPTH = 4096,      // events per batch
+    parameter integer REC_DEPTH = 16384  // records per batch
+) (
+    input  wire        clk,
+    input  wire        rst,
+    input  wire        start,
+    input  wire [31:0] count,           // events in this batch
+    input  wire [31:0] seed,            // the generator's seed (non-zero), taken at start
+    input  wire [7:0]  gap_threshold,   // P(input gap) = gap_threshold / 256 per cycle
+    input  wire [7:0]  stall_threshold, // P(output stall) = stall_threshold / 256 per cycle
+    output reg         done,
+    output reg  [31:0] accepted,
+    output reg  [31:0] traced,
+    output reg  [31:0] captured,
+    output reg         overflow,
+    output reg  [31:0] cycles,
+    output reg  [31:0] filter_cycles,
+    output reg  [31:0] filter_steps
+);
+`include "evclust_params.vh"
+
+    localparam integer SLOT_W = N_CLUSTERS > 1 ? $clog2(N_CLUSTERS) : 1;
+    localparam integer EV_W = 32 + 2 * EV_XY_W + 1 + 24;
+    localparam integer REC_W = 32 + 32 + SLOT_W + 32 + 2 * CENTRE_W + 2 * HALF_SIZE_W + ACTIVITY_W
+                             + 2 * V_MCM_W + 2 * V_INT_W + 3 * COLOUR_W + 8 + 4;
+
+    reg [EV_W-1:0]  ev_mem    [0:DEPTH-1];
+    reg [REC_W-1:0] rec_mem   [0:REC_DEPTH-1];
+    reg [31:0]      rec_tag   [0:REC_DEPTH-1];  // events traced when the record left
+    reg [9:0]       trace_mem [0:DEPTH-1];
+
+    reg              running;
+    reg [31:0]       random;
+    reg              ev_valid;
+    reg [EV_W-1:0]   ev_data;
+    wire             ev_ready;
+    wire             rec_valid;
+    wire [REC_W-1:0] rec_data;
+    wire             trace_valid;
+    wire [9:0]       trace_data;
+    wire             filter_active;
+    reg              filter_was_active;
+    wire             rec_ready = running && random[15:8] >= stall_threshold;
+    // xorshift32 (Marsaglia): x ^= x << 13; x ^= x >> 17; x ^= x << 5.
+    wire [31:0]      xs1 = random ^ (random << 13);
+    wire [31:0]      xs2 = xs1 ^ (xs1 >> 17);
+    wire [31:0]      next_random = xs2 ^ (xs2 << 5);
+
+    evclust_core core (
+        .clk(clk),
+        .rst(rst),
+        .ev_valid(ev_valid),
+        .ev_ready(ev_ready),
+        .ev_data(ev_data),
+        .rec_valid(rec_valid),
+        .rec_ready(rec_ready),
+        .rec_data(rec_data),
+        .trace_valid(trace_valid),
+        .trace_data(trace_data),
+        .filter_active(filter_active)
+    );
+
+    // The next event to offer, once the current one (if any) has been taken.
+    wire [31:0] next_index = accepted + ((ev_valid && ev_ready) ? 32'd1 : 32'd0);
+    wire        offer = running && next_index < count && random[7:0] >= gap_threshold;
+
+    always @(posedge clk) begin
+        if (rst) begin
+            running <= 1'b0;
+            done <= 1'b0;
+            ev_valid <= 1'b0;
+            random <= 32'd1;
+            accepted <= 32'd0;
+            traced <= 32'd0;
+            captured <= 32'd0;
+            overflow <= 1'b0;
+            cycles <= 32'd0;
+            filter_cycles <= 32'd0;
+            filter_steps <= 32'd0;
+            filter_was_active <= 1'b0;
+        end else if (start) begin
+            running <= 1'b1;
+            done <= 1'b0;
+            random <= seed == 32'd0 ? 32'd1 : seed;
+            accepted <= 32'd0;
+            traced <= 32'd0;
+            captured <= 32'd0;
+            overflow <= 1'b0;
+            cycles <= 32'd0;
+            filter_cycles <= 32'd0;
+            filter_steps <= 32'd0;
+        end else if (running) begin
+            random <= next_random;
+            cycles <= cycles + 32'd1;
+            filter_was_active <= filter_active;
+            if (filter_active)
+                filter_cycles <= filter_cycles + 32'd1;
+            if (filter_active && !filter_was_active)
+                filter_steps <= filter_steps + 32'd1;
+            // Input: hold an offered event until it is taken (valid may not drop before ready).
+            if (ev_valid && ev_ready)
+                accepted <= accepted + 32'd1;
+            if (!ev_valid || ev_ready) begin
+                ev_valid <= offer;
+                ev_data <= ev_mem[next_index[$clog2(DEPTH)-1:0]];
+            end
+            if (trace_valid) begin
+                trace_mem[traced[$clog2(DEPTH)-1:0]] <= trace_data;
+                traced <= traced + 32'd1;
+            end
+            if (rec_valid && rec_ready) begin
+                if (captured < REC_DEPTH) begin
+                    rec_mem[captured[$clog2(REC_DEPTH)-1:0]] <= rec_data;
+                    rec_tag[captured[$clog2(REC_DEPTH)-1:0]] <= traced;
+                end else begin
+                    overflow <= 1'b1;
+                end
+                captured <= captured + 32'd1;
+            end
+            // Done: every event taken and traced, the core idle again, no record waiting.
+            if (accepted == count && traced == count && ev_ready && !ev_valid && !rec_valid && !filter_active) begin
+                running <= 1'b0;
+                done <= 1'b1;
+            end
+        end
+    end
+endmodule

@@ -1,0 +1,204 @@
+"""evclust_core against the fixed-point model, bit for bit, under Icarus and Verilator.
+
+Two halves in one file, in the style of verilog-axis: cocotb tests (run inside the simulator,
+configured by the EVCLUST_TB environment variable) and the pytest functions that build the RTL
+for each parameter set and launch them through `cocotb_tools.runner` (tb/cosim.py).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+# ------------------------------------------------------------------------------------------
+# Inside the simulator.
+
+try:
+    import cocotb
+    from cocotb.clock import Clock
+    from cocotb.triggers import ClockCycles, RisingEdge, with_timeout
+    from cocotb.triggers import SimTimeoutError
+except ImportError:  # collected by pytest without cocotb: the pytest half still reports why
+    cocotb = None
+
+CLOCK_NS = 10
+
+
+def _config() -> dict:
+    return json.loads(os.environ["EVCLUST_TB"])
+
+
+def _finish(config: dict, result: dict) -> None:
+    Path(config["out"]).write_text(json.dumps(result))
+    if result.get("error"):
+        raise AssertionError(result["error"])
+
+
+class Harness:
+    """The evclust_tb harness: batches in, records and trace out."""
+
+    def __init__(self, dut, n_clusters: int, filter_every: int):
+        self.dut = dut
+        self.depth = len(dut.ev_mem)
+        rec_depth = len(dut.rec_mem)
+        # A batch's records must fit the capture memory: at most N per filter step.
+        self.batch = max(1, min(self.depth, (rec_depth // n_clusters - 1) * filter_every))
+        self.ev_mem = [dut.ev_mem[i] for i in range(self.depth)]
+        self.stats = {"cycles": 0, "filter_cycles": 0, "filter_steps": 0, "events": 0, "wall_s": 0.0}
+
+    async def reset(self, cycles: int = 3):
+        self.dut.rst.value = 1
+        self.dut.start.value = 0
+        await ClockCycles(self.dut.clk, cycles)
+        self.dut.rst.value = 0
+        await ClockCycles(self.dut.clk, 2)  # the harness holds events until the core is ready
+
+    async def stream(self, words: list[int], seed: int, gap: int, stall: int, n_clusters: int):
+        """All words through the core in batches: (trace words, record words, record tags)."""
+        trace, records, tags = [], [], []
+        dut = self.dut
+        start = time.perf_counter()
+        for lo in range(0, len(words), self.batch):
+            batch = words[lo : lo + self.batch]
+            for handle, word in zip(self.ev_mem, batch):
+                handle.value = word
+            dut.count.value = len(batch)
+            dut.seed.value = (seed + lo) & 0xFFFFFFFF or 1
+            dut.gap_threshold.value = gap
+            dut.stall_threshold.value = stall
+            dut.start.value = 1
+            await RisingEdge(dut.clk)
+            dut.start.value = 0
+            # Bound: every event, eviction scan and filter step at its worst, slowed by the gaps and stalls.
+            bound = 1000 + len(batch) * (8 + 2 * n_clusters) * 256 // max(1, 256 - max(gap, stall))
+            try:
+                await with_timeout(RisingEdge(dut.done), bound * CLOCK_NS, "ns")
+            except SimTimeoutError:
+                raise AssertionError(
+                    f"no progress: after {bound} cycles the core took {int(dut.accepted.value)} of {len(batch)} events "
+                    f"of batch {lo // self.batch}, traced {int(dut.traced.value)}, emitted {int(dut.captured.value)} records"
+                ) from None
+            await RisingEdge(dut.clk)
+            if int(dut.overflow.value):
+                raise AssertionError("the harness's record memory overflowed: a smaller batch is needed")
+            traced, captured = int(dut.traced.value), int(dut.captured.value)
+            trace += [int(dut.trace_mem[i].value) for i in range(traced)]
+            records += [int(dut.rec_mem[i].value) for i in range(captured)]
+            tags += [lo + int(dut.rec_tag[i].value) for i in range(captured)]
+            for name in ("cycles", "filter_cycles", "filter_steps"):
+                self.stats[name] += int(getattr(dut, name).value)
+            self.stats["events"] += len(batch)
+        self.stats["wall_s"] += time.perf_counter() - start
+        return trace, records, tags
+
+
+def _seed(*parts) -> int:
+    return int.from_bytes(hashlib.sha256(repr(parts).encode()).digest()[:4], "little") or 1
+
+
+def _compare(name, events, expected_trace, trace, expected, records, tags, table):
+    from evclust.vectors.pack import event_fields, record_fields
+    from evclust.vectors.scoreboard import first_mismatch
+
+    return first_mismatch(name, events, event_fields(table), expected_trace, trace, record_fields(table), expected, records, tags)
+
+
+if cocotb is not None:
+
+    @cocotb.test()
+    async def replay_vectors(dut):
+        """Every listed vector case, each after a reset, with random input gaps and output stalls."""
+        from evclust.errors import EvclustError
+        from evclust.vectors.read import load_case
+
+        config = _config()
+        result = {"cases": {}}
+        cocotb.start_soon(Clock(dut.clk, CLOCK_NS, unit="ns").start())
+        header = Path(config["header"]).read_text()
+        for folder in config["cases"]:
+            try:
+                case = load_case(folder, rtl_header=header)
+            except EvclustError as exc:
+                result["error"] = str(exc)
+                break
+            harness = Harness(dut, case.table.n_clusters, case.params.filter_every)
+            await harness.reset()
+            trace, records, tags = await harness.stream(case.events, _seed(case.name, config["seed"]), config["gap"], config["stall"], case.table.n_clusters)
+            error = _compare(case.name, case.events, case.trace, trace, case.expected, records, tags, case.table)
+            result["cases"][case.name] = harness.stats | {"records": len(records)}
+            if error:
+                result["error"] = error
+                break
+        _finish(config, result)
+
+    @cocotb.test()
+    async def model_in_the_loop(dut):
+        """Random streams through the RTL and the fixed model in this process, compared bit for bit;
+        with `reset_at`, a reset lands in the middle of the stream and both start again."""
+        from evclust.clusterer import load_params
+        from evclust.fixed.model import FixedClusterer
+        from evclust.vectors.stimulus import random_stream
+        from evclust.vectors.write import model_words
+
+        config = _config()
+        cocotb.start_soon(Clock(dut.clk, CLOCK_NS, unit="ns").start())
+        params, _ = load_params(config["preset"])
+        params = params.model_copy(update={"n_clusters": config["n_clusters"]})
+        width, height, t_frame = config["width"], config["height"], config["t_frame_us"]
+        events = random_stream(config["seed"], config["count"], width, height)
+        model = FixedClusterer(params, width, height, t_frame)
+        harness = Harness(dut, params.n_clusters, params.filter_every)
+        await harness.reset()
+        if config.get("reset_at"):
+            # Part of the stream, cut off by a reset while events are flowing.
+            part = events[: config["reset_at"]]
+            words, _, _ = model_words(FixedClusterer(params, width, height, t_frame), part)
+            for handle, word in zip(harness.ev_mem, words):
+                handle.value = word
+            dut.count.value, dut.seed.value, dut.gap_threshold.value, dut.stall_threshold.value = len(words), 7, 0, 0
+            dut.start.value = 1
+            await RisingEdge(dut.clk)
+            dut.start.value = 0
+            await ClockCycles(dut.clk, config["reset_cycle"])
+            if int(dut.done.value):
+                _finish(config, {"error": "the stream ended before the reset: choose an earlier reset_cycle"})
+            await harness.reset(cycles=1)
+        event_list, expected, expected_trace = model_words(model, events)
+        trace, records, tags = await harness.stream(event_list, config["seed"], config["gap"], config["stall"], params.n_clusters)
+        error = _compare(f"random stream {config['seed']}", event_list, expected_trace, trace, expected, records, tags, model.table)
+        _finish(config, harness.stats | {"records": len(records), "error": error})
+
+
+# ------------------------------------------------------------------------------------------
+# pytest: build per parameter set, launch, check.
+
+from cosim import run, selected_simulators  # noqa: E402
+
+from evclust.vectors import CASES  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[2]
+VECTORS = ROOT / "vectors"
+SIMS = selected_simulators()
+GAP, STALL = 64, 96  # random input gaps 25 % of cycles, output stalls 37.5 %
+
+
+def _case_header(name: str) -> str:
+    from evclust.vectors.read import load_case
+
+    return load_case(VECTORS / name).header
+
+
+@pytest.mark.parametrize("case", list(CASES))
+@pytest.mark.parametrize("sim", SIMS)
+def test_vector_case_replays_bit_exact(sim, case):
+    result = run(sim, _case_header(case), "replay_vectors", {"cases": [str(VECTORS / case)], "seed": 1, "gap": GAP, "stall": STALL})
+    assert case in result["cases"]
+    assert result["cases"][case]["records"] == json.loads((VECTORS / case / "manifest.json").read_text())["counts"]["records"]
