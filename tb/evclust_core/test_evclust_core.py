@@ -202,3 +202,120 @@ def test_vector_case_replays_bit_exact(sim, case):
     result = run(sim, _case_header(case), "replay_vectors", {"cases": [str(VECTORS / case)], "seed": 1, "gap": GAP, "stall": STALL})
     assert case in result["cases"]
     assert result["cases"][case]["records"] == json.loads((VECTORS / case / "manifest.json").read_text())["counts"]["records"]
+
+
+# Model in the loop: two parameter sets whose formats differ (the presets' filters set different
+# guard bits, hence different widths), each at N = 4 and N = 16.
+FORMAT_SETS = {"traffic": (480, 270, 50000.0), "pedestrian": (270, 480, 40000.0)}
+
+
+def _random_config(preset: str, n_clusters: int, seed: int, count: int, **extra) -> tuple[str, dict]:
+    from evclust.clusterer import load_params
+    from evclust.fixed.formats import build_formats, verilog_header
+
+    width, height, t_frame = FORMAT_SETS[preset]
+    params, _ = load_params(preset)
+    params = params.model_copy(update={"n_clusters": n_clusters})
+    t_frame = params.t_frame_us or t_frame
+    header = verilog_header(build_formats(params, width, height, t_frame))
+    config = {"preset": preset, "n_clusters": n_clusters, "width": width, "height": height, "t_frame_us": t_frame,
+              "seed": seed, "count": count, "gap": GAP, "stall": STALL} | extra  # fmt: skip
+    return header, config
+
+
+@pytest.mark.parametrize("n_clusters", [4, 16])
+@pytest.mark.parametrize("preset", list(FORMAT_SETS))
+@pytest.mark.parametrize("sim", SIMS)
+def test_random_streams_match_the_model_in_the_loop(sim, preset, n_clusters):
+    header, config = _random_config(preset, n_clusters, seed=1000 + n_clusters, count=10_000)
+    result = run(sim, header, "model_in_the_loop", config)
+    assert result["events"] == 10_000
+    assert result["records"] > 0, "a stream that reports nothing checks little"
+
+
+def test_the_two_format_sets_differ():
+    a, _ = _random_config("traffic", 16, 0, 0)
+    b, _ = _random_config("pedestrian", 16, 0, 0)
+    widths = lambda h: {line.split("=")[0] for line in h.splitlines() if "_W =" in line and "PALETTE" not in line}  # noqa: E731
+    assert widths(a) == widths(b)
+    assert [line for line in a.splitlines() if "_W =" in line] != [line for line in b.splitlines() if "_W =" in line]
+
+
+@pytest.mark.parametrize("sim", SIMS)
+def test_a_reset_in_the_middle_of_a_stream_recovers_the_models_state_after_reset(sim):
+    header, config = _random_config("traffic", 16, seed=77, count=5000, reset_at=4000, reset_cycle=3001)
+    result = run(sim, header, "model_in_the_loop", config)
+    assert result["events"] == 5000
+
+
+def test_no_event_is_lost_or_duplicated_under_heavy_back_pressure():
+    # 10^5 events with the output stalled 75 % of the cycles and input gaps: the trace must count
+    # every event once, in order, and every record must match the model. Verilator, for volume.
+    header, config = _random_config("traffic", 16, seed=5, count=100_000, gap=32, stall=192)
+    result = run("verilator", header, "model_in_the_loop", config | {"gap": 32, "stall": 192})
+    assert result["events"] == 100_000
+
+
+@pytest.mark.parametrize("sim", SIMS)
+def test_two_cycles_per_event_and_one_cycle_per_slot_in_a_sweep(sim):
+    # Without gaps or stalls: each event takes IDLE + EXEC, each filter step max(N, P) cycles.
+    case = "bursts"  # no evictions: no scans
+    result = run(sim, _case_header(case), "replay_vectors", {"cases": [str(VECTORS / case)], "seed": 1, "gap": 0, "stall": 0})
+    stats = result["cases"][case]
+    manifest = json.loads((VECTORS / case / "manifest.json").read_text())
+    assert stats["filter_steps"] == manifest["counts"]["steps"]
+    assert stats["filter_cycles"] == stats["filter_steps"] * max(manifest["n_clusters"], manifest["palette_size"])
+    assert stats["cycles"] - stats["filter_cycles"] <= 2 * stats["events"] + 2
+
+
+def _tampered_copy(tmp_path, case: str, edit) -> Path:
+    """A copy of a case with one file edited and its manifest's sha256 updated to match."""
+    import shutil
+
+    folder = tmp_path / case
+    shutil.copytree(VECTORS / case, folder)
+    file = edit(folder)
+    manifest = json.loads((folder / "manifest.json").read_text())
+    manifest["sha256"][file] = hashlib.sha256((folder / file).read_bytes()).hexdigest()
+    (folder / "manifest.json").write_text(json.dumps(manifest))
+    return folder
+
+
+@pytest.mark.parametrize("sim", SIMS)
+def test_a_wrong_expected_record_is_reported_field_by_field(sim, tmp_path):
+    from evclust.vectors.pack import record_fields, pack, unpack
+    from evclust.vectors.read import load_case
+
+    case = load_case(VECTORS / "bursts")
+    fields = record_fields(case.table)
+    values = unpack(case.expected[7], fields)
+    values[[f[0] for f in fields].index("vx_int")] += 1
+
+    def edit(folder):
+        lines = (folder / "expected.hex").read_text().splitlines()
+        lines[7] = f"{pack(values, fields):0{len(lines[7])}x}"
+        (folder / "expected.hex").write_text("\n".join(lines) + "\n")
+        return "expected.hex"
+
+    folder = _tampered_copy(tmp_path, "bursts", edit)
+    with pytest.raises(AssertionError, match=r"bursts: record 7 \(expected.hex line 8\), emitted after event \d+ \(trace.hex line \d+\): vx_int: RTL -?\d+, model -?\d+$"):
+        run(sim, case.header, "replay_vectors", {"cases": [str(folder)], "seed": 1, "gap": 0, "stall": 0})
+
+
+@pytest.mark.parametrize("sim", SIMS)
+def test_a_case_for_another_parameter_set_fails_clearly(sim):
+    header = _case_header("traffic_clip")
+    with pytest.raises(AssertionError, match="bursts: made for another parameter set than the RTL was built with"):
+        run(sim, header, "replay_vectors", {"cases": [str(VECTORS / "bursts")], "seed": 1, "gap": 0, "stall": 0})
+
+
+@pytest.mark.parametrize("sim", SIMS)
+def test_a_truncated_case_fails_clearly(sim, tmp_path):
+    def edit(folder):
+        lines = (folder / "events.hex").read_text().splitlines()
+        (folder / "events.hex").write_text("\n".join(lines[:-5]) + "\n")
+        return "events.hex"
+
+    folder = _tampered_copy(tmp_path, "bursts", edit)
+    with pytest.raises(AssertionError, match=r"events.hex: 1995 lines, the manifest says 2000 \(truncated\?\)"):
+        run(sim, _case_header("bursts"), "replay_vectors", {"cases": [str(folder)], "seed": 1, "gap": 0, "stall": 0})
