@@ -30,3 +30,19 @@ def test_lint_reports_a_real_problem(tmp_path):
     # The check is not vacuous: a header that breaks a width is reported.
     header = (Path(__file__).resolve().parents[1] / "rtl" / "evclust_params.vh").read_text()
     assert lint(header.replace("localparam integer FILTER_EVERY = 64;", "localparam integer FILTER_EVERY = 64;\nwire spare;")) != ""
+
+
+def test_the_fusesoc_core_file_lints_through_edalize(tmp_path):
+    import os
+    import shutil
+    import subprocess
+
+    from cosim import _use_simulator
+
+    _use_simulator("verilator")
+    fusesoc = shutil.which("fusesoc", path=str(Path(sys.executable).parent)) or "fusesoc"
+    root = Path(__file__).resolve().parents[1]
+    done = subprocess.run([fusesoc, "--cores-root", str(root), "run", "--target", "lint", "evclust:evclust:core"],
+                          cwd=tmp_path, capture_output=True, text=True, env=os.environ)  # fmt: skip
+    assert done.returncode == 0, done.stdout[-2000:] + done.stderr[-2000:]
+    assert "%Warning" not in done.stdout + done.stderr
