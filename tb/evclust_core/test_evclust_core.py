@@ -248,12 +248,15 @@ def test_a_reset_in_the_middle_of_a_stream_recovers_the_models_state_after_reset
     assert result["events"] == 5000
 
 
-def test_no_event_is_lost_or_duplicated_under_heavy_back_pressure():
-    # 10^5 events with the output stalled 75 % of the cycles and input gaps: the trace must count
-    # every event once, in order, and every record must match the model. Verilator, for volume.
-    header, config = _random_config("traffic", 16, seed=5, count=100_000, gap=32, stall=192)
-    result = run("verilator", header, "model_in_the_loop", config | {"gap": 32, "stall": 192})
-    assert result["events"] == 100_000
+@pytest.mark.parametrize("sim", SIMS)
+def test_no_event_is_lost_or_duplicated_under_heavy_back_pressure(sim):
+    # The output stalled 75 % of the cycles, with input gaps: the trace must count every event
+    # once, in order, and every record must match the model. 10^5 events under Verilator; Icarus,
+    # some 40 times slower on this design, checks the same behaviour on 10^4.
+    count = 100_000 if sim == "verilator" else 10_000
+    header, config = _random_config("traffic", 16, seed=5, count=count)
+    result = run(sim, header, "model_in_the_loop", config | {"gap": 32, "stall": 192})
+    assert result["events"] == count
 
 
 @pytest.mark.parametrize("sim", SIMS)

@@ -1,0 +1,107 @@
+"""RTL figures: cycles per event and per filter sweep (measured by the testbench on every vector
+case, without input gaps or output stalls), and co-simulation speed under Icarus and Verilator.
+
+Writes its section of docs/BENCHMARKS.md. Targets (issue 5): Verilator co-simulation >= 50k
+events/s; 1 event per clock at N = 16 and at most N + 4 cycles per sweep (not met: see the text).
+"""
+
+from __future__ import annotations
+
+import common  # noqa: F401  (first: pins every thread pool to one core)
+
+import argparse
+import datetime
+import json
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "tb"))
+
+from cosim import SIMULATORS, run  # noqa: E402
+
+from evclust.clusterer import load_params  # noqa: E402
+from evclust.fixed.formats import build_formats, verilog_header  # noqa: E402
+from evclust.vectors import CASES  # noqa: E402
+from evclust.vectors.read import load_case  # noqa: E402
+
+START, END = "<!-- bench:rtl:start -->", "<!-- bench:rtl:end -->"
+VECTORS = ROOT / "vectors"
+STREAM = {"icarus": 20_000, "verilator": 200_000}  # random events per co-simulation speed run
+
+
+def cycles_per_case(sim: str) -> list[dict]:
+    rows = []
+    for name in CASES:
+        case = load_case(VECTORS / name)
+        stats = run(sim, case.header, "replay_vectors", {"cases": [str(VECTORS / name)], "seed": 1, "gap": 0, "stall": 0})["cases"][name]
+        rows.append(stats | {"case": name, "n": case.table.n_clusters, "p": case.table.palette_size,
+                             "evictions": case.manifest["counts"]["evicted"] + case.manifest["counts"]["dropped"]})  # fmt: skip
+    return rows
+
+
+def stream_speed(sim: str) -> dict:
+    params, _ = load_params("traffic")
+    t_frame = params.t_frame_us or 50000.0
+    header = verilog_header(build_formats(params, 480, 270, t_frame))
+    config = {"preset": "traffic", "n_clusters": 16, "width": 480, "height": 270, "t_frame_us": t_frame,
+              "seed": 3, "count": STREAM[sim], "gap": 0, "stall": 0}  # fmt: skip
+    run(sim, header, "model_in_the_loop", config | {"count": 1000})  # build outside the timing
+    start = time.perf_counter()
+    result = run(sim, header, "model_in_the_loop", config)
+    return result | {"total_s": time.perf_counter() - start}
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--write", metavar="BENCHMARKS.md", help="rewrite this file's RTL section")
+    args = parser.parse_args()
+    cases = {sim: cycles_per_case(sim) for sim in SIMULATORS}
+    speed = {sim: stream_speed(sim) for sim in SIMULATORS}
+    lines = [
+        START,
+        "## RTL: cycles and co-simulation speed",
+        "",
+        f"Command: `make bench` (= `.venv/bin/python bench/rtl.py --write docs/BENCHMARKS.md`), "
+        f"run {datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC, on the machine above.",
+        "",
+        "Cycles, counted by the harness (tb/evclust_core/evclust_tb.v) while every vector case replays "
+        "with no input gap and no output stall. `filter` cycles are those with `filter_active` high.",
+        "",
+        "| case | N | events | cycles | cycles/event | cycles/event outside sweeps | sweeps | cycles/sweep | evictions + drops |",
+        "|---|---:|---:|---:|---:|---:|---:|---:|---:|",
+    ]
+    for r in cases["verilator"]:
+        outside = (r["cycles"] - r["filter_cycles"]) / r["events"]
+        lines.append(f"| {r['case']} | {r['n']} | {r['events']:,} | {r['cycles']:,} | {r['cycles'] / r['events']:.2f} | {outside:.2f} "
+                     f"| {r['filter_steps']} | {r['filter_cycles'] / max(1, r['filter_steps']):.1f} | {r['evictions']} |")  # fmt: skip
+    same = all(a["cycles"] == b["cycles"] for a, b in zip(cases["icarus"], cases["verilator"]))
+    lines += [
+        "",
+        f"Icarus counts the same cycles for every case: {'yes' if same else '**no**'}.",
+        "",
+        "Co-simulation speed: random streams (traffic parameters, N = 16, 480x270) through the RTL and the "
+        "fixed model in one process, no gaps or stalls. `stream` is the time cocotb spends loading the batches, "
+        "simulating and reading the records back; `whole run` adds the simulator's start, the model and the "
+        "comparison.",
+        "",
+        "| simulator | events | records | stream s | events/s (stream) | whole run s | events/s (whole run) |",
+        "|---|---:|---:|---:|---:|---:|---:|",
+    ]
+    for sim, r in speed.items():
+        lines.append(f"| {sim} | {r['events']:,} | {r['records']:,} | {r['wall_s']:.2f} | {r['events'] / r['wall_s']:,.0f} "
+                     f"| {r['total_s']:.1f} | {r['events'] / r['total_s']:,.0f} |")  # fmt: skip
+    v = speed["verilator"]
+    lines += ["", f"Target: Verilator co-simulation ≥ 50k events/s: {v['events'] / v['wall_s']:,.0f} (stream), "
+              f"**{'PASS' if v['events'] / v['wall_s'] >= 50_000 else 'FAIL'}**.", END, ""]  # fmt: skip
+    text = "\n".join(lines)
+    print(text)
+    if args.write:
+        common.write_section(Path(args.write), text, START, END)
+    json.dump({"cases": cases, "speed": speed}, open(ROOT / "build" / "bench_rtl.json", "w"), indent=1)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

