@@ -100,17 +100,28 @@ module evclust_core (
         end
     endfunction
 
-    // |V|^2 in speed_sq's format, each component first clamped to full scale (model: _speed_sq).
-    function automatic signed [63:0] speed_sq;
-        input signed [63:0] vx;
-        input signed [63:0] vy;
+    // |V|^2 (model: _speed_sq) from squares taken once per component: each component is
+    // clamped to full scale, so its magnitude fits SQ_MAG_W bits and its square a small multiplier.
+    localparam integer SQ_MAG_W = V_FULL_BITS + (FV > FI ? FV : FI);
+    function automatic [2*SQ_MAG_W-1:0] square;
+        input signed [63:0] v;
         input integer frac;
-        reg signed [63:0] full, cx, cy;
+        reg signed [63:0] full, c;
+        reg [SQ_MAG_W-1:0] m;
         begin
             full = (64'sd1 <<< (V_FULL_BITS + frac)) - 1;
-            cx = saturate(vx, -full, full);
-            cy = saturate(vy, -full, full);
-            speed_sq = align(cx * cx + cy * cy, 2 * frac, SQ_F);
+            c = abs64(saturate(v, -full, full));
+            m = c[SQ_MAG_W-1:0];
+            square = m * m;
+        end
+    endfunction
+
+    // A sum of squares with 2 * frac fraction bits, in speed_sq's format.
+    function automatic signed [63:0] speed_sq;
+        input [2*SQ_MAG_W:0] sum;
+        input integer frac;
+        begin
+            speed_sq = align($signed({{(63 - 2 * SQ_MAG_W){1'b0}}, sum}), 2 * frac, SQ_F);
         end
     endfunction
 
@@ -133,16 +144,18 @@ module evclust_core (
         end
     endfunction
 
-    // floor(a / b) for b > 0, as Python's // (the model's MCM bias correction).
+    // floor(a / b) for b > 0, as Python's // (the model's MCM bias correction), with one
+    // divider sized to V << 20: a negative quotient is -ceil(|a| / b) = -((|a| + b - 1) / b).
+    localparam integer QUOTIENT_W = V_MCM_W + 21;
     function automatic signed [63:0] floor_div;
         input signed [63:0] a;
         input [W20_W-1:0] b;
-        reg [63:0] magnitude, quotient;
+        reg [QUOTIENT_W-1:0] magnitude, divisor, quotient;
         begin
-            magnitude = a < 0 ? -a : a;
-            quotient = magnitude / {{(64 - W20_W){1'b0}}, b};
-            floor_div = a >= 0 ? $signed(quotient)
-                      : -$signed(quotient) - ((quotient * {{(64 - W20_W){1'b0}}, b} != magnitude) ? 64'sd1 : 64'sd0);
+            magnitude = a < 0 ? ~a[QUOTIENT_W-1:0] + {{(QUOTIENT_W - 1){1'b0}}, 1'b1} : a[QUOTIENT_W-1:0];
+            divisor = {{(QUOTIENT_W - W20_W){1'b0}}, b};
+            quotient = (a < 0 ? magnitude + divisor - {{(QUOTIENT_W - 1){1'b0}}, 1'b1} : magnitude) / divisor;
+            floor_div = a < 0 ? -$signed({{(64 - QUOTIENT_W){1'b0}}, quotient}) : $signed({{(64 - QUOTIENT_W){1'b0}}, quotient});
         end
     endfunction
 
@@ -194,7 +207,7 @@ module evclust_core (
     reg [SLOT_W-1:0]       e_slot, e_free_slot;
     reg [SLOT_W-1:0]       weakest;
     reg [ACTIVITY_W-1:0]   weakest_a;
-    reg [63:0]             boundaries;   // tau boundaries since the last filter step
+    reg [32:0]             boundaries;   // tau boundaries since the last filter step
     reg [FRAME_PER_TAU_W-1:0] per_frame; // T_frame / (boundaries * tau)
 
     assign ev_ready = state == ST_IDLE;
@@ -270,6 +283,7 @@ module evclust_core (
         .vote(vote)
     );
 
+    reg signed [63:0] u_ox, u_oy;
     reg signed [63:0] ex, ey, u_px, u_py, u_px_new, u_py_new, u_gx, u_gy, u_rx, u_ry, u_step_x, u_step_y;
     reg signed [63:0] u_ux, u_uy, u_vmx, u_vmy, u_norm, u_act, u_cy, u_ccb, u_ccr, u_evc, u_gamma;
     reg signed [63:0] u_hist [0:P-1];
@@ -286,16 +300,19 @@ module evclust_core (
         u_px_new = alpha_step(u_px, ex, K_B_POS, BETA_POS_FRAC, FP, 1'b0);
         u_py_new = alpha_step(u_py, ey, K_B_POS, BETA_POS_FRAC, FP, 1'b0);
         // 3c. Size.
-        u_gx = saturate((abs64((ex <<< FP) - u_px) * K_GAIN) >>> (SIZE_GAIN_FRAC + FP - FR), 0, MAX_SIZE_TARGET);
-        u_gy = saturate((abs64((ey <<< FP) - u_py) * K_GAIN) >>> (SIZE_GAIN_FRAC + FP - FR), 0, MAX_SIZE_TARGET);
+        u_ox = abs64((ex <<< FP) - u_px);  // |e - P| < 2^CENTRE_W
+        u_oy = abs64((ey <<< FP) - u_py);
+        u_gx = saturate((u64({{(63 - CENTRE_W){1'b0}}, u_ox[CENTRE_W-1:0]}) * K_GAIN) >>> (SIZE_GAIN_FRAC + FP - FR), 0, MAX_SIZE_TARGET);
+        u_gy = saturate((u64({{(63 - CENTRE_W){1'b0}}, u_oy[CENTRE_W-1:0]}) * K_GAIN) >>> (SIZE_GAIN_FRAC + FP - FR), 0, MAX_SIZE_TARGET);
         u_rx = saturate(alpha_step(u64({{(63 - HALF_SIZE_W){1'b0}}, rx[e_slot]}), u_gx, K_B_SIZE, BETA_SIZE_FRAC, 0, 1'b0), K_R_MIN, K_R_MAX);
         u_ry = saturate(alpha_step(u64({{(63 - HALF_SIZE_W){1'b0}}, ry[e_slot]}), u_gy, K_B_SIZE, BETA_SIZE_FRAC, 0, 1'b0), K_R_MIN, K_R_MAX);
         // 3d. MCM velocity and its bias-correction weight.
         u_gamma = u64({{(63 - GAMMA_W){1'b0}}, gamma[e_slot]});
         u_step_x = saturate(u_px_new - u_px, MIN_STEP, MAX_STEP);
         u_step_y = saturate(u_py_new - u_py, MIN_STEP, MAX_STEP);
-        u_ux = saturate(align(u_gamma * u_step_x, FG + FP, FV), MIN_V, MAX_V);
-        u_uy = saturate(align(u_gamma * u_step_y, FG + FP, FV), MIN_V, MAX_V);
+        // gamma * (P_new - P): the step saturated to centre_step's format, so 22 x 22 bits.
+        u_ux = saturate(align(u_gamma * $signed({{(64 - CENTRE_STEP_W){u_step_x[CENTRE_STEP_W-1]}}, u_step_x[CENTRE_STEP_W-1:0]}), FG + FP, FV), MIN_V, MAX_V);
+        u_uy = saturate(align(u_gamma * $signed({{(64 - CENTRE_STEP_W){u_step_y[CENTRE_STEP_W-1]}}, u_step_y[CENTRE_STEP_W-1:0]}), FG + FP, FV), MIN_V, MAX_V);
         u_vmx = alpha_step($signed({{(64 - V_MCM_W){vmx[e_slot][V_MCM_W-1]}}, vmx[e_slot]}), u_ux, K_B_VM, BETA_VEL_MCM_FRAC, 0, 1'b1);
         u_vmy = alpha_step($signed({{(64 - V_MCM_W){vmy[e_slot][V_MCM_W-1]}}, vmy[e_slot]}), u_uy, K_B_VM, BETA_VEL_MCM_FRAC, 0, 1'b1);
         u_norm = alpha_step(u64({{(63 - MCM_NORM_W){1'b0}}, norm[e_slot]}), 64'sd1, K_B_VM, BETA_VEL_MCM_FRAC, FW, 1'b1);
@@ -320,6 +337,7 @@ module evclust_core (
     wire [SLOT_W-1:0] k = index[SLOT_W-1:0];
     reg signed [63:0] f_gamma, f_mx, f_my, f_vix, f_viy, f_vmx, f_vmy, f_vmx_raw, f_vmy_raw, f_px, f_py;
     reg signed [63:0] f_speed_sq, f_limit, f_per_frame, f_evc;
+    reg [2*SQ_MAG_W-1:0] f_sq_x, f_sq_y;
     reg [W20_W-1:0]   f_w20;
     reg [1:0]         f_vi_count;
     reg               f_expire, f_exit, f_left, f_right, f_top, f_bottom, f_moving_mcm, f_moving_int, f_report;
@@ -340,7 +358,7 @@ module evclust_core (
         f_viy = $signed({{(64 - V_INT_W){viy[k][V_INT_W-1]}}, viy[k]});
         f_mx = saturate(align((f_px - u64({{(63 - CENTRE_W){1'b0}}, ppx[k]})) * f_per_frame, FP + FPT_F, FI), MIN_VI, MAX_VI);
         f_my = saturate(align((f_py - u64({{(63 - CENTRE_W){1'b0}}, ppy[k]})) * f_per_frame, FP + FPT_F, FI), MIN_VI, MAX_VI);
-        if (boundaries != 64'd0) begin
+        if (boundaries != 33'd0) begin
             if (GAMMA_MODE == 2 && vi_count[k] != 2'd0)
                 f_gamma = saturate((f_evc * f_per_frame) >>> (FPT_F - FG), 0, MAX_GAMMA);
             f_evc = 0;
@@ -364,19 +382,21 @@ module evclust_core (
             f_vmy = floor_div(f_vmy_raw <<< 20, f_w20);
         end
         // Exit prediction on the squared speed.
-        f_speed_sq = saturate(speed_sq(f_vmx, f_vmy, FV), 0, MAX_SPEED_SQ);
+        f_sq_x = square(f_vmx, FV);
+        f_sq_y = square(f_vmy, FV);
+        f_speed_sq = saturate(speed_sq({1'b0, f_sq_x} + {1'b0, f_sq_y}, FV), 0, MAX_SPEED_SQ);
         f_left = f_px < K_EXIT_M;
         f_right = f_px > HI_X;
         f_top = f_py < K_EXIT_M;
         f_bottom = f_py > HI_Y;
         f_limit = (f_speed_sq * K_COS_SQ) >>> COS_SQ_F;
         f_exit = f_speed_sq >= K_V_EXIT_SQ && f_speed_sq > 0
-              && ((f_left && f_vmx < 0 && speed_sq(f_vmx, 0, FV) >= f_limit)
-               || (f_right && f_vmx > 0 && speed_sq(f_vmx, 0, FV) >= f_limit)
-               || (f_top && f_vmy < 0 && speed_sq(0, f_vmy, FV) >= f_limit)
-               || (f_bottom && f_vmy > 0 && speed_sq(0, f_vmy, FV) >= f_limit));
-        f_moving_mcm = speed_sq(f_vmx_raw, f_vmy_raw, FV) >= K_V_MIN_SQ;
-        f_moving_int = speed_sq(f_vix, f_viy, FI) >= K_V_MIN_SQ;
+              && ((f_left && f_vmx < 0 && speed_sq({1'b0, f_sq_x}, FV) >= f_limit)
+               || (f_right && f_vmx > 0 && speed_sq({1'b0, f_sq_x}, FV) >= f_limit)
+               || (f_top && f_vmy < 0 && speed_sq({1'b0, f_sq_y}, FV) >= f_limit)
+               || (f_bottom && f_vmy > 0 && speed_sq({1'b0, f_sq_y}, FV) >= f_limit));
+        f_moving_mcm = speed_sq({1'b0, square(f_vmx_raw, FV)} + {1'b0, square(f_vmy_raw, FV)}, FV) >= K_V_MIN_SQ;
+        f_moving_int = speed_sq({1'b0, square(f_vix, FI)} + {1'b0, square(f_viy, FI)}, FI) >= K_V_MIN_SQ;
         f_report = a_decayed >= K_A_VALID && (f_moving_mcm || f_moving_int);
         // The class: the strongest non-background histogram entry, none while all are zero.
         f_class = 8'hff;
@@ -402,19 +422,23 @@ module evclust_core (
     };
 
     // tau boundaries since the last filter step, from the phase counter; T_frame/(n tau).
-    wire [63:0] phase = {{(64 - TAU_PHASE_W){1'b0}}, tau_phase} + {32'd0, e_t - t_filter};
-    wire [63:0] phase_boundaries = phase / TAU;
-    wire [63:0] phase_left = phase - phase_boundaries * TAU;
-    wire [63:0] frame_per_boundary = {{(64 - FRAME_PER_TAU_W){1'b0}}, FRAME_PER_TAU}
-                                   / (phase_boundaries == 64'd0 ? 64'd1 : phase_boundaries);
+    // Dividers sized to their operands: a 33-bit phase by the constant tau, T_frame/tau by a
+    // count that leaves nothing once it reaches 2^FRAME_PER_TAU_W.
+    wire [32:0] phase = {{(33 - TAU_PHASE_W){1'b0}}, tau_phase} + {1'b0, e_t - t_filter};
+    wire [32:0] phase_boundaries = phase / TAU[32:0];
+    wire [32:0] phase_left = phase - phase_boundaries * TAU[32:0];
+    wire        many_boundaries = phase_boundaries >= (33'd1 << FRAME_PER_TAU_W);
+    wire [FRAME_PER_TAU_W-1:0] boundary_count = phase_boundaries == 33'd0 ? {{(FRAME_PER_TAU_W - 1){1'b0}}, 1'b1}
+                                              : phase_boundaries[FRAME_PER_TAU_W-1:0];
+    wire [FRAME_PER_TAU_W-1:0] frame_per_boundary = many_boundaries ? {FRAME_PER_TAU_W{1'b0}} : FRAME_PER_TAU / boundary_count;
 
     // 1/|palette_j - BG|^2 for the mixing rule (model: refresh_mixing), one entry per cycle.
     wire [CLASS_W-1:0] refresh_j = index[CLASS_W-1:0];
     wire signed [63:0] w_y = u64({55'd0, PALETTE_Y[refresh_j * 8 +: 8]}) - (u64({{(63 - BACKGROUND_W){1'b0}}, bg_y}) >>> FB);
     wire signed [63:0] w_cb = u64({55'd0, PALETTE_CB[refresh_j * 8 +: 8]}) - (u64({{(63 - BACKGROUND_W){1'b0}}, bg_cb}) >>> FB);
     wire signed [63:0] w_cr = u64({55'd0, PALETTE_CR[refresh_j * 8 +: 8]}) - (u64({{(63 - BACKGROUND_W){1'b0}}, bg_cr}) >>> FB);
-    wire [63:0] ww = w_y * w_y + w_cb * w_cb + w_cr * w_cr;
-    wire [63:0] inverse = ww == 64'd0 ? 64'd0 : (64'd1 << 32) / ww;  // at most 2^32: INV_WW_W bits
+    wire signed [63:0] ww = w_y * w_y + w_cb * w_cb + w_cr * w_cr;  // < 3 * 255^2 < 2^18
+    wire [32:0] inverse = ww == 64'sd0 ? 33'd0 : (33'd1 << 32) / {15'd0, ww[17:0]};
     wire [INV_WW_W-1:0] refreshed = inverse[INV_WW_W-1:0];
 
     // ---------------------------------------------------------------- the event's decision
@@ -484,7 +508,7 @@ module evclust_core (
             tau_phase <= {TAU_PHASE_W{1'b0}};
             since_filter <= {EVERY_W{1'b0}};
             started <= 1'b0;
-            boundaries <= 64'd0;
+            boundaries <= 33'd0;
             per_frame <= {FRAME_PER_TAU_W{1'b0}};
             for (i = 0; i < N; i = i + 1) begin
                 valid[i] <= 1'b0;
@@ -557,7 +581,7 @@ module evclust_core (
                     since_filter <= {EVERY_W{1'b0}};
                     boundaries <= phase_boundaries;
                     tau_phase <= phase_left[TAU_PHASE_W-1:0];
-                    per_frame <= frame_per_boundary[FRAME_PER_TAU_W-1:0];
+                    per_frame <= frame_per_boundary;
                     index <= {SWEEP_W{1'b0}};
                     state <= ST_SWEEP;
                 end else begin
@@ -627,7 +651,7 @@ module evclust_core (
                     vix[k] <= f_vix[V_INT_W-1:0];
                     viy[k] <= f_viy[V_INT_W-1:0];
                     vi_count[k] <= f_vi_count;
-                    if (boundaries != 64'd0) begin
+                    if (boundaries != 33'd0) begin
                         ppx[k] <= px[k];
                         ppy[k] <= py[k];
                     end

@@ -36,7 +36,6 @@ module evclust_palette (
     localparam signed [63:0] W_Y = $signed({{(64 - LUMA_WEIGHT_W){1'b0}}, LUMA_WEIGHT});
     localparam signed [63:0] TOLERANCE = $signed({{(64 - MIXING_TOLERANCE_W){1'b0}}, MIXING_TOLERANCE}) <<< FW;
     localparam signed [63:0] FAR = 64'sd1 <<< 62;
-    localparam signed [63:0] Q_ONE = 64'sd1 <<< 16;
 
     wire signed [63:0] e_y = $signed({56'd0, lum});
     wire signed [63:0] e_cb = $signed({56'd0, cb});
@@ -48,13 +47,20 @@ module evclust_palette (
     wire signed [63:0] bi_y = b_y >>> FB;
     wire signed [63:0] bi_cb = b_cb >>> FB;
     wire signed [63:0] bi_cr = b_cr >>> FB;
-    wire signed [63:0] u_y = e_y - bi_y;
-    wire signed [63:0] u_cb = e_cb - bi_cb;
-    wire signed [63:0] u_cr = e_cr - bi_cr;
+    wire signed [9:0] u_y10 = e_y[9:0] - bi_y[9:0];  // both in 0..255
+    wire signed [9:0] u_cb10 = e_cb[9:0] - bi_cb[9:0];
+    wire signed [9:0] u_cr10 = e_cr[9:0] - bi_cr[9:0];
 
+    // Operands are sized to their ranges so that synthesis builds small multipliers: colour
+    // differences fit 9 bits, u.w fits 19, q fits 17 bits (0..2^16), the residual 27.
     integer j;
-    reg signed [63:0] p_y, p_cb, p_cr, w_y, w_cb, w_cr, dot, q, r_y, r_cb, r_cr;
-    reg signed [63:0] d_end, d_line, nearest_d, mixed_d;
+    reg signed [63:0] p_y, p_cb, p_cr, t_y, t_cb, t_cr, d_end, d_line, nearest_d, mixed_d;
+    reg [7:0]         ad_y, ad_cb, ad_cr;
+    reg signed [9:0]  w_y, w_cb, w_cr;
+    reg signed [19:0] dot;
+    reg [50:0]        q_wide;
+    reg [16:0]        q;
+    reg signed [27:0] r_y, r_cb, r_cr;
     reg [CLASS_W-1:0] nearest, mixed;
     reg mixed_found;
 
@@ -68,20 +74,33 @@ module evclust_palette (
             p_y = $signed({56'd0, PALETTE_Y[j*8 +: 8]});
             p_cb = $signed({56'd0, PALETTE_CB[j*8 +: 8]});
             p_cr = $signed({56'd0, PALETTE_CR[j*8 +: 8]});
-            d_end = W_Y * abs64(e_y - p_y) + ((abs64(e_cb - p_cb) + abs64(e_cr - p_cr)) <<< FW);
+            t_y = abs64(e_y - p_y);
+            t_cb = abs64(e_cb - p_cb);
+            t_cr = abs64(e_cr - p_cr);
+            ad_y = t_y[7:0];
+            ad_cb = t_cb[7:0];
+            ad_cr = t_cr[7:0];
+            d_end = W_Y * $signed({56'd0, ad_y}) + (($signed({56'd0, ad_cb}) + $signed({56'd0, ad_cr})) <<< FW);
             if (d_end < nearest_d) begin
                 nearest = j[CLASS_W-1:0];
                 nearest_d = d_end;
             end
-            w_y = p_y - bi_y;
-            w_cb = p_cb - bi_cb;
-            w_cr = p_cr - bi_cr;
-            dot = u_y * w_y + u_cb * w_cb + u_cr * w_cr;
-            q = dot <= 0 ? 64'sd0 : min64((dot * $signed({{(64 - INV_WW_W){1'b0}}, inv_ww[j*INV_WW_W +: INV_WW_W]})) >>> 16, Q_ONE);
-            r_y = (u_y <<< 16) - q * w_y;
-            r_cb = (u_cb <<< 16) - q * w_cb;
-            r_cr = (u_cr <<< 16) - q * w_cr;
-            d_line = BACKGROUND_MASK[j] ? d_end : (W_Y * abs64(r_y) + ((abs64(r_cb) + abs64(r_cr)) <<< FW)) >>> 16;
+            t_y = p_y - bi_y;
+            t_cb = p_cb - bi_cb;
+            t_cr = p_cr - bi_cr;
+            w_y = t_y[9:0];
+            w_cb = t_cb[9:0];
+            w_cr = t_cr[9:0];
+            dot = u_y10 * w_y + u_cb10 * w_cb + u_cr10 * w_cr;
+            q_wide = {33'd0, dot[17:0]} * {18'd0, inv_ww[j*INV_WW_W +: INV_WW_W]};
+            q = dot <= 20'sd0 ? 17'd0 : (q_wide[50:16] > 35'd65536 ? 17'd65536 : q_wide[32:16]);  // Q0.16, clamped to 1
+            r_y = ($signed({{18{u_y10[9]}}, u_y10}) <<< 16) - $signed({11'd0, q}) * w_y;
+            r_cb = ($signed({{18{u_cb10[9]}}, u_cb10}) <<< 16) - $signed({11'd0, q}) * w_cb;
+            r_cr = ($signed({{18{u_cr10[9]}}, u_cr10}) <<< 16) - $signed({11'd0, q}) * w_cr;
+            t_y = abs64({{36{r_y[27]}}, r_y});
+            t_cb = abs64({{36{r_cb[27]}}, r_cb});
+            t_cr = abs64({{36{r_cr[27]}}, r_cr});
+            d_line = BACKGROUND_MASK[j] ? d_end : (W_Y * t_y + ((t_cb + t_cr) <<< FW)) >>> 16;
             if (d_line <= TOLERANCE && d_end < mixed_d) begin
                 mixed = j[CLASS_W-1:0];
                 mixed_d = d_end;
