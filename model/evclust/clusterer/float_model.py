@@ -28,6 +28,14 @@ from evclust.clusterer.layout import (
 ) = range(36)  # fmt: skip
 N_PARAMS = 36
 LN2 = math.log(2.0)
+
+# Quantisation points: the stores of the signals the formats table gives a format to. With a
+# precision table (rows as below) the loop rounds each store to its format, as the fixed model
+# does, so one quantisation source at a time can be measured (evclust.report.budget). Without
+# one (None) numba compiles the loop without them: the reference model is untouched.
+PRECISION_SIGNALS = ("centre", "half_size", "activity", "v_mcm", "mcm_norm", "v_int", "colour", "background", "gamma", "decay_table")
+Q_CENTRE, Q_HALF, Q_ACT, Q_VM, Q_NORM, Q_VI, Q_COLOUR, Q_BG, Q_GAMMA, Q_DECAY = range(len(PRECISION_SIGNALS))
+P_FRAC, P_LO, P_HI, P_NEAREST = range(4)  # precision columns: fraction bits (-1: exact), range, rounding
 GAMMA_MODES = ("global", "activity", "count")
 GAMMA_GLOBAL, GAMMA_ACTIVITY, GAMMA_COUNT = range(3)
 
@@ -51,9 +59,24 @@ def param_vector(p, width: int, height: int, t_frame_us: float, has_colour: bool
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
-def _decayed(activity, dt_us, t_half_us):
-    """A · 2^(-Δt / T_half)."""
-    return activity * math.exp2(-dt_us / t_half_us)
+def _q(x, signal, precision):
+    """x rounded to its signal's format (floor, or nearest) and saturated; x itself when the
+    signal is exact or there is no precision table."""
+    if precision is None or precision[signal, P_FRAC] < 0:
+        return x
+    scale = 2.0 ** precision[signal, P_FRAC]
+    v = math.floor(x * scale + 0.5 * precision[signal, P_NEAREST]) / scale
+    return min(max(v, precision[signal, P_LO]), precision[signal, P_HI])
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _decayed(activity, dt_us, t_half_us, precision=None):
+    """A · 2^(-Δt / T_half); with the decay table quantised, 2^-frac comes from its table entry."""
+    if precision is None or precision[Q_DECAY, P_FRAC] < 0:
+        return activity * math.exp2(-dt_us / t_half_us)
+    u = dt_us / t_half_us
+    whole = math.floor(u)
+    return activity * math.exp2(-whole) * _q(math.exp2(-(u - whole)), Q_DECAY, precision)
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
@@ -116,14 +139,14 @@ def _seek(S, x, y, seek):
 
 
 @numba.njit(cache=True, nogil=True)
-def _slot_for_new(S, G, t, k):
+def _slot_for_new(S, G, t, k, precision):
     """Step 2: a free slot; if none, the least active slot if its activity is below A_valid."""
     for s in range(S.shape[0]):
         if S[s, VALID] == 0.0:
             return s
     weakest, weakest_a = -1, np.inf
     for s in range(S.shape[0]):
-        a = _decayed(S[s, ACT], t - S[s, T_LAST], k[K_T_HALF])
+        a = _q(_decayed(S[s, ACT], t - S[s, T_LAST], k[K_T_HALF], precision), Q_ACT, precision)
         if a < weakest_a:
             weakest, weakest_a = s, a
     if weakest_a < k[K_A_VALID]:
@@ -133,7 +156,7 @@ def _slot_for_new(S, G, t, k):
 
 
 @numba.njit(cache=True, nogil=True)
-def _create(S, H, G, s, t, x, y, lum, cb, cr, k):
+def _create(S, H, G, s, t, x, y, lum, cb, cr, k, precision):
     S[s, :] = 0.0
     S[s, VALID] = 1.0
     S[s, ID] = G[NEXT_ID]
@@ -142,7 +165,7 @@ def _create(S, H, G, s, t, x, y, lum, cb, cr, k):
     S[s, PPX], S[s, PPY] = x, y
     S[s, RX], S[s, RY] = k[K_R_INIT], k[K_R_INIT]
     S[s, ACT] = 1.0
-    S[s, GAMMA] = _gamma(1.0, k)
+    S[s, GAMMA] = _q(_gamma(1.0, k), Q_GAMMA, precision)
     S[s, T_LAST] = t
     S[s, CY], S[s, CCB], S[s, CCR] = lum, cb, cr
     H[s, :] = 0
@@ -150,10 +173,10 @@ def _create(S, H, G, s, t, x, y, lum, cb, cr, k):
 
 
 @numba.njit(cache=True, nogil=True)
-def _update(S, H, G, s, t, x, y, lum, cb, cr, k, palette, background_mask):
+def _update(S, H, G, s, t, x, y, lum, cb, cr, k, palette, background_mask, precision):
     """Step 3: mean-shift update of the chosen cluster."""
-    a = _decayed(S[s, ACT], t - S[s, T_LAST], k[K_T_HALF]) + 1.0
-    S[s, ACT] = a
+    a = _q(_decayed(S[s, ACT], t - S[s, T_LAST], k[K_T_HALF], precision), Q_ACT, precision) + 1.0
+    S[s, ACT] = _q(a, Q_ACT, precision)
     px, py = S[s, PX], S[s, PY]
     # Eq. (1) on the centre: P_new = P + β_P (e - P).
     px_new = px + k[B_POS] * (x - px)
@@ -161,20 +184,21 @@ def _update(S, H, G, s, t, x, y, lum, cb, cr, k, palette, background_mask):
     # Size: R += β_R (g_R |e - P| - R), clamped.
     rx = S[s, RX] + k[B_SIZE] * (k[K_GAIN] * abs(x - px) - S[s, RX])
     ry = S[s, RY] + k[B_SIZE] * (k[K_GAIN] * abs(y - py) - S[s, RY])
-    S[s, RX] = min(max(rx, k[K_R_MIN]), k[K_R_MAX])
-    S[s, RY] = min(max(ry, k[K_R_MIN]), k[K_R_MAX])
+    S[s, RX] = min(max(_q(rx, Q_HALF, precision), k[K_R_MIN]), k[K_R_MAX])
+    S[s, RY] = min(max(_q(ry, Q_HALF, precision), k[K_R_MIN]), k[K_R_MAX])
     # Eq. (5), MCM: V += β_vm (γ (P_new - P) - V).
     gamma = S[s, GAMMA]
-    S[s, VMX] += k[B_VM] * (gamma * (px_new - px) - S[s, VMX])
-    S[s, VMY] += k[B_VM] * (gamma * (py_new - py) - S[s, VMY])
+    px_new, py_new = _q(px_new, Q_CENTRE, precision), _q(py_new, Q_CENTRE, precision)
+    S[s, VMX] = _q(S[s, VMX] + k[B_VM] * (gamma * (px_new - px) - S[s, VMX]), Q_VM, precision)
+    S[s, VMY] = _q(S[s, VMY] + k[B_VM] * (gamma * (py_new - py) - S[s, VMY]), Q_VM, precision)
     # The same filter on a constant 1 gives 1 - α^n: the weight V has gathered since V = 0.
-    S[s, MCM_NORM] += k[B_VM] * (1.0 - S[s, MCM_NORM])
+    S[s, MCM_NORM] = _q(S[s, MCM_NORM] + k[B_VM] * (1.0 - S[s, MCM_NORM]), Q_NORM, precision)
     S[s, PX], S[s, PY] = px_new, py_new
     if k[K_COLOUR] != 0.0:
         # Eq. (10): colour mean shift, luminance and chrominance with their own β.
-        S[s, CY] += k[B_LUM] * (lum - S[s, CY])
-        S[s, CCB] += k[B_CHRO] * (cb - S[s, CCB])
-        S[s, CCR] += k[B_CHRO] * (cr - S[s, CCR])
+        S[s, CY] = _q(S[s, CY] + k[B_LUM] * (lum - S[s, CY]), Q_COLOUR, precision)
+        S[s, CCB] = _q(S[s, CCB] + k[B_CHRO] * (cb - S[s, CCB]), Q_COLOUR, precision)
+        S[s, CCR] = _q(S[s, CCR] + k[B_CHRO] * (cr - S[s, CCR]), Q_COLOUR, precision)
         # §7.2.2: count the event's palette class; halve all counters when one saturates.
         if k[K_ASSIGN_MIXING] != 0.0:
             c = _mixing_palette(lum, cb, cr, G[BG_Y], G[BG_CB], G[BG_CR], palette, background_mask, k[K_LUMA_W], k[K_MIX_TOL])
@@ -226,7 +250,7 @@ def _exiting(S, s, k):
 
 
 @numba.njit(cache=True, nogil=True)
-def _filter_step(S, H, G, t, k, palette, background_mask, out, n_out):
+def _filter_step(S, H, G, t, k, palette, background_mask, out, n_out, precision):
     """Every N_f events: decay, free, interval velocity, noise and exit decisions, records."""
     # τ boundaries crossed since the last step: usually 0 or 1, more when events are sparse.
     boundaries = math.floor((t - G[T_FIRST]) / k[K_TAU]) - math.floor((G[T_FILTER] - G[T_FIRST]) / k[K_TAU])
@@ -236,24 +260,24 @@ def _filter_step(S, H, G, t, k, palette, background_mask, out, n_out):
     for s in range(S.shape[0]):
         if S[s, VALID] == 0.0:
             continue
-        S[s, ACT] = _decayed(S[s, ACT], t - S[s, T_LAST], k[K_T_HALF])
+        S[s, ACT] = _q(_decayed(S[s, ACT], t - S[s, T_LAST], k[K_T_HALF], precision), Q_ACT, precision)
         S[s, T_LAST] = t
         if S[s, ACT] < k[K_A_MIN]:
             S[s, VALID] = 0.0
             G[EXPIRED] += 1
             continue
         if k[K_GAMMA_MODE] != GAMMA_COUNT or S[s, VI_COUNT] == 0.0:
-            S[s, GAMMA] = _gamma(S[s, ACT], k)
+            S[s, GAMMA] = _q(_gamma(S[s, ACT], k), Q_GAMMA, precision)
         if interval_due:
             if k[K_GAMMA_MODE] == GAMMA_COUNT and S[s, VI_COUNT] >= 1.0:
-                S[s, GAMMA] = S[s, EV_COUNT] * per_frame  # events per frame since the last boundary
+                S[s, GAMMA] = _q(S[s, EV_COUNT] * per_frame, Q_GAMMA, precision)  # events per frame since the last boundary
             S[s, EV_COUNT] = 0.0
             # Eq. (4): V_RI += β_vi ((P - P_prev) · T_frame / τ - V_RI); P_prev = P.
-            mx = (S[s, PX] - S[s, PPX]) * per_frame
-            my = (S[s, PY] - S[s, PPY]) * per_frame
+            mx = _q((S[s, PX] - S[s, PPX]) * per_frame, Q_VI, precision)
+            my = _q((S[s, PY] - S[s, PPY]) * per_frame, Q_VI, precision)
             if k[K_WARM_START] == 0.0 or S[s, VI_COUNT] >= 2.0:
-                S[s, VIX] += k[B_VI] * (mx - S[s, VIX])
-                S[s, VIY] += k[B_VI] * (my - S[s, VIY])
+                S[s, VIX] = _q(S[s, VIX] + k[B_VI] * (mx - S[s, VIX]), Q_VI, precision)
+                S[s, VIY] = _q(S[s, VIY] + k[B_VI] * (my - S[s, VIY]), Q_VI, precision)
             elif S[s, VI_COUNT] == 1.0:  # the first full interval: take it as it is
                 S[s, VIX], S[s, VIY] = mx, my
             # (VI_COUNT 0: the cluster was born inside this interval; its displacement is partial.)
@@ -307,8 +331,9 @@ def _filter_step(S, H, G, t, k, palette, background_mask, out, n_out):
 
 
 @numba.njit(cache=True, nogil=True)
-def run_events(S, H, G, k, palette, background_mask, t_us, xs, ys, lums, cbs, crs, out):
-    """Feed events through the table; write track records into `out`; return how many."""
+def run_events(S, H, G, k, palette, background_mask, t_us, xs, ys, lums, cbs, crs, out, precision=None):
+    """Feed events through the table; write track records into `out`; return how many. With a
+    `precision` table (PRECISION_SIGNALS x 4) each quantisation point rounds to its format."""
     n_out = 0
     every = int(k[K_EVERY])
     for i in range(t_us.size):
@@ -322,21 +347,21 @@ def run_events(S, H, G, k, palette, background_mask, t_us, xs, ys, lums, cbs, cr
         s = _seek(S, x, y, k[K_SEEK])
         updated_reported = False
         if s < 0:
-            s = _slot_for_new(S, G, t, k)
+            s = _slot_for_new(S, G, t, k, precision)
             if s >= 0:
-                _create(S, H, G, s, t, x, y, lum, cb, cr, k)
+                _create(S, H, G, s, t, x, y, lum, cb, cr, k, precision)
             else:
                 G[DROPPED] += 1
         else:
-            _update(S, H, G, s, t, x, y, lum, cb, cr, k, palette, background_mask)
+            _update(S, H, G, s, t, x, y, lum, cb, cr, k, palette, background_mask, precision)
             updated_reported = S[s, REPORTED] != 0.0
         # Step 4: events that do not update a reported cluster track the background colour.
         if k[K_COLOUR] != 0.0 and k[K_BG_FIXED] == 0.0 and not updated_reported:
-            G[BG_Y] += k[B_BG] * (lum - G[BG_Y])
-            G[BG_CB] += k[B_BG] * (cb - G[BG_CB])
-            G[BG_CR] += k[B_BG] * (cr - G[BG_CR])
+            G[BG_Y] = _q(G[BG_Y] + k[B_BG] * (lum - G[BG_Y]), Q_BG, precision)
+            G[BG_CB] = _q(G[BG_CB] + k[B_BG] * (cb - G[BG_CB]), Q_BG, precision)
+            G[BG_CR] = _q(G[BG_CR] + k[B_BG] * (cr - G[BG_CR]), Q_BG, precision)
         G[SINCE_FILTER] += 1
         if G[SINCE_FILTER] >= every:
             G[SINCE_FILTER] = 0
-            n_out = _filter_step(S, H, G, t, k, palette, background_mask, out, n_out)
+            n_out = _filter_step(S, H, G, t, k, palette, background_mask, out, n_out, precision)
     return n_out

@@ -41,8 +41,12 @@ class FloatClusterer:
 
     model = "float"
 
-    def __init__(self, params: ClustererParams, width: int, height: int, t_frame_us: float, has_colour: bool = True):
+    def __init__(self, params: ClustererParams, width: int, height: int, t_frame_us: float, has_colour: bool = True,
+                 precision: np.ndarray | None = None):  # fmt: skip
+        """`precision` (evclust.fixed.formats.precision_table) rounds each quantisation point to
+        its format: the float model then emulates chosen sources of the fixed model's error."""
         self.params = params
+        self.precision = precision
         self.k = float_model.param_vector(params, width, height, t_frame_us, has_colour)
         self.palette = params.palette_ycbcr()
         self.background_mask = params.background_mask()
@@ -58,7 +62,7 @@ class FloatClusterer:
         out = np.empty(((events.size // every + 1) * self.params.n_clusters, RECORD_COLUMNS))
         n = float_model.run_events(
             self.slots, self.hist, self.globals, self.k, self.palette, self.background_mask,
-            events["t"], events["x"], events["y"], events["Y"], events["Cb"], events["Cr"], out,
+            events["t"], events["x"], events["y"], events["Y"], events["Cb"], events["Cr"], out, self.precision,
         )  # fmt: skip
         return out[:n]
 

@@ -167,9 +167,9 @@ def build_formats(params: ClustererParams, width: int, height: int, t_frame_us: 
         Format("activity", False, _bits_for((1 << 16)), 8, "state", "decayed event count A"),
         Format("t_last", False, 32, 0, "state", "time the activity refers to, µs", overflow="wrap"),
         # V_MCM's input γ·(P_new - P) is large per event even when V is small: γ reaches ~10^4.
-        Format("v_mcm", True, 12, guard("beta_vel_mcm"), "state", "MCM velocity accumulator and its input, px/frame"),
+        Format("v_mcm", True, 12, guard("beta_vel_mcm"), "state", "MCM velocity accumulator and its input, px/frame", rounding="nearest"),
         # w is a divisor: its dead band must be tiny relative to 1, not to a pixel (2^-20).
-        Format("mcm_norm", False, 1, guard("beta_vel_mcm") + 14, "state", "1 - α_vm^n: the MCM filter run on 1 (reaches 1.0)"),
+        Format("mcm_norm", False, 1, guard("beta_vel_mcm") + 14, "state", "1 - α_vm^n: the MCM filter run on 1 (reaches 1.0)", rounding="nearest"),
         Format("v_int", True, _bits_for(v_full), guard("beta_vel_int"), "state", "interval velocity, px/frame"),
         Format("colour", False, 8, guard("beta_chro") if p.alpha_chro >= p.alpha_lum else guard("beta_lum"), "state", "cluster colour Y, Cb, Cr"),
         Format("background", False, 8, guard("beta_bg"), "state", "background colour Y, Cb, Cr"),
@@ -253,6 +253,30 @@ def _options(p: ClustererParams, background: Format) -> tuple[tuple[str, int], .
         ("BG_FIXED", int(p.background is not None)), ("BACKGROUND_MASK", mask),
         *((f"BG_INIT_{c}", int(round(v * 2**background.frac_bits))) for c, v in zip(("Y", "CB", "CR"), bg)),
     )  # fmt: skip
+
+
+def precision_table(table: FormatTable, signals=None, frac_bits: dict[str, int] | None = None):
+    """The float model's quantisation table (clusterer/float_model.PRECISION_SIGNALS x 4): the
+    named `signals` (default: all) rounded to their formats, with `frac_bits` overriding a
+    format's fraction bits (its integer bits kept); every other signal exact."""
+    import numpy as np
+
+    from evclust.clusterer.float_model import P_FRAC, P_HI, P_LO, P_NEAREST, PRECISION_SIGNALS
+
+    signals = PRECISION_SIGNALS if signals is None else tuple(signals)
+    frac_bits = frac_bits or {}
+    out = np.zeros((len(PRECISION_SIGNALS), 4))
+    out[:, P_FRAC] = -1
+    for row, name in enumerate(PRECISION_SIGNALS):
+        if name not in signals:
+            continue
+        fmt = table.formats[name]
+        frac = frac_bits.get(name, fmt.frac_bits)
+        out[row, P_FRAC] = frac
+        out[row, P_LO] = -(2.0**fmt.int_bits) if fmt.signed else 0.0
+        out[row, P_HI] = 2.0**fmt.int_bits - 2.0**-frac
+        out[row, P_NEAREST] = fmt.rounding == "nearest"
+    return out
 
 
 def decay_table(table: FormatTable):
