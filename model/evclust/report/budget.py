@@ -1,0 +1,147 @@
+"""The fixed-point error budget: what each quantisation source adds to the outputs, alone and all
+together, against the float model (docs/report/REPORT.md).
+
+A source is one signal of the formats table rounded to its format, the decay table, or the
+quantised constants. The float model emulates it: its quantisation points (float_model._q)
+round only that signal, everything else stays float64. Errors are measured on the track
+records both runs emit at the same filter step for the same object: at each step the records
+are paired by centre distance (Hungarian, within PAIR_GATE_PX), as the models' slot and id
+numbering may part ways after a creation one of them makes and the other does not.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+
+from evclust.clusterer import ClustererParams, track_events
+from evclust.clusterer.float_model import PRECISION_SIGNALS
+from evclust.fixed.formats import FormatTable, build_formats, precision_table
+
+# Output groups: the record columns each reports, and the format whose LSB measures it.
+OUTPUTS = {
+    "position": (("x", "y"), "centre"),
+    "size": (("rx", "ry"), "half_size"),
+    "velocity": (("vx_mcm", "vy_mcm", "vx_int", "vy_int"), "v_int"),
+    "colour": (("Y", "Cb", "Cr"), "colour"),
+}
+SOURCES = (*PRECISION_SIGNALS, "constants")
+PAIR_GATE_PX = 2.0
+
+
+@dataclasses.dataclass
+class Error:
+    """One source's error on one output group: max |e| in output LSBs, RMS, bias, noise power
+    and SQNR (dB) against the float outputs' power."""
+
+    max_lsb: float
+    rms: float
+    bias: float
+    power: float
+    sqnr_db: float
+    pairs: int
+
+
+def quantised_constants(params: ClustererParams, table: FormatTable) -> ClustererParams:
+    """The parameters as the fixed model holds them: every constant replaced by its quantised value."""
+    c = {name: k.quantised for name, k in table.constants.items()}
+    update = {f"alpha_{name[5:]}": 1.0 - value for name, value in c.items() if name.startswith("beta_")}
+    update |= {"size_gain": c["size_gain"], "t_half_us": 1.0 / c["inv_t_half"], "gamma": c["gamma_global"],
+               "p_correction": 1.0 / c["inv_p"], "r_init": c["r_init"], "r_min": c["r_min"], "r_max": c["r_max"]}  # fmt: skip
+    for name in ("seek_margin", "exit_margin", "a_min", "a_valid", "mixing_tolerance", "luma_weight"):
+        if name in c:
+            update[name] = c[name]
+    for name in ("v_min", "v_exit"):
+        if f"{name}_sq" in c:
+            update[name] = math.sqrt(c[f"{name}_sq"])
+    if "cos_sq_exit" in c:
+        update["theta_exit_deg"] = math.degrees(math.acos(math.sqrt(c["cos_sq_exit"])))
+    return params.model_copy(update=update)
+
+
+def emulate(events, meta, params: ClustererParams, table: FormatTable, sources, frac_bits=None):
+    """The float model with `sources` quantised (names of SOURCES); `frac_bits` overrides formats."""
+    sources = tuple(sources)
+    run_params = quantised_constants(params, table) if "constants" in sources else params
+    signals = [s for s in sources if s != "constants"]
+    precision = precision_table(table, signals, frac_bits) if signals else None
+    return track_events(events, meta, run_params, model="float", precision=precision)
+
+
+def record_errors(reference: np.ndarray, tracks: np.ndarray, table: FormatTable) -> dict[str, Error]:
+    """Each output group's error of `tracks` against `reference`, over the records both emit."""
+    pairs = paired_records(reference, tracks)
+    out = {}
+    for group, (columns, fmt) in OUTPUTS.items():
+        if not pairs:
+            out[group] = Error(math.nan, math.nan, math.nan, math.nan, math.nan, 0)
+            continue
+        a = np.array([[p[0][c] for c in columns] for p in pairs], dtype=np.float64).ravel()
+        b = np.array([[p[1][c] for c in columns] for p in pairs], dtype=np.float64).ravel()
+        e = b - a
+        power = float(np.mean(e * e))
+        signal = float(np.mean(a * a))
+        sqnr = math.inf if power == 0 else 10 * math.log10(signal / power) if signal > 0 else -math.inf
+        out[group] = Error(float(np.max(np.abs(e))) / table[fmt].lsb, math.sqrt(power), float(np.mean(e)), power, sqnr, len(pairs))
+    return out
+
+
+def paired_records(reference: np.ndarray, tracks: np.ndarray) -> list[tuple]:
+    """(reference record, record) pairs: per filter step, Hungarian on the centre distance."""
+    from scipy.optimize import linear_sum_assignment
+
+    pairs = []
+    ref_steps, steps = reference["step"], tracks["step"]
+    for step in np.intersect1d(ref_steps, steps):
+        a, b = reference[ref_steps == step], tracks[steps == step]
+        cost = np.hypot(a["x"][:, None] - b["x"][None], a["y"][:, None] - b["y"][None])
+        rows, cols = linear_sum_assignment(cost)
+        pairs += [(a[i], b[j]) for i, j in zip(rows, cols) if cost[i, j] <= PAIR_GATE_PX]
+    return pairs
+
+
+def budget(events, meta, params: ClustererParams, progress=None) -> dict:
+    """Per source, then all together (emulated) and the fixed model itself: errors per output."""
+    t_frame = params.t_frame_us or meta.t_frame_us
+    table = build_formats(params, meta.width, meta.height, t_frame)
+    reference = track_events(events, meta, params, model="float").tracks
+    rows = {}
+    for source in (*SOURCES, "all"):
+        sources = SOURCES if source == "all" else (source,)
+        rows[source] = record_errors(reference, emulate(events, meta, params, table, sources).tracks, table)
+        if progress:
+            progress(source)
+    rows["fixed model"] = record_errors(reference, track_events(events, meta, params, model="fixed").tracks, table)
+    return {"table": table, "rows": rows, "reference_records": len(reference)}
+
+
+def noise_sum_ratio(rows: dict, group: str) -> float:
+    """Sum of the sources' noise powers over the all-together power (1: the sources add up)."""
+    total = rows["all"][group].power
+    parts = sum(rows[s][group].power for s in SOURCES if not math.isnan(rows[s][group].power))
+    return parts / total if total > 0 else math.nan
+
+
+def error_vs_frac_bits(events, meta, params: ClustererParams, signal: str, offsets, group_of=None) -> list[tuple[int, float]]:
+    """(fraction bits, RMS error of the signal's output group) as one signal's format narrows or widens."""
+    t_frame = params.t_frame_us or meta.t_frame_us
+    table = build_formats(params, meta.width, meta.height, t_frame)
+    reference = track_events(events, meta, params, model="float").tracks
+    group = (group_of or SIGNAL_GROUP)[signal]
+    curve = []
+    for offset in offsets:
+        frac = table[signal].frac_bits + offset
+        if frac < 0:
+            continue
+        run = emulate(events, meta, params, table, (signal,), {signal: frac})
+        curve.append((frac, record_errors(reference, run.tracks, table)[group].rms))
+    return curve
+
+
+# The output group each signal feeds most directly.
+SIGNAL_GROUP = {
+    "centre": "position", "half_size": "size", "activity": "velocity", "v_mcm": "velocity", "mcm_norm": "velocity",
+    "v_int": "velocity", "colour": "colour", "background": "colour", "gamma": "velocity", "decay_table": "velocity",
+}  # fmt: skip
