@@ -6,7 +6,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 BUILD  := build
 
-.PHONY: setup demo test cosim lint synth bench results params vectors clean
+.PHONY: setup demo test cosim lint synth bench results report params vectors clean
 
 setup: $(STAMP)
 
@@ -67,6 +67,10 @@ vectors: $(STAMP)
 # Task accuracy on the built-in scenes: docs/RESULTS.md and its figures.
 results: $(STAMP)
 	$(PY) -m evclust.report --write docs/RESULTS.md
+
+# The precision and accuracy report: docs/report/REPORT.md and its figures.
+report: $(STAMP)
+	$(VENV)/bin/evclust report -o docs/report
 
 clean:
 	rm -rf $(BUILD) .pytest_cache

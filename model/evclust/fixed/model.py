@@ -10,6 +10,15 @@ from evclust.fixed import fixed_model
 from evclust.fixed.formats import build_formats, decay_table
 
 
+# The format each instrumented signal (fixed_model.SIGNALS) is measured in.
+SIGNAL_FORMATS = {
+    "centre": "centre", "half_size": "half_size", "activity": "activity", "v_mcm": "v_mcm", "mcm_norm": "mcm_norm",
+    "v_int": "v_int", "colour": "colour", "background": "background", "gamma": "gamma",
+    "events_in_interval": "events_in_interval", "hist": "hist", "centre_step": "centre_step", "speed_sq": "speed_sq",
+    "mcm_step": "v_mcm", "size_target": "size_target",
+}  # fmt: skip
+
+
 class FixedClusterer:
     """The bit-accurate model: the same interface as the float one, integer arithmetic inside."""
 
@@ -59,10 +68,6 @@ class FixedClusterer:
 
     def range_report(self) -> list[tuple[str, float, float, int]]:
         """(signal, min seen, max seen, saturations) in real units, for `--ranges`."""
-        frac = {"centre": "centre", "half_size": "half_size", "activity": "activity", "v_mcm": "v_mcm", "mcm_norm": "mcm_norm",
-                "v_int": "v_int", "colour": "colour", "background": "background", "gamma": "gamma",
-                "events_in_interval": "events_in_interval", "hist": "hist", "centre_step": "centre", "speed_sq": "speed_sq",
-                "mcm_step": "v_mcm", "size_target": "size_target"}  # fmt: skip
         rows = []
         if self.ranges is None:
             return rows
@@ -70,6 +75,6 @@ class FixedClusterer:
             lo, hi = self.ranges[j]
             if lo > hi:
                 continue
-            scale = 2.0 ** -self.table[frac[name]].frac_bits
+            scale = 2.0 ** -self.table[SIGNAL_FORMATS[name]].frac_bits
             rows.append((name, lo * scale, hi * scale, int(self.overflow[j])))
         return rows

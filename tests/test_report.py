@@ -1,0 +1,74 @@
+"""The report's error budget and its quick mode (issue: reports)."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from evclust.clusterer import load_params, track_events
+from evclust.fixed.formats import build_formats
+from evclust.report.budget import OUTPUTS, SOURCES, budget, emulate, noise_sum_ratio, record_errors
+from evclust.report.report import NOISE_SUM_TOLERANCE_DB, write_report
+from evclust.scenes import load_scene
+from evclust.simulator import simulate_scene
+
+
+@pytest.fixture(scope="module")
+def traffic_clip():
+    sim = simulate_scene(load_scene("traffic"))
+    params, _ = load_params("traffic")
+    return sim.events[:120_000], sim.meta, params
+
+
+@pytest.fixture(scope="module")
+def traffic_budget(traffic_clip):
+    return budget(*traffic_clip)
+
+
+def test_the_sources_noise_powers_add_up_to_the_total_within_the_stated_tolerance(traffic_budget):
+    for group in OUTPUTS:
+        ratio = noise_sum_ratio(traffic_budget["rows"], group)
+        assert abs(10 * math.log10(ratio)) <= NOISE_SUM_TOLERANCE_DB, (group, ratio)
+
+
+def test_the_emulated_total_is_the_fixed_models_error(traffic_budget):
+    # Independent of the emulation: the bit-exact model's own error against float.
+    rows = traffic_budget["rows"]
+    for group in OUTPUTS:
+        emulated, fixed = rows["all"][group].rms, rows["fixed model"][group].rms
+        assert fixed > 0
+        assert abs(emulated - fixed) <= 0.25 * fixed, (group, emulated, fixed)
+
+
+def test_a_source_touches_only_the_outputs_it_feeds(traffic_budget):
+    rows = traffic_budget["rows"]
+    assert rows["colour"]["position"].power == 0 and rows["colour"]["velocity"].power == 0
+    assert rows["centre"]["position"].power > 0
+    assert rows["half_size"]["position"].power == 0  # the size never moves the centre of the same events
+
+
+@pytest.mark.parametrize("signal", ["centre", "v_mcm", "v_int", "colour", "activity"])
+def test_a_format_widened_to_48_fraction_bits_adds_no_measurable_error(traffic_clip, signal):
+    events, meta, params = traffic_clip
+    table = build_formats(params, meta.width, meta.height, params.t_frame_us or meta.t_frame_us)
+    reference = track_events(events, meta, params).tracks
+    errors = record_errors(reference, emulate(events, meta, params, table, (signal,), {signal: 48}).tracks, table)
+    default = record_errors(reference, emulate(events, meta, params, table, (signal,)).tracks, table)
+    for group in OUTPUTS:
+        assert errors[group].rms <= 1e-9, (signal, group, errors[group].rms)
+    assert any(default[g].rms > 1e-6 for g in OUTPUTS), "the default format must show an error to widen away"
+
+
+def test_every_source_is_in_the_budget(traffic_budget):
+    assert set(traffic_budget["rows"]) == {*SOURCES, "all", "fixed model"}
+
+
+def test_the_quick_report_writes_its_markdown_and_figures(tmp_path):
+    path = write_report(tmp_path, quick=True, progress=False)
+    text = path.read_text()
+    for heading in ("## Fixed-point error budget", "## Error against fraction bits", "## Ranges and saturation", "## Task results: float and fixed"):
+        assert heading in text
+    for figure in ("budget_traffic.png", "budget_pedestrian.png", "error_vs_bits_traffic.png", "ranges_traffic.png"):
+        assert (tmp_path / "img" / figure).stat().st_size > 5000
+        assert f"img/{figure}" in text
