@@ -113,6 +113,7 @@ def script(src, out, hier):
         f"{SYNTH}{'' if hier else ' -flatten'}",
         f"tee -o {out / 'stat.json'} stat -json -tech xilinx",
         f"tee -o {out / 'stat.txt'} stat -tech xilinx",  # per module when --hier
+        f"write_rtlil {out / 'netlist.il'}",  # for later questions (src attributes survive on DSPs)
     ]
     if hier:
         lines.append("flatten")
@@ -125,13 +126,13 @@ def script(src, out, hier):
     return "\n".join(lines) + "\n"
 
 
-def run_yosys(n, yosys, hier):
+def run_yosys(n, yosys, hier, sources):
     out = BUILD / (f"n{n}-hier" if hier else f"n{n}")
     src = out / "src"
     shutil.rmtree(out, ignore_errors=True)
     src.mkdir(parents=True)
-    for name in SOURCES + INCLUDES:
-        shutil.copy(RTL / name, src / name)
+    for name, text in sources.items():
+        (src / name).write_text(text)
     (src / "evclust_params.vh").write_text(params_header(n))
     (out / "synth.ys").write_text(script(src, out, hier))
     log = out / "yosys.log"
@@ -160,6 +161,15 @@ def run_yosys(n, yosys, hier):
     return out, wall, cpu
 
 
+def rtl_version():
+    """The last commit touching rtl/, "+dirty" when rtl/ has uncommitted changes."""
+    try:
+        git = lambda *a: subprocess.run(["git", *a], cwd=ROOT, capture_output=True, text=True, check=True).stdout.strip()
+        return git("log", "-1", "--format=%h", "--", "rtl") + ("+dirty" if git("status", "--porcelain", "--", "rtl") else "")
+    except (OSError, subprocess.CalledProcessError):
+        return None
+
+
 def last_step(log):
     steps = [l for l in log.read_text(errors="replace").splitlines() if l[:1].isdigit() and "Executing" in l] if log.exists() else []
     return steps[-1].strip() if steps else "starting"
@@ -183,7 +193,7 @@ def path_cells(stat_json):
     return total
 
 
-def figures(n, out, wall, cpu, hier):
+def figures(n, out, wall, cpu, hier, rtl):
     design = json.loads((out / "stat.json").read_text())["design"]  # the whole hierarchy
     c = design["num_cells_by_type"]
     path = path_cells(out / "path.json")
@@ -193,6 +203,7 @@ def figures(n, out, wall, cpu, hier):
     path_luts = sum(path.get(k, 0) for k in LUTS)
     return {
         "n_clusters": n,
+        "rtl": rtl,
         "lut": sum(c.get(k, 0) for k in LUTS),
         "inv": c.get("INV", 0),  # a LUT1 in Vivado unless absorbed
         "estimated_lc": design.get("estimated_num_lc"),  # Yosys's stat -tech xilinx estimate
@@ -237,13 +248,16 @@ def main():
     parser.add_argument("--hier", action="store_true",
                         help="keep the hierarchy through synthesis (per-module stat.txt), flatten only for ltp")
     args = parser.parse_args()
+    # One snapshot of the RTL for every N: others may be editing rtl/ meanwhile.
+    rtl = rtl_version()
+    sources = {name: (RTL / name).read_text() for name in SOURCES + INCLUDES}
     try:
         yosys = yosys_command()
         rows = []
         for n in args.n:
             print(f"synth: N={n} ...", file=sys.stderr)
-            out, wall, cpu = run_yosys(n, yosys, args.hier)
-            rows.append(figures(n, out, wall, cpu, args.hier))
+            out, wall, cpu = run_yosys(n, yosys, args.hier, sources)
+            rows.append(figures(n, out, wall, cpu, args.hier, rtl))
             print(f"synth: N={n} done in {wall / 60:.1f} min", file=sys.stderr)
     except SynthError as e:
         sys.exit(f"synth: {e}")

@@ -145,3 +145,76 @@ SIGNAL_GROUP = {
     "centre": "position", "half_size": "size", "activity": "velocity", "v_mcm": "velocity", "mcm_norm": "velocity",
     "v_int": "velocity", "colour": "colour", "background": "colour", "gamma": "velocity", "decay_table": "velocity",
 }  # fmt: skip
+
+
+# The task metrics a recommended set of formats must keep within tolerance of the float model's.
+TASK_METRICS = (
+    ("mcm", "nrmse"), ("mcm", "angular_deg"), ("interval", "nrmse"), ("interval", "angular_deg"),
+    ("position_rmse_px",), ("luminance", "nrmse"), ("chrominance", "nrmse"), ("class_palette_accuracy",),
+)  # fmt: skip
+
+
+def task_scores(run, truth) -> dict:
+    from evclust.metrics import DEFAULT_GATE_PX, match_with_counts
+    from evclust.metrics.scores import scores_from_matches
+
+    s = scores_from_matches(*match_with_counts(run.tracks, run.meta, truth), run.meta, DEFAULT_GATE_PX, False).to_dict()
+    out = {}
+    for path in TASK_METRICS:
+        value = s
+        for key in path:
+            value = value[key]
+        out[".".join(path)] = value
+    return out
+
+
+def within(reference: dict, scores: dict, tolerance: float) -> bool:
+    """Every task metric within `tolerance` (relative) of the reference's."""
+    for name, ref in reference.items():
+        value = scores[name]
+        if ref is None or value is None:
+            if ref is not value:
+                return False
+            continue
+        if abs(value - ref) > tolerance * abs(ref) + 1e-12:
+            return False
+    return True
+
+
+@dataclasses.dataclass
+class WordLengths:
+    default: dict[str, int]  # fraction bits
+    recommended: dict[str, int]
+    word_bits: dict[str, tuple[int, int]]  # signal -> (default word, recommended word)
+    evaluations: int
+    defaults_within: bool
+
+
+def wordlength_search(events, meta, params: ClustererParams, truth, tolerance: float = 0.01, progress=None) -> WordLengths:
+    """Greedy: signal by signal, drop fraction bits (steps of 8, 4, 2, 1) while every task metric of
+    the emulated model, all sources quantised, stays within `tolerance` of the float model's."""
+    t_frame = params.t_frame_us or meta.t_frame_us
+    table = build_formats(params, meta.width, meta.height, t_frame)
+    reference = task_scores(track_events(events, meta, params, model="float"), truth)
+    default = {s: table[s].frac_bits for s in PRECISION_SIGNALS}
+    evaluations = 0
+
+    def ok(fracs):
+        nonlocal evaluations
+        evaluations += 1
+        if progress:
+            progress()
+        return within(reference, task_scores(emulate(events, meta, params, table, SOURCES, fracs), truth), tolerance)
+
+    fracs = dict(default)
+    defaults_within = ok(fracs)
+    for signal in PRECISION_SIGNALS:
+        step = 8
+        while step >= 1:
+            trial = fracs | {signal: fracs[signal] - step}
+            if trial[signal] >= 0 and ok(trial):
+                fracs = trial
+            else:
+                step //= 2
+    words = {s: (table[s].word_bits, table[s].word_bits - default[s] + fracs[s]) for s in PRECISION_SIGNALS}
+    return WordLengths(default, fracs, words, evaluations, defaults_within)
