@@ -210,7 +210,7 @@ module evclust_core (
     reg [32:0]             boundaries;   // tau boundaries since the last filter step
     reg [FRAME_PER_TAU_W-1:0] per_frame; // T_frame / (boundaries * tau)
 
-    assign ev_ready = state == ST_IDLE;
+    assign ev_ready = !rst && state == ST_IDLE;  // no handshake during a reset
     assign filter_active = state == ST_SWEEP;
 
     // ---------------------------------------------------------------- step 1: the seek
@@ -288,7 +288,7 @@ module evclust_core (
     reg signed [63:0] u_ux, u_uy, u_vmx, u_vmy, u_norm, u_act, u_cy, u_ccb, u_ccr, u_evc, u_gamma;
     reg signed [63:0] u_hist [0:P-1];
     reg               u_halve;
-    integer c;
+    integer c;  // the update's loop; the sweep has its own (one variable per always block)
     always @* begin
         ex = u64({{(63 - EV_XY_W){1'b0}}, e_x});
         ey = u64({{(63 - EV_XY_W){1'b0}}, e_y});
@@ -335,6 +335,7 @@ module evclust_core (
     // One slot per cycle: decay, expiry, gamma, the interval velocity at tau boundaries,
     // the MCM bias correction (the sweep's divider), exit prediction, the record.
     wire [SLOT_W-1:0] k = index[SLOT_W-1:0];
+    integer cls;
     reg signed [63:0] f_gamma, f_mx, f_my, f_vix, f_viy, f_vmx, f_vmy, f_vmx_raw, f_vmy_raw, f_px, f_py;
     reg signed [63:0] f_speed_sq, f_limit, f_per_frame, f_evc;
     reg [2*SQ_MAG_W-1:0] f_sq_x, f_sq_y;
@@ -378,8 +379,8 @@ module evclust_core (
         f_vmx = f_vmx_raw;
         f_vmy = f_vmy_raw;
         if (MCM_CORRECT != 0 && f_w20 != {W20_W{1'b0}}) begin
-            f_vmx = floor_div(f_vmx_raw <<< 20, f_w20);
-            f_vmy = floor_div(f_vmy_raw <<< 20, f_w20);
+            f_vmx = saturate(floor_div(f_vmx_raw <<< 20, f_w20), MIN_V, MAX_V);  // the record's format
+            f_vmy = saturate(floor_div(f_vmy_raw <<< 20, f_w20), MIN_V, MAX_V);
         end
         // Exit prediction on the squared speed.
         f_sq_x = square(f_vmx, FV);
@@ -401,10 +402,10 @@ module evclust_core (
         // The class: the strongest non-background histogram entry, none while all are zero.
         f_class = 8'hff;
         f_best = 0;
-        for (c = 0; c < P; c = c + 1) begin
-            if (!BACKGROUND_MASK[c] && u64({{(63 - HIST_W){1'b0}}, hist[k * P + c]}) > f_best) begin
-                f_best = u64({{(63 - HIST_W){1'b0}}, hist[k * P + c]});
-                f_class = c[7:0];
+        for (cls = 0; cls < P; cls = cls + 1) begin
+            if (!BACKGROUND_MASK[cls] && u64({{(63 - HIST_W){1'b0}}, hist[k * P + cls]}) > f_best) begin
+                f_best = u64({{(63 - HIST_W){1'b0}}, hist[k * P + cls]});
+                f_class = cls[7:0];
             end
         end
         f_flags = (ever_reported[k] ? 4'd0 : FLAG_NEW) | ((f_left || f_right || f_top || f_bottom) ? FLAG_BORDER : 4'd0)

@@ -98,3 +98,13 @@ def test_formats_verb_refuses_bad_input(tmp_path, capsys):
     assert_one_line_error(code, err, "clusterer.alpha_pos")
     code, _, err = run_cli(capsys, "formats", "--width", "0")
     assert_one_line_error(code, err, "sensor 0x270")
+
+
+def test_formats_whose_speed_squares_overflow_the_datapath_are_refused():
+    with pytest.raises(EvclustError, match=r"clusterer.alpha_vel_mcm: .* its square needs 65 bits, over 63"):
+        build_formats(ClustererParams(alpha_vel_mcm=0.999995), 480, 270, 50000.0)
+
+
+def test_the_rtl_header_refuses_more_clusters_than_the_trace_can_name():
+    with pytest.raises(EvclustError, match="the RTL holds at most 256 clusters"):
+        verilog_header(build_formats(ClustererParams(n_clusters=257), 480, 270, 50000.0))

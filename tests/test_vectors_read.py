@@ -120,3 +120,15 @@ def test_the_scoreboard_lists_every_wrong_field_of_the_first_wrong_record():
         f"class: RTL {values[names.index('class')]}, model {want[names.index('class')]}"
     )
     assert "the RTL emitted 309 records, the model 310" in first_mismatch("c", *args, list(case.expected)[:-1], tags)
+
+
+def test_the_scoreboard_reports_whichever_difference_comes_first_in_the_stream():
+    case, args, _ = _streams()
+    events, fields, expected_trace, _, rec_fields, expected = args
+    trace, records = list(expected_trace), list(expected)
+    trace[600] = pack((3, 0), TRACE_FIELDS) if trace[600] != pack((3, 0), TRACE_FIELDS) else pack((0, 1), TRACE_FIELDS)
+    records[2] ^= 1 << 4
+    tags = [10] * len(records)  # every record left after event 9, long before the trace difference
+    assert first_mismatch("c", events, fields, expected_trace, trace, rec_fields, expected, records, tags).startswith("c: record 2 ")
+    tags = [700] * len(records)  # now the trace difference comes first
+    assert first_mismatch("c", events, fields, expected_trace, trace, rec_fields, expected, records, tags).startswith("c: event 600 ")

@@ -108,7 +108,8 @@ module evclust_tb #(
                 accepted <= accepted + 32'd1;
             if (!ev_valid || ev_ready) begin
                 ev_valid <= offer;
-                ev_data <= ev_mem[next_index[$clog2(DEPTH)-1:0]];
+                // Junk while not valid, so a core that samples ev_data at the wrong time fails.
+                ev_data <= offer ? ev_mem[next_index[$clog2(DEPTH)-1:0]] : {(EV_W / 32 + 1){next_random}};
             end
             if (trace_valid) begin
                 trace_mem[traced[$clog2(DEPTH)-1:0]] <= trace_data;

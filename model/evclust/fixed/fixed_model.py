@@ -372,8 +372,9 @@ def _filter_step(S, H, G, t, k, table, palette, inv_ww, background_mask, out, n_
         vmx, vmy = S[s, VMX], S[s, VMY]
         w20 = S[s, MCM_NORM] >> (fw - 20)  # w to 20 fraction bits: V·2^20 fits an int64
         if k[C_MCM_CORRECT] != 0 and w20 > 0:
-            vmx = (S[s, VMX] << 20) // w20
-            vmy = (S[s, VMY] << 20) // w20
+            # Saturated: early on (w small) V/w can leave V's format, which the record must hold.
+            vmx = _store((S[s, VMX] << 20) // w20, k[C_MIN_V], k[C_MAX_V], S_VM, log, ranges)
+            vmy = _store((S[s, VMY] << 20) // w20, k[C_MIN_V], k[C_MAX_V], S_VM, log, ranges)
         # Exit prediction on the squared speed (no square root).
         speed_sq = _store(_speed_sq(vmx, vmy, fv, k), 0, k[C_MAX_SPEED_SQ], S_SPEED, log, ranges)
         left, right, top, bottom = _near(S[s, PX], S[s, PY], k)

@@ -19,26 +19,29 @@ def describe_event(word: int, fields) -> str:
 
 def first_mismatch(name: str, events: list[int], event_fields, expected_trace: list[int], trace: list[int],
                    record_fields, expected: list[int], records: list[int], tags: list[int]) -> str | None:  # fmt: skip
-    """None when the streams agree bit for bit; else one message on the first difference.
-    `tags[j]`: how many events the RTL had traced when record j left it."""
-    for i, (want, got) in enumerate(zip(expected_trace, trace)):
-        if want != got:
-            return (
-                f"{name}: event {i} (events.hex/trace.hex line {i + 1}: {describe_event(events[i], event_fields)}): "
-                f"RTL did '{describe_trace(got)}', the model '{describe_trace(want)}'"
-            )
+    """None when the streams agree bit for bit; else one message on the first difference, in
+    stream order: a record that left after event i is reported before a trace difference at a
+    later event. `tags[j]`: how many events the RTL had traced when record j left it."""
+    trace_at = next((i for i, (want, got) in enumerate(zip(expected_trace, trace)) if want != got), None)
+    record_at = next((j for j, (want, got) in enumerate(zip(expected, records)) if want != got), None)
+    record_event = (tags[record_at] - 1 if record_at < len(tags) else -1) if record_at is not None else None
+    if record_at is not None and (trace_at is None or record_event < trace_at):
+        diffs = [
+            f"{f[0]}: RTL {g}, model {w}"
+            for f, w, g in zip(record_fields, unpack(expected[record_at], record_fields), unpack(records[record_at], record_fields)) if w != g
+        ]  # fmt: skip
+        return (
+            f"{name}: record {record_at} (expected.hex line {record_at + 1}), emitted after event {record_event} "
+            f"(trace.hex line {record_event + 1}): " + "; ".join(diffs)
+        )
+    if trace_at is not None:
+        i = trace_at
+        return (
+            f"{name}: event {i} (events.hex/trace.hex line {i + 1}: {describe_event(events[i], event_fields)}): "
+            f"RTL did '{describe_trace(trace[i])}', the model '{describe_trace(expected_trace[i])}'"
+        )
     if len(trace) != len(expected_trace):
         return f"{name}: the RTL traced {len(trace)} events, the model {len(expected_trace)}"
-    for j, (want, got) in enumerate(zip(expected, records)):
-        if want != got:
-            event = tags[j] - 1 if j < len(tags) else -1
-            diffs = [
-                f"{f[0]}: RTL {g}, model {w}" for f, w, g in zip(record_fields, unpack(want, record_fields), unpack(got, record_fields)) if w != g
-            ]  # fmt: skip
-            return (
-                f"{name}: record {j} (expected.hex line {j + 1}), emitted after event {event} "
-                f"(trace.hex line {event + 1}): " + "; ".join(diffs)
-            )
     if len(records) != len(expected):
         j = min(len(records), len(expected))
         extra = "the RTL's" if len(records) > len(expected) else "the model's"
