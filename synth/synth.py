@@ -88,9 +88,11 @@ def native_stack():
 
 def params_header(n):
     """evclust_params.vh for n clusters, from the formats table (as `evclust formats --verilog`)."""
-    from evclust.clusterer import load_params
-    from evclust.fixed.formats import build_formats, verilog_header
-
+    try:
+        from evclust.clusterer import load_params
+        from evclust.fixed.formats import build_formats, verilog_header
+    except ImportError as e:
+        raise SynthError(f"{e}: run with the project's venv (.venv/bin/python synth/synth.py)")
     params, _ = load_params("traffic")
     params = params.model_copy(update={"n_clusters": n})
     text = verilog_header(build_formats(params, 480, 270, params.t_frame_us or 50000.0))
@@ -200,7 +202,7 @@ def figures(n, out, wall, cpu, hier, rtl):
     ltp = (out / "ltp.txt").read_text()
     depth = int(ltp.split("(length=")[1].split(")")[0])
     lutram = {k: v for k, v in c.items() if k in LUTRAM}
-    path_luts = sum(path.get(k, 0) for k in LUTS)
+    path_luts = sum(path.get(k, 0) for k in LUTS + ["INV"])
     return {
         "n_clusters": n,
         "rtl": rtl,
@@ -228,14 +230,14 @@ def figures(n, out, wall, cpu, hier, rtl):
 
 
 def table(rows):
-    head = ("| N | LUT | FF | DSP48E1 | BRAM (RAMB18/36) | LUTRAM (LUTs) | CARRY4 "
+    head = ("| N | LUT (+INV) | FF | DSP48E1 | BRAM (RAMB18/36) | LUTRAM (LUTs) | CARRY4 "
             "| logic depth, cells (LUT + CARRY4 + DSP) | synthesis time |")
     lines = [head, "|" + "---|" * (head.count("|") - 1)]
     for r in rows:
         d = r["depth_by_type"]
         other = f" + {d['other']} other" if d["other"] else ""
         lines.append(
-            f"| {r['n_clusters']} | {r['lut']:,} | {r['ff']:,} | {r['dsp48e1']} | {r['ramb18e1']}/{r['ramb36e1']} "
+            f"| {r['n_clusters']} | {r['lut']:,} (+{r['inv']:,}) | {r['ff']:,} | {r['dsp48e1']} | {r['ramb18e1']}/{r['ramb36e1']} "
             f"| {r['lutram_luts']} | {r['carry4']:,} | {r['depth_cells']} ({d['lut']} + {d['carry4']} + {d['dsp48e1']}{other}) "
             f"| {r['wall_s'] / 60:.1f} min |")
     return "\n".join(lines)
