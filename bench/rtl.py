@@ -19,10 +19,8 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tb"))
 
-from cosim import SIMULATORS, run  # noqa: E402
+from cosim import SIMULATORS, random_config, run  # noqa: E402
 
-from evclust.clusterer import load_params  # noqa: E402
-from evclust.fixed.formats import build_formats, verilog_header  # noqa: E402
 from evclust.vectors import CASES  # noqa: E402
 from evclust.vectors.read import load_case  # noqa: E402
 
@@ -42,11 +40,7 @@ def cycles_per_case(sim: str) -> list[dict]:
 
 
 def stream_speed(sim: str) -> dict:
-    params, _ = load_params("traffic")
-    t_frame = params.t_frame_us or 50000.0
-    header = verilog_header(build_formats(params, 480, 270, t_frame))
-    config = {"preset": "traffic", "n_clusters": 16, "width": 480, "height": 270, "t_frame_us": t_frame,
-              "seed": 3, "count": STREAM[sim], "gap": 0, "stall": 0}  # fmt: skip
+    header, config = random_config("traffic", 16, seed=3, count=STREAM[sim])
     run(sim, header, "model_in_the_loop", config | {"count": 1000})  # build outside the timing
     start = time.perf_counter()
     result = run(sim, header, "model_in_the_loop", config)

@@ -98,3 +98,34 @@ def run(sim: str, header: str, testcase: str, config: dict) -> dict:
     if result.get("error"):
         raise AssertionError(f"{sim}: {result['error']}")
     return result
+
+
+# Model-in-the-loop configurations: two parameter sets whose formats differ (the presets' filters
+# set different guard bits, hence different widths), and a small sensor whose parameters switch
+# on what the presets leave off (a learning background with the mixing table refreshed at every
+# filter step, γ counted per interval, frequent filter steps). Name: (width, height, T_frame).
+CONFIGURATIONS = {"traffic": (480, 270, 50000.0), "pedestrian": (270, 480, 40000.0), "small": (64, 48, 10000.0)}
+
+
+def configuration_params(name: str, n_clusters: int):
+    from evclust.clusterer import load_params
+    from evclust.vectors.cases import _small_params
+
+    if name == "small":
+        return _small_params(n_clusters=n_clusters, gamma_mode="count", a_valid=6.0)
+    params, _ = load_params(name)
+    return params.model_copy(update={"n_clusters": n_clusters})
+
+
+def random_config(name: str, n_clusters: int, seed: int, count: int, **extra) -> tuple[str, dict]:
+    """(header, testbench configuration) of a model-in-the-loop run."""
+    from evclust.fixed.formats import build_formats, verilog_header
+
+    width, height, t_frame = CONFIGURATIONS[name]
+    params = configuration_params(name, n_clusters)
+    t_frame = params.t_frame_us or t_frame
+    header = verilog_header(build_formats(params, width, height, t_frame))
+    config = {"parameters": params.model_dump(mode="json", exclude_none=True), "n_clusters": n_clusters,
+              "width": width, "height": height, "t_frame_us": t_frame, "seed": seed, "count": count,
+              "gap": 0, "stall": 0} | extra  # fmt: skip
+    return header, config

@@ -190,7 +190,7 @@ if cocotb is not None:
 # ------------------------------------------------------------------------------------------
 # pytest: build per parameter set, launch, check.
 
-from cosim import run, selected_simulators  # noqa: E402
+from cosim import CONFIGURATIONS, random_config, run, selected_simulators  # noqa: E402
 
 from evclust.vectors import CASES  # noqa: E402
 
@@ -214,34 +214,11 @@ def test_vector_case_replays_bit_exact(sim, case):
     assert result["cases"][case]["records"] == json.loads((VECTORS / case / "manifest.json").read_text())["counts"]["records"]
 
 
-# Model in the loop: two parameter sets whose formats differ (the presets' filters set different
-# guard bits, hence different widths), each at N = 4 and N = 16; and a small sensor whose
-# parameters switch on what the presets leave off (a learning background with the mixing table
-# refreshed at every filter step, γ counted per interval, frequent filter steps).
-FORMAT_SETS = {"traffic": (480, 270, 50000.0), "pedestrian": (270, 480, 40000.0), "small": (64, 48, 10000.0)}
+FORMAT_SETS = CONFIGURATIONS
 
 
-def _params(preset: str, n_clusters: int):
-    from evclust.clusterer import load_params
-    from evclust.vectors.cases import _small_params
-
-    if preset == "small":
-        return _small_params(n_clusters=n_clusters, gamma_mode="count", a_valid=6.0)
-    params, _ = load_params(preset)
-    return params.model_copy(update={"n_clusters": n_clusters})
-
-
-def _random_config(preset: str, n_clusters: int, seed: int, count: int, **extra) -> tuple[str, dict]:
-    from evclust.fixed.formats import build_formats, verilog_header
-
-    width, height, t_frame = FORMAT_SETS[preset]
-    params = _params(preset, n_clusters)
-    t_frame = params.t_frame_us or t_frame
-    header = verilog_header(build_formats(params, width, height, t_frame))
-    config = {"parameters": params.model_dump(mode="json", exclude_none=True), "n_clusters": n_clusters,
-              "width": width, "height": height, "t_frame_us": t_frame, "seed": seed, "count": count,
-              "gap": GAP, "stall": STALL} | extra  # fmt: skip
-    return header, config
+def _random_config(preset, n_clusters, seed, count, **extra):
+    return random_config(preset, n_clusters, seed, count, **({"gap": GAP, "stall": STALL} | extra))
 
 
 @pytest.mark.parametrize("n_clusters", [4, 16])
