@@ -55,6 +55,7 @@ synth: $(SYNTH_STAMP)
 bench: $(STAMP)
 	$(PY) bench/simulator.py --write docs/BENCHMARKS.md
 	$(PY) bench/clusterer.py --write docs/BENCHMARKS.md
+	$(PY) bench/rtl.py --write docs/BENCHMARKS.md
 
 # The RTL parameter header, generated from the formats table (tests fail when it is stale).
 params: $(STAMP)
