@@ -93,7 +93,7 @@ def main() -> int:
     print(text)
     if args.write:
         common.write_section(Path(args.write), text, START, END)
-    json.dump({"cases": cases, "speed": speed}, open(ROOT / "build" / "bench_rtl.json", "w"), indent=1)
+    (ROOT / "build" / "bench_rtl.json").write_text(json.dumps({"cases": cases, "speed": speed}, indent=1))
     return 0
 
 

@@ -274,7 +274,7 @@ def section(rows) -> str:
         "- Logic depth is Yosys `ltp` on the flattened, mapped netlist with registers (FD*, LUTRAM, SRL, DSPs with a "
         "packed register) left out, so a path runs register to register. It counts cells, not nanoseconds: a CARRY4 "
         "carries 4 bits. The longest path is the MCM bias correction's 56/21-bit divider (`floor_div`) in the filter "
-        "sweep; the four dividers take about 60 % of the CARRY4s and half the LUTs (docs/RTL.md: pipelining them).",
+        "sweep; the four dividers hold about 60 % of the CARRY4s and, by an estimate from synthesising each alone, about half the LUTs (docs/RTL.md: pipelining them).",
         "- INV cells are counted apart from the LUTs (Vivado absorbs most into LUTs); the LUTRAM holds the table "
         "fields that only one slot reads at a time.",
         END,

@@ -11,6 +11,7 @@ from evclust.clusterer import ClustererParams, PaletteEntry, parse_params, track
 from evclust.clusterer.run import FloatClusterer
 from evclust.errors import EvclustError
 from evclust.events import EVENT_DTYPE, EventMeta
+from evclust.metrics.convergence import converged_after
 
 from conftest import simulate_toml
 
@@ -52,19 +53,6 @@ def run(text, **overrides):
 def single_track(result):
     ids, counts = np.unique(result.tracks["id"], return_counts=True)
     return result.tracks[result.tracks["id"] == ids[np.argmax(counts)]]
-
-
-def converged_after(t_us, estimate, target, tolerance, window):
-    """First time after which the estimate, averaged over `window` records (one frame), stays
-    within tolerance · |target| of the target; None if it never settles."""
-    kernel = np.ones(window) / window
-    smooth = np.stack([np.convolve(estimate[:, j], kernel, mode="valid") for j in range(2)], 1)
-    t_us = t_us[window - 1 :]
-    bad = np.linalg.norm(smooth - target, axis=1) > tolerance * np.linalg.norm(target)
-    if bad[-1]:
-        return None
-    last_bad = np.flatnonzero(bad)
-    return t_us[0] if last_bad.size == 0 else t_us[last_bad[-1] + 1]
 
 
 @pytest.mark.parametrize("v", [(2.0, 0.0), (0.0, 2.0), (1.5, 1.5)])

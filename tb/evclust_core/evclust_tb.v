@@ -71,11 +71,11 @@ module evclust_tb #(
     wire        offer = running && next_index < count && random[7:0] >= gap_threshold;
 
     always @(posedge clk) begin
-        if (rst) begin
-            running <= 1'b0;
+        if (rst || start) begin  // a reset idles the harness; a start begins a batch
+            running <= !rst;
             done <= 1'b0;
             ev_valid <= 1'b0;
-            random <= 32'd1;
+            random <= (rst || seed == 32'd0) ? 32'd1 : seed;
             accepted <= 32'd0;
             traced <= 32'd0;
             captured <= 32'd0;
@@ -84,17 +84,6 @@ module evclust_tb #(
             filter_cycles <= 32'd0;
             filter_steps <= 32'd0;
             filter_was_active <= 1'b0;
-        end else if (start) begin
-            running <= 1'b1;
-            done <= 1'b0;
-            random <= seed == 32'd0 ? 32'd1 : seed;
-            accepted <= 32'd0;
-            traced <= 32'd0;
-            captured <= 32'd0;
-            overflow <= 1'b0;
-            cycles <= 32'd0;
-            filter_cycles <= 32'd0;
-            filter_steps <= 32'd0;
         end else if (running) begin
             random <= next_random;
             cycles <= cycles + 32'd1;

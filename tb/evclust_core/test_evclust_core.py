@@ -214,15 +214,12 @@ def test_vector_case_replays_bit_exact(sim, case):
     assert result["cases"][case]["records"] == json.loads((VECTORS / case / "manifest.json").read_text())["counts"]["records"]
 
 
-FORMAT_SETS = CONFIGURATIONS
-
-
 def _random_config(preset, n_clusters, seed, count, **extra):
     return random_config(preset, n_clusters, seed, count, **({"gap": GAP, "stall": STALL} | extra))
 
 
 @pytest.mark.parametrize("n_clusters", [4, 16])
-@pytest.mark.parametrize("preset", list(FORMAT_SETS))
+@pytest.mark.parametrize("preset", list(CONFIGURATIONS))
 @pytest.mark.parametrize("sim", SIMS)
 def test_random_streams_match_the_model_in_the_loop(sim, preset, n_clusters):
     # EVCLUST_SEED=n draws other streams than the committed seeds.

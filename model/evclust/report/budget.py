@@ -124,20 +124,22 @@ def noise_sum_ratio(rows: dict, group: str) -> float:
     return parts / total if total > 0 else math.nan
 
 
-def error_vs_frac_bits(events, meta, params: ClustererParams, signal: str, offsets, group_of=None) -> list[tuple[int, float]]:
-    """(fraction bits, RMS error of the signal's output group) as one signal's format narrows or widens."""
+def error_vs_frac_bits(events, meta, params: ClustererParams, signals, offsets) -> dict[str, list[tuple[int, float]]]:
+    """Per signal, (fraction bits, RMS error of the signal's output group) as that signal's
+    format narrows or widens, every other signal exact; one float reference for all."""
     t_frame = params.t_frame_us or meta.t_frame_us
     table = build_formats(params, meta.width, meta.height, t_frame)
     reference = track_events(events, meta, params, model="float").tracks
-    group = (group_of or SIGNAL_GROUP)[signal]
-    curve = []
-    for offset in offsets:
-        frac = table[signal].frac_bits + offset
-        if frac < 0:
-            continue
-        run = emulate(events, meta, params, table, (signal,), {signal: frac})
-        curve.append((frac, record_errors(reference, run.tracks, table)[group].rms))
-    return curve
+    curves = {}
+    for signal in signals:
+        curves[signal] = []
+        for offset in offsets:
+            frac = table[signal].frac_bits + offset
+            if frac < 0:
+                continue
+            run = emulate(events, meta, params, table, (signal,), {signal: frac})
+            curves[signal].append((frac, record_errors(reference, run.tracks, table)[SIGNAL_GROUP[signal]].rms))
+    return curves
 
 
 # The output group each signal feeds most directly.

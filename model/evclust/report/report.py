@@ -226,7 +226,7 @@ def write_report(out: Path, quick: bool = False, progress: bool = True) -> Path:
     bar = tqdm(total=steps, desc="report", unit="run", disable=None if progress else True)
     scenes = {name: _scene(name, quick) for name in SCENES}
     bar.update(1)
-    budget_lines, range_lines, task_lines, word_lines, curves = [], [], [], [], {}
+    budget_lines, range_lines, task_lines, word_lines = [], [], [], []
     for name, (meta, events, params, origin, truth) in scenes.items():
         result = budget(events, meta, params, progress=lambda _s: bar.update(1))
         budget_lines += budget_section(name, result, img)
@@ -241,10 +241,9 @@ def write_report(out: Path, quick: bool = False, progress: bool = True) -> Path:
         task_lines += task_section(name, *_scene(name, quick))
     meta, events, params, _, _ = scenes["traffic"]
     formats = build_formats(params, meta.width, meta.height, params.t_frame_us or meta.t_frame_us)
-    signals = [s for s in SIGNAL_GROUP]
-    for signal in signals:
-        curves[signal] = error_vs_frac_bits(events, meta, params, signal, FRAC_OFFSETS[quick])
-        bar.update(1)
+    signals = list(SIGNAL_GROUP)
+    curves = error_vs_frac_bits(events, meta, params, signals, FRAC_OFFSETS[quick])
+    bar.update(len(signals))
     figures.error_vs_bits(curves, {s: formats[s].frac_bits for s in signals}, img / "error_vs_bits_traffic.png",
                           "traffic: error against fraction bits, one signal quantised at a time")  # fmt: skip
     velocity_lines = velocity_section(img, quick, lambda: bar.update(1))

@@ -12,6 +12,7 @@ import numpy as np
 
 from evclust.clusterer import ClustererParams, load_params, track_events
 from evclust.metrics import DEFAULT_GATE_PX, match_with_counts
+from evclust.metrics.convergence import converged_after
 from evclust.metrics.scores import scores_from_matches
 from evclust.scenes import scene_from_toml
 from evclust.scenes.truth import truth_array
@@ -55,19 +56,6 @@ class VelocityPoint:
     alpha: float
     steady_nrmse: float  # before the turn, once settled, and after the turn, once converged
     convergence_frames: float | None  # after the turn, until within 10 % of the new velocity and staying
-
-
-def converged_after(t_us, estimate, target, tolerance, window):
-    """First time after which the estimate, averaged over `window` records, stays within
-    `tolerance`·|target| of `target`; None if it never does."""
-    kernel = np.ones(window) / window
-    smooth = np.stack([np.convolve(estimate[:, j], kernel, mode="valid") for j in range(2)], 1)
-    t_us = t_us[window - 1 :]
-    bad = np.linalg.norm(smooth - target, axis=1) > tolerance * np.linalg.norm(target)
-    if bad.size == 0 or bad[-1]:
-        return None
-    last_bad = np.flatnonzero(bad)
-    return t_us[0] if last_bad.size == 0 else t_us[last_bad[-1] + 1]
 
 
 def velocity_tradeoff(quick: bool = False, progress=None) -> list[VelocityPoint]:
