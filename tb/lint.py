@@ -9,14 +9,14 @@ import sys
 import tempfile
 from pathlib import Path
 
-from cosim import RTL, _use_simulator
+from cosim import RTL, use_simulator
 
-RTL_SOURCES = ("evclust_core.v", "evclust_decay.v", "evclust_palette.v")
+from evclust.rtl.sources import RTL_SOURCES
 
 
 def lint(header: str | None = None) -> str:
     """Verilator's complaints ('' when clean)."""
-    _use_simulator("verilator")
+    use_simulator("verilator")
     with tempfile.TemporaryDirectory() as tmp:
         src = Path(tmp)
         for name in (*RTL_SOURCES, "evclust_arith.vh", "evclust_lint.vlt", "evclust_params.vh"):

@@ -37,9 +37,9 @@ def test_the_fusesoc_core_file_lints_through_edalize(tmp_path):
     import shutil
     import subprocess
 
-    from cosim import _use_simulator
+    from cosim import use_simulator
 
-    _use_simulator("verilator")
+    use_simulator("verilator")
     fusesoc = shutil.which("fusesoc", path=str(Path(sys.executable).parent)) or "fusesoc"
     root = Path(__file__).resolve().parents[1]
     done = subprocess.run([fusesoc, "--cores-root", str(root), "run", "--target", "lint", "evclust:evclust:core"],

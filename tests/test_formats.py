@@ -68,6 +68,28 @@ def test_shift_only_betas_are_powers_of_two():
         assert c.quantised == 2.0 ** -max(1, round(-math.log2(exact)))
 
 
+@pytest.mark.parametrize("dead_band_bits", [0, 3])
+def test_the_guard_bits_move_every_filtered_signals_fraction_and_nothing_else(dead_band_bits):
+    # A filter's state keeps ceil(log2(1/β)) + dead_band_bits fraction bits (the centre the larger
+    # of its two filters'), so every filtered signal moves by the change; the rest stay put.
+    params, _ = load_params("traffic")
+    default = build_formats(params, 480, 270, 50000.0)
+    narrow = build_formats(params, 480, 270, 50000.0, dead_band_bits=dead_band_bits)
+    filtered = {"centre", "offset", "seek_distance", "centre_step", "half_size", "size_target", "v_mcm", "mcm_norm", "v_int", "colour", "background",
+                "r_init", "r_min", "r_max", "seek_margin", "exit_margin"}  # the last five: constants held in R's and P's formats
+    shift = dead_band_bits - 6
+    for name, fmt in default.formats.items():
+        moved = narrow[name].frac_bits - fmt.frac_bits
+        assert moved == (shift if name in filtered else 0), name
+        assert narrow[name].int_bits == fmt.int_bits, name
+
+
+def test_guard_bits_out_of_range_are_refused():
+    params, _ = load_params("traffic")
+    with pytest.raises(EvclustError, match="dead_band_bits = 17"):
+        build_formats(params, 480, 270, 50000.0, dead_band_bits=17)
+
+
 @pytest.mark.parametrize(
     "update, fragments",
     [

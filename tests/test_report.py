@@ -67,8 +67,17 @@ def test_every_source_is_in_the_budget(traffic_budget):
 def test_the_quick_report_writes_its_markdown_and_figures(tmp_path):
     path = write_report(tmp_path, quick=True, progress=False)
     text = path.read_text()
-    for heading in ("## Fixed-point error budget", "## Error against fraction bits", "## Ranges and saturation", "## Task results: float and fixed"):
+    for heading in ("## Fixed-point error budget", "## Error against fraction bits", "## Ranges and saturation", "## Task results: float and fixed",
+                    "### Float, fixed and RTL", "### Word lengths and N: accuracy against area and cycles", "### Shift-only β against multiplier β"):  # fmt: skip
         assert heading in text
-    for figure in ("budget_traffic.png", "budget_pedestrian.png", "error_vs_bits_traffic.png", "ranges_traffic.png"):
+    for figure in ("budget_traffic.png", "budget_pedestrian.png", "error_vs_bits_traffic.png", "ranges_traffic.png", "runtime_traffic.png"):
         assert (tmp_path / "img" / figure).stat().st_size > 5000
         assert f"img/{figure}" in text
+    # The RTL ran under both simulators, and its cycles per event follow the sweep law: two cycles
+    # an event plus max(N, P) per filter step every 64 events (more only when a full table scans).
+    for sim in ("verilator", "icarus"):
+        assert f"| traffic | RTL, {sim} (stream) |" in text
+    cycles = {row.split(" | ")[0].lstrip("| "): float(row.split(" | ")[2]) for row in text.splitlines() if row.startswith("| N=")}
+    palette = len(load_params("traffic")[0].palette)
+    for label, n in (("N=4", 4), ("N=8", 8), ("N=16 (default)", 16)):
+        assert 2 + max(n, palette) / 64 <= cycles[label] < 2 + max(n, palette) / 64 + 0.05

@@ -137,9 +137,16 @@ def _quantise(value: float, fmt: Format, name: str, param: str) -> int:
     return raw
 
 
-def build_formats(params: ClustererParams, width: int, height: int, t_frame_us: float, beta_shift_only: bool = False) -> FormatTable:
+def build_formats(
+    params: ClustererParams, width: int, height: int, t_frame_us: float, beta_shift_only: bool = False,
+    dead_band_bits: int = DEAD_BAND_BITS,
+) -> FormatTable:  # fmt: skip
     """The formats of a parameter set on a sensor, and its quantised constants. With
-    `beta_shift_only`, each β is rounded to the nearest power of two (a shift, no multiplier)."""
+    `beta_shift_only`, each β is rounded to the nearest power of two (a shift, no multiplier).
+    `dead_band_bits` is the word-length knob: the guard bits every α filter's state keeps beyond
+    1/β, so each filtered signal's fraction moves with it."""
+    if not 0 <= dead_band_bits <= 16:
+        raise EvclustError(f"dead_band_bits = {dead_band_bits}: expected 0..16 guard bits beyond 1/β")
     p = params
     coord = _bits_for(max(width, height) - 1)
     seek_int = _bits_for(p.r_max + p.seek_margin + max(width, height))
@@ -154,7 +161,7 @@ def build_formats(params: ClustererParams, width: int, height: int, t_frame_us: 
 
     def guard(beta_name: str) -> int:
         # x moves by (u - x)·β: with f fractional bits, |u - x| < 2^-f / β never moves it.
-        return max(0, math.ceil(-math.log2(betas[beta_name]))) + DEAD_BAND_BITS
+        return max(0, math.ceil(-math.log2(betas[beta_name]))) + dead_band_bits
 
     # The centre keeps at least R's fraction bits: the seek shifts R up to P's, never down.
     pos_frac = max(guard("beta_pos"), guard("beta_size"))

@@ -156,11 +156,21 @@ TASK_METRICS = (
 )  # fmt: skip
 
 
-def task_scores(run, truth) -> dict:
-    from evclust.metrics import DEFAULT_GATE_PX, match_with_counts
-    from evclust.metrics.scores import scores_from_matches
+def scene_scores(run, truth) -> dict:
+    """Every task metric of a tracking run against the scene's ground truth (metrics' dict form)."""
+    from evclust.metrics.scores import score
 
-    s = scores_from_matches(*match_with_counts(run.tracks, run.meta, truth), run.meta, DEFAULT_GATE_PX, False).to_dict()
+    return score(run.tracks, run.meta, truth).to_dict()
+
+
+def best_velocity_nrmse(scores: dict) -> float | None:
+    """The better of the two velocity methods' NRMSE (None when neither was scored)."""
+    values = [v for v in (scores["mcm"]["nrmse"], scores["interval"]["nrmse"]) if v is not None]
+    return min(values) if values else None
+
+
+def task_scores(run, truth) -> dict:
+    s = scene_scores(run, truth)
     out = {}
     for path in TASK_METRICS:
         value = s

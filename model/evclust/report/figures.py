@@ -102,3 +102,49 @@ def cost_against_accuracy(labels, seconds, accuracy, path: Path, title: str, xla
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
+
+
+def area_against_accuracy(labels, areas: list[dict], errors, path: Path, title: str, error_label: str) -> None:
+    """Left: LUTs and FFs per configuration (DSP count written above); right: LUTs against the
+    task error, one labelled point per configuration."""
+    fig, (bars, scatter) = plt.subplots(1, 2, figsize=(12, 4.6), gridspec_kw={"width_ratios": [1.3, 1]})
+    x = np.arange(len(labels))
+    luts = np.array([a["lut"] + a["inv"] for a in areas])
+    ffs = np.array([a["ff"] for a in areas])
+    bars.bar(x - 0.2, luts, 0.4, label="LUT (+INV)", color="#2b6cb0")
+    bars.bar(x + 0.2, ffs, 0.4, label="FF", color="#dd8452")
+    for xi, lut, a in zip(x, luts, areas):
+        bars.annotate(f"{a['dsp48e1']} DSP", (xi - 0.2, lut), textcoords="offset points", xytext=(0, 3), ha="center", fontsize=7)
+    bars.set_xticks(x, labels, rotation=20, ha="right", fontsize=8)
+    bars.set_ylabel("cells (Yosys synth_xilinx)")
+    bars.legend(fontsize=8)
+    bars.grid(True, axis="y", alpha=0.3)
+    scatter.scatter(luts, errors, color="#2b6cb0")
+    for label, xi, yi in zip(labels, luts, errors):
+        scatter.annotate(label, (xi, yi), textcoords="offset points", xytext=(4, 3), fontsize=7)
+    scatter.set_xlabel("LUT (+INV)")
+    scatter.set_ylabel(error_label)
+    scatter.grid(True, alpha=0.3)
+    fig.suptitle(title)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def runtime_bars(labels, ns_per_event, errors, path: Path, title: str, error_name: str) -> None:
+    """Horizontal bars of runtime per event (log), each labelled with its model's task error:
+    the models' errors are equal or nearly so, their runtimes span decades."""
+    fig, ax = plt.subplots(figsize=(8, 0.5 * len(labels) + 1.4))
+    y = np.arange(len(labels))[::-1]
+    ax.barh(y, ns_per_event, color="#2b6cb0")
+    for yi, ns, err in zip(y, ns_per_event, errors):
+        ax.annotate(f"{ns:,.0f} ns, {error_name} {err}", (ns, yi), textcoords="offset points", xytext=(4, -3), fontsize=7)
+    ax.set_yticks(y, labels, fontsize=8)
+    ax.set_xscale("log")
+    ax.set_xlim(right=max(ns_per_event) * 60)
+    ax.set_xlabel("ns per event (log)")
+    ax.set_title(title)
+    ax.grid(True, axis="x", alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)

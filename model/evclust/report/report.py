@@ -14,10 +14,12 @@ from evclust.clusterer import load_params, track_events
 from evclust.errors import atomic_output
 from evclust.fixed.formats import build_formats
 from evclust.fixed.model import SIGNAL_FORMATS
-from evclust.metrics import DEFAULT_GATE_PX, match_with_counts
-from evclust.metrics.scores import scores_from_matches
 from evclust.report import figures
-from evclust.report.budget import OUTPUTS, SIGNAL_GROUP, SOURCES, budget, error_vs_frac_bits, noise_sum_ratio, wordlength_search
+from evclust.fixed.formats import DEAD_BAND_BITS
+from evclust.report.budget import (
+    OUTPUTS, SIGNAL_GROUP, SOURCES, best_velocity_nrmse, budget, error_vs_frac_bits, noise_sum_ratio, scene_scores, wordlength_search,
+)  # fmt: skip
+from evclust.report.hardware import CONFIGS, evaluate_configs, rtl_runtime, start_synthesis
 from evclust.report.results import PAPER, _num, _pct
 from evclust.report.tradeoffs import TAU_FRAMES, effect_costs, velocity_tradeoff
 from evclust.scenes import load_scene
@@ -28,6 +30,10 @@ SCENES = ("traffic", "pedestrian")
 QUICK_EVENTS = {"traffic": 150_000, "pedestrian": 60_000}  # the first events of each scene in --quick
 TASK_ONLY_SCENES = ("crossing", "slow", "grey_on_grey")  # small built-in scenes: task tables only, whole
 FRAC_OFFSETS = {False: (-8, -6, -4, -2, 0, 2, 4, 8), True: (-4, 0, 4)}
+# RTL co-simulation: events per simulator for the runtime table (None: the whole scene), and the
+# events each hardware configuration runs for its cycle count. Keyed by --quick.
+RTL_EVENTS = {False: {"verilator": None, "icarus": 5_000}, True: {"verilator": 20_000, "icarus": 1_000}}
+CYCLE_EVENTS = {False: 100_000, True: 10_000}
 # Noise powers of separate sources add when the errors are independent; here they are not quite
 # (the activity and the interval velocity feed the same decisions), so the check allows 3 dB.
 NOISE_SUM_TOLERANCE_DB = 3.0
@@ -98,7 +104,7 @@ def ranges_section(name: str, meta, events, params) -> tuple[list[str], list]:
 
 def task_section(name: str, meta, events, params, origin, truth) -> list[str]:
     runs = {model: track_events(events, meta, params, model=model) for model in ("float", "fixed")}
-    scores = {m: scores_from_matches(*match_with_counts(r.tracks, r.meta, truth), r.meta, DEFAULT_GATE_PX, False).to_dict() for m, r in runs.items()}
+    scores = {m: scene_scores(r, truth) for m, r in runs.items()}
     p = PAPER.get(name)
     lines = [
         f"### {name}",
@@ -195,26 +201,127 @@ def effects_section(img: Path, tick) -> list[str]:
     return lines + [""]
 
 
-def runtime_section(scenes: dict) -> list[str]:
+def runtime_section(scenes: dict, rtl: dict, img: Path) -> list[str]:
+    """Float and fixed on every scene; the RTL (bit-exact with fixed) on the first scene's first events."""
     import time
 
-    lines = [
-        "Runtime per event of each model on the same events (one core; the compiled loop warmed up first). The RTL is "
-        "bit-exact with the fixed model on every vector case under Icarus and Verilator (`make test`), so its task "
-        "accuracy is the fixed column's; its co-simulation speed is in [BENCHMARKS.md](../BENCHMARKS.md).",
-        "",
-        "| scene | model | ns per event | velocity NRMSE | chrominance NRMSE | position RMSE (px) |",
-        "|---|---|---:|---:|---:|---:|",
-    ]
+    rows, points = [], []
     for name, (meta, events, params, _origin, truth) in scenes.items():
         for model in ("float", "fixed"):
             track_events(events[:5000], meta, params, model=model)
             start = time.perf_counter()
             run = track_events(events, meta, params, model=model)
             wall = time.perf_counter() - start
-            s = scores_from_matches(*match_with_counts(run.tracks, run.meta, truth), run.meta, DEFAULT_GATE_PX, False).to_dict()
-            best = min(v for v in (s["mcm"]["nrmse"], s["interval"]["nrmse"], 9.9) if v is not None)
-            lines.append(f"| {name} | {model} | {1e9 * wall / events.size:.0f} | {_pct(best)} | {_pct(s['chrominance']['nrmse'])} | {_num(s['position_rmse_px'])} |")
+            s = scene_scores(run, truth)
+            rows.append((name, model, events.size, 1e9 * wall / events.size, s))
+    first = next(iter(scenes))
+    fixed_first = next(r[4] for r in rows if r[0] == first and r[1] == "fixed")
+    for sim, r in rtl.items():
+        rows.append((first, f"RTL, {sim} (stream)", r.events, 1e9 * r.stream_s / r.events, fixed_first))
+        rows.append((first, f"RTL, {sim} (whole run)", r.events, 1e9 * r.total_s / r.events, fixed_first))
+    lines = [
+        "Runtime per event of each model (one core; the compiled loops warmed up first). The RTL runs the first "
+        f"`{first}` events under each simulator with the fixed model beside it, every record and trace word compared "
+        "bit for bit (a mismatch stops the report), so its accuracy is the fixed model's: its rows repeat the fixed "
+        f"model's scores on the whole of `{first}`. `stream` is the time spent loading events, simulating and reading "
+        "records back; `whole run` adds the simulator's start, the model and the comparison. The figures were taken "
+        "while Yosys ran on the other core.",
+        "",
+        f"![runtime per event and accuracy]({img.name}/runtime_{first}.png)",
+        "",
+        "| scene | model | events | ns per event | velocity NRMSE (better method) | chrominance NRMSE | position RMSE (px) |",
+        "|---|---|---:|---:|---:|---:|---:|",
+    ]
+    for name, model, count, ns, s in rows:
+        lines.append(f"| {name} | {model} | {count:,} | {ns:,.0f} | {_pct(best_velocity_nrmse(s))} | {_pct(s['chrominance']['nrmse'])} | {_num(s['position_rmse_px'])} |")
+        if name == first:
+            points.append((model, ns, _pct(best_velocity_nrmse(s))))
+    figures.runtime_bars([p[0] for p in points], [p[1] for p in points], [p[2] for p in points], img / f"runtime_{first}.png",
+                         f"{first}: runtime per event of each model", "velocity NRMSE")  # fmt: skip
+    return lines + [""]
+
+
+def _area_cells(area) -> list[str]:
+    if area is None:
+        return ["not synthesised"] + [""] * 4
+    if isinstance(area, Exception):
+        return [f"failed: {area}"] + [""] * 4
+    d = area["depth_by_type"]
+    cached = " (cached)" if area.get("cached") else ""
+    return [f"{area['lut']:,} (+{area['inv']:,})", f"{area['ff']:,}", str(area["dsp48e1"]),
+            f"{area['depth_cells']} ({d['lut']} LUT + {d['carry4']} CARRY4)", f"{area['wall_s'] / 60:.1f} min{cached}"]  # fmt: skip
+
+
+def hardware_section(results, img: Path, scene_names: list[str], quick: bool) -> list[str]:
+    first = scene_names[0]
+    rtl = results[0].rtl
+    lines = [
+        "Each configuration's task accuracy is the fixed model's on the whole scene; its cycles per event are counted "
+        f"by the RTL harness on the first {rtl.events:,} `{first}` events under Verilator, without input gaps or output "
+        "stalls, with every record compared bit for bit against the fixed model of that configuration; its area is "
+        "Yosys `synth_xilinx -flatten` for Xilinx 7-series (`evclust.rtl.synth`, the flow of `make synth`). The word-length "
+        "knob is the guard bits every α filter's state keeps beyond 1/β (`dead_band_bits`, default "
+        f"{DEAD_BAND_BITS}): each filtered signal's fraction moves with it; `state bits` sums the filtered signals' words.",
+        "",
+    ]
+    synthesised = [r for r in results if isinstance(r.area, dict)]
+    if quick or not synthesised:
+        lines += ["Area: not synthesised in this run (`--quick` skips Yosys; `make report` runs it).", ""]
+    else:
+        figures.area_against_accuracy(
+            [r.config.label for r in synthesised], [r.area for r in synthesised],
+            [100 * (best_velocity_nrmse(r.scores[first]) or 0) for r in synthesised], img / "area.png",
+            f"Area against accuracy ({first})", f"{first}: velocity NRMSE, better method (%)",
+        )  # fmt: skip
+        lines += ["![area against accuracy](img/area.png)", ""]
+    head = ["configuration", "state bits", "cycles/event"]
+    for name in scene_names:
+        head += [f"{name}: velocity NRMSE", f"{name}: position RMSE (px)", f"{name}: chrominance NRMSE"]
+    head += ["LUT (+INV)", "FF", "DSP48E1", "logic depth, cells", "synthesis"]
+    lines += ["| " + " | ".join(head) + " |", "|---|" + "---:|" * (len(head) - 1)]
+    for r in results:
+        cells = [r.config.label, str(r.state_bits), f"{r.rtl.cycles_per_event:.3f}"]
+        for name in scene_names:
+            s = r.scores[name]
+            cells += [_pct(best_velocity_nrmse(s)), _num(s["position_rmse_px"]), _pct(s["chrominance"]["nrmse"])]
+        lines.append("| " + " | ".join(cells + _area_cells(r.area)) + " |")
+    return lines + [""]
+
+
+def shift_section(results, params_by_scene: dict, scene_names: list[str]) -> list[str]:
+    """Shift-only β against the multiplier β at N = 16: the βs, the accuracy and the area."""
+    from evclust.report.hardware import DEFAULT_LABEL, SHIFT_LABEL
+
+    by_label = {r.config.label: r for r in results}
+    mult, shift = by_label[DEFAULT_LABEL], by_label[SHIFT_LABEL]
+    meta, params = params_by_scene[scene_names[0]]
+    tables = {k: r.config.table(params, meta) for k, r in (("mult", mult), ("shift", shift))}
+    lines = [
+        "With every β = 1 - α rounded to the nearest power of two (at least a shift of 1), each α filter's product "
+        "becomes a shift: the RTL is the same, its header's β constants are powers of two, and Yosys turns the products "
+        "into shifts. The filters then smooth a little more or a little less than the tuned α asks for.",
+        "",
+        f"| filter | β, multiplier ({scene_names[0]}) | β, shift-only |",
+        "|---|---:|---:|",
+    ]
+    for name, k in tables["mult"].constants.items():
+        if name.startswith("beta_"):
+            lines.append(f"| {name[5:]} | {k.quantised:.6g} | 2^{round(math.log2(tables['shift'].constants[name].quantised))} |")
+    lines += ["", "| measure | multiplier β | shift-only β |", "|---|---:|---:|"]
+    for name in scene_names:
+        a, b = mult.scores[name], shift.scores[name]
+        for method, label in (("mcm", "MCM"), ("interval", "interval")):
+            lines.append(f"| {name}: {label} velocity NRMSE | {_pct(a[method]['nrmse'])} | {_pct(b[method]['nrmse'])} |")
+        lines += [
+            f"| {name}: position RMSE (px) | {_num(a['position_rmse_px'])} | {_num(b['position_rmse_px'])} |",
+            f"| {name}: chrominance NRMSE | {_pct(a['chrominance']['nrmse'])} | {_pct(b['chrominance']['nrmse'])} |",
+            f"| {name}: palette classification | {_pct(a['class_palette_accuracy'])} | {_pct(b['class_palette_accuracy'])} |",
+        ]
+    if isinstance(mult.area, dict) and isinstance(shift.area, dict):
+        for key, label in (("lut", "LUT"), ("inv", "INV"), ("ff", "FF"), ("dsp48e1", "DSP48E1"), ("carry4", "CARRY4")):
+            lines.append(f"| {label} | {mult.area[key]:,} | {shift.area[key]:,} ({shift.area[key] - mult.area[key]:+,}) |")
+    else:
+        lines.append("| area | not synthesised in this run | |")
     return lines + [""]
 
 
@@ -222,9 +329,13 @@ def write_report(out: Path, quick: bool = False, progress: bool = True) -> Path:
     out = Path(out)
     img = out / "img"
     img.mkdir(parents=True, exist_ok=True)
-    steps = len(SCENES) * (len(SOURCES) + 4 + 45) + len(SIGNAL_GROUP) + 1 + 20 + 10
+    steps = len(SCENES) * (len(SOURCES) + 4 + 45) + len(SIGNAL_GROUP) + 1 + 20 + 10 + len(CONFIGS) + 2
     bar = tqdm(total=steps, desc="report", unit="run", disable=None if progress else True)
     scenes = {name: _scene(name, quick) for name in SCENES}
+    first_meta, first_events, first_params, _, _ = scenes[SCENES[0]]
+    # Yosys takes minutes per configuration: it starts now, beside the model runs.
+    beat = lambda seconds, step: bar.set_postfix_str(f"yosys {seconds / 60:.0f} min")  # noqa: E731
+    synthesis = None if quick else start_synthesis(first_params, first_meta, heartbeat=beat)
     bar.update(1)
     budget_lines, range_lines, task_lines, word_lines = [], [], [], []
     for name, (meta, events, params, origin, truth) in scenes.items():
@@ -248,7 +359,19 @@ def write_report(out: Path, quick: bool = False, progress: bool = True) -> Path:
                           "traffic: error against fraction bits, one signal quantised at a time")  # fmt: skip
     velocity_lines = velocity_section(img, quick, lambda: bar.update(1))
     effect_lines = effects_section(img, lambda: bar.update(1))
-    runtime_lines = runtime_section(scenes)
+    rtl = rtl_runtime(first_meta, first_events, first_params, RTL_EVENTS[quick])
+    bar.update(1)
+    runtime_lines = runtime_section(scenes, rtl, img)
+    if synthesis:
+        synthesis.add_worker()  # the models are done: both cores to Yosys
+    configs = evaluate_configs(scenes, CYCLE_EVENTS[quick], progress=lambda: bar.update(1))
+    if synthesis:
+        areas = synthesis.wait()
+        for r in configs:
+            r.area = areas.get(r.config.slug)
+    bar.update(1)
+    hardware_lines = hardware_section(configs, img, list(scenes), quick)
+    shift_lines = shift_section(configs, {n: (v[0], v[2]) for n, v in scenes.items()}, list(scenes))
     bar.close()
     mode = "--quick (the first events of each scene)" if quick else "full scenes"
     text = [
@@ -299,6 +422,12 @@ def write_report(out: Path, quick: bool = False, progress: bool = True) -> Path:
         "### Float, fixed and RTL",
         "",
         *runtime_lines,
+        "### Word lengths and N: accuracy against area and cycles",
+        "",
+        *hardware_lines,
+        "### Shift-only β against multiplier β",
+        "",
+        *shift_lines,
         "## Task results: float and fixed",
         "",
         "In the layout of the paper's Tables 5 and 7, all visible objects, for every built-in scene. Only `traffic` and "

@@ -11,7 +11,7 @@ import numpy as np
 from evclust.clusterer import load_params, track_events
 from evclust.errors import atomic_output
 from evclust.metrics import DEFAULT_GATE_PX, match_with_counts
-from evclust.metrics.scores import class_correct, scores_from_matches
+from evclust.metrics.scores import class_correct, score, scores_from_matches
 from evclust.render.plots import plot_colour, plot_velocity
 from evclust.scenes import load_scene
 from evclust.scenes.truth import truth_array
@@ -79,7 +79,7 @@ def model_agreement(p: PreparedScene) -> dict:
 
     truth = p.truth
     runs = {"float": p.float_run, "fixed": track_events(p.sim.events, p.sim.meta, p.params, model="fixed")}
-    scores = {m: scores_from_matches(*match_with_counts(r.tracks, r.meta, truth), r.meta, DEFAULT_GATE_PX, False).to_dict() for m, r in runs.items()}
+    scores = {m: score(r.tracks, r.meta, truth).to_dict() for m, r in runs.items()}
     rows = []
     for label, path in AGREEMENT_METRICS:
         a, b = scores["float"], scores["fixed"]

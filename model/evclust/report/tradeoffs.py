@@ -11,9 +11,8 @@ from importlib import resources
 import numpy as np
 
 from evclust.clusterer import ClustererParams, load_params, track_events
-from evclust.metrics import DEFAULT_GATE_PX, match_with_counts
 from evclust.metrics.convergence import converged_after
-from evclust.metrics.scores import scores_from_matches
+from evclust.report.budget import best_velocity_nrmse, scene_scores
 from evclust.scenes import scene_from_toml
 from evclust.scenes.truth import truth_array
 from evclust.simulator import simulate_scene
@@ -117,10 +116,8 @@ def effect_costs(scene: str = "traffic", progress=None) -> list[EffectPoint]:
             walls.append(wall)
             ideal_walls.append(timed(ideal)[0])
         run = track_events(sim.events, sim.meta, params)
-        matches, counts = match_with_counts(run.tracks, run.meta, truth_array(spec.source.truth()))
-        s = scores_from_matches(matches, counts, run.meta, DEFAULT_GATE_PX, False).to_dict()
-        best = [v for v in (s["mcm"]["nrmse"], s["interval"]["nrmse"]) if v is not None]
-        points.append(EffectPoint(effect or "none (ideal sensor)", min(walls), min(walls) / min(ideal_walls), int(sim.events.size), min(best) if best else None,
+        s = scene_scores(run, truth_array(spec.source.truth()))
+        points.append(EffectPoint(effect or "none (ideal sensor)", min(walls), min(walls) / min(ideal_walls), int(sim.events.size), best_velocity_nrmse(s),
                                   s["chrominance"]["nrmse"], s["class_palette_accuracy"]))  # fmt: skip
         if progress:
             progress()

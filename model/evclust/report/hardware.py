@@ -1,0 +1,133 @@
+"""What the hardware costs: the RTL's co-simulation time per event, and for each hardware
+configuration (N, the filters' word lengths, shift-only β) its task accuracy (fixed model),
+its cycles per event (RTL under Verilator, bit-exact with the model on the scene's events) and
+its area (Yosys synth_xilinx)."""
+
+from __future__ import annotations
+
+import dataclasses
+import queue
+import threading
+
+from evclust.clusterer import ClustererParams, track_events
+from evclust.errors import EvclustError
+from evclust.fixed.formats import build_formats, verilog_header
+from evclust.report.budget import SIGNAL_GROUP, scene_scores
+from evclust.rtl.stream import run_stream
+
+
+@dataclasses.dataclass(frozen=True)
+class HardwareConfig:
+    label: str
+    slug: str  # build/synth folder name
+    n_clusters: int
+    formats: dict  # build_formats's options
+
+    def params(self, params: ClustererParams) -> ClustererParams:
+        return params.model_copy(update={"n_clusters": self.n_clusters})
+
+    def table(self, params: ClustererParams, meta):
+        return build_formats(self.params(params), meta.width, meta.height, params.t_frame_us or meta.t_frame_us, **self.formats)
+
+
+DEFAULT_LABEL = "N=16 (default)"
+# N at the default formats; then, at N = 16, the word-length knob (the guard bits every α filter's
+# state keeps beyond 1/β; the default is DEAD_BAND_BITS) and shift-only β.
+CONFIGS = (
+    HardwareConfig("N=4", "n4", 4, {}),
+    HardwareConfig("N=8", "n8", 8, {}),
+    HardwareConfig(DEFAULT_LABEL, "n16", 16, {}),
+    HardwareConfig("N=16, 3 guard bits", "n16-guard3", 16, {"dead_band_bits": 3}),
+    HardwareConfig("N=16, 0 guard bits", "n16-guard0", 16, {"dead_band_bits": 0}),
+    HardwareConfig("N=16, shift-only β", "n16-shift", 16, {"beta_shift_only": True}),
+)
+SHIFT_LABEL = CONFIGS[-1].label
+
+
+def state_bits(table) -> int:
+    """Bits of one slot's filtered signals (each signal's word counted once)."""
+    return sum(table[s].word_bits for s in SIGNAL_GROUP if s in table.formats and table[s].role == "state")
+
+
+class SynthesisQueue:
+    """Yosys runs in background threads while the report's other sections run: one worker at
+    first (the other core runs the models), a second once the models are done."""
+
+    def __init__(self, jobs: list[tuple[str, str]], heartbeat=None):
+        """`jobs`: (label, header) pairs, run in this order."""
+        from evclust.rtl.synth import synthesise, yosys_command
+
+        yosys_command()  # no Yosys: fail now, not after the other sections
+        self._synthesise, self._heartbeat = synthesise, heartbeat
+        self._jobs: queue.Queue = queue.Queue()
+        for job in jobs:
+            self._jobs.put(job)
+        self.results: dict[str, dict | Exception] = {}
+        self._threads: list[threading.Thread] = []
+        self.add_worker()
+
+    def add_worker(self) -> None:
+        thread = threading.Thread(target=self._work, daemon=True)
+        thread.start()
+        self._threads.append(thread)
+
+    def _work(self) -> None:
+        while True:
+            try:
+                label, header = self._jobs.get_nowait()
+            except queue.Empty:
+                return
+            try:
+                self.results[label] = self._synthesise(header, label, heartbeat=self._heartbeat)
+            except EvclustError as exc:
+                self.results[label] = exc
+
+    def wait(self) -> dict[str, dict | Exception]:
+        for thread in self._threads:
+            thread.join()
+        return self.results
+
+
+def start_synthesis(params: ClustererParams, meta, heartbeat=None) -> SynthesisQueue:
+    longest_first = sorted(CONFIGS, key=lambda c: -c.n_clusters)
+    return SynthesisQueue([(c.slug, verilog_header(c.table(params, meta))) for c in longest_first], heartbeat)
+
+
+@dataclasses.dataclass
+class ConfigResult:
+    config: HardwareConfig
+    state_bits: int
+    scores: dict  # scene: every task metric of the fixed model
+    rtl: object | None  # RtlRun on the cycle-count prefix (None when not run)
+    area: dict | Exception | None  # Yosys figures, its failure, or None when not synthesised
+
+
+def evaluate_configs(scenes: dict, rtl_events: int, progress=None) -> list[ConfigResult]:
+    """Each configuration's task accuracy on every scene (fixed model, whole scene) and its
+    cycles per event: the first `rtl_events` of the first scene through the RTL under
+    Verilator, checked bit for bit against the model."""
+    out = []
+    first = next(iter(scenes))
+    for config in CONFIGS:
+        scores = {}
+        for name, (meta, events, params, _origin, truth) in scenes.items():
+            run = track_events(events, meta, config.params(params), model="fixed", **config.formats)
+            scores[name] = scene_scores(run, truth)
+        meta, events, params, _, _ = scenes[first]
+        t_frame = params.t_frame_us or meta.t_frame_us
+        rtl = run_stream("verilator", events[:rtl_events], config.params(params), meta.width, meta.height, t_frame, **config.formats)
+        out.append(ConfigResult(config, state_bits(config.table(params, meta)), scores, rtl, None))
+        if progress:
+            progress()
+    return out
+
+
+def rtl_runtime(meta, events, params, counts: dict[str, int]) -> dict:
+    """{simulator: RtlRun} for the first counts[simulator] events under each simulator; the
+    build happens before, outside the timing, on a short stream."""
+    t_frame = params.t_frame_us or meta.t_frame_us
+    runs = {}
+    for sim, count in counts.items():
+        run_stream(sim, events[:200], params, meta.width, meta.height, t_frame)
+        runs[sim] = run_stream(sim, events[:count], params, meta.width, meta.height, t_frame)
+    return runs

