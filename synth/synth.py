@@ -13,9 +13,9 @@ from pathlib import Path
 
 from evclust.clusterer import load_params
 from evclust.errors import EvclustError
-from evclust.fixed.formats import build_formats, verilog_header
-from evclust.rtl.sources import BUILD, RTL_DIR, RTL_INCLUDES, RTL_SOURCES
-from evclust.rtl.synth import ABC9_KNOBS, rtl_version, synthesise
+from evclust.rtl.sources import BUILD, RTL_DIR
+from evclust.rtl.sources import params_header as rtl_header
+from evclust.rtl.synth import ABC9_KNOBS, rtl_snapshot, synthesise
 
 ROOT = Path(__file__).resolve().parents[1]
 START, END = "<!-- bench:synth:start -->", "<!-- bench:synth:end -->"
@@ -25,8 +25,7 @@ ARTIX7_DSP = {"XC7A35T": 90, "XC7A50T": 120, "XC7A75T": 180, "XC7A100T": 240, "X
 def params_header(n: int) -> str:
     """evclust_params.vh for n clusters, from the formats table (as `evclust formats --verilog`)."""
     params, _ = load_params("traffic")
-    params = params.model_copy(update={"n_clusters": n})
-    text = verilog_header(build_formats(params, 480, 270, params.t_frame_us or 50000.0))
+    text = rtl_header(params.model_copy(update={"n_clusters": n}), 480, 270, params.t_frame_us or 50000.0)
     reference = (RTL_DIR / "evclust_params.vh").read_text()
     if f"N_CLUSTERS = {n};" in reference and text != reference:  # the RTL's own N: must match
         print(f"synth: warning: the generated header for N={n} differs from rtl/evclust_params.vh "
@@ -84,15 +83,14 @@ def main():
     parser.add_argument("--write", type=Path, metavar="BENCHMARKS.md", help="rewrite this file's synthesis section")
     args = parser.parse_args()
     # One snapshot of the RTL for every N: others may be editing rtl/ meanwhile.
-    sources = {name: (RTL_DIR / name).read_text() for name in RTL_SOURCES + RTL_INCLUDES}
-    rtl = rtl_version()
+    snapshot = rtl_snapshot()
     rows = []
     try:
         for n in args.n:
             print(f"synth: N={n} ...", file=sys.stderr)
             beat = lambda s, step, n=n: print(f"  N={n}: {s:5.0f} s, {step}", file=sys.stderr)  # noqa: E731
-            figures = synthesise(params_header(n), f"n{n}{'-hier' if args.hier else ''}", args.hier, beat, sources)
-            rows.append(figures | {"n_clusters": n, "rtl": figures.get("rtl") or rtl})
+            figures = synthesise(params_header(n), f"n{n}{'-hier' if args.hier else ''}", args.hier, beat, snapshot)
+            rows.append(figures | {"n_clusters": n})
             print(f"synth: N={n} done in {figures['wall_s'] / 60:.1f} min{' (cached)' if figures['cached'] else ''}", file=sys.stderr)
     except EvclustError as e:
         sys.exit(f"synth: {e}")

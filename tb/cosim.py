@@ -8,6 +8,7 @@ import os
 
 from evclust.rtl.cosim import SIMULATORS, build, run, use_simulator  # noqa: F401  (the testbench's API)
 from evclust.rtl.sources import RTL_DIR as RTL  # noqa: F401
+from evclust.rtl.sources import params_header
 
 
 def selected_simulators() -> tuple[str, ...]:
@@ -42,13 +43,11 @@ def configuration_params(name: str, n_clusters: int):
 
 def random_config(name: str, n_clusters: int, seed: int, count: int, formats: dict | None = None, **extra) -> tuple[str, dict]:
     """(header, testbench configuration) of a model-in-the-loop run; `formats` are build_formats's options."""
-    from evclust.fixed.formats import build_formats, verilog_header
-
     formats = formats or {}
     width, height, t_frame = CONFIGURATIONS[name]
     params = configuration_params(name, n_clusters)
     t_frame = params.t_frame_us or t_frame
-    header = verilog_header(build_formats(params, width, height, t_frame, **formats))
+    header = params_header(params, width, height, t_frame, **formats)
     config = {"parameters": params.model_dump(mode="json", exclude_none=True), "n_clusters": n_clusters,
               "width": width, "height": height, "t_frame_us": t_frame, "seed": seed, "count": count,
               "gap": 0, "stall": 0, "formats": formats} | extra  # fmt: skip

@@ -16,6 +16,7 @@ from evclust.cli.formats import reference_table
 from evclust.clusterer import ClustererParams, load_params
 from evclust.errors import EvclustError
 from evclust.fixed import build_formats, verilog_header
+from evclust.fixed.formats import DEAD_BAND_BITS
 
 from test_cli import assert_one_line_error, run_cli
 
@@ -77,17 +78,18 @@ def test_the_guard_bits_move_every_filtered_signals_fraction_and_nothing_else(de
     narrow = build_formats(params, 480, 270, 50000.0, dead_band_bits=dead_band_bits)
     filtered = {"centre", "offset", "seek_distance", "centre_step", "half_size", "size_target", "v_mcm", "mcm_norm", "v_int", "colour", "background",
                 "r_init", "r_min", "r_max", "seek_margin", "exit_margin"}  # the last five: constants held in R's and P's formats
-    shift = dead_band_bits - 6
+    shift = dead_band_bits - DEAD_BAND_BITS
     for name, fmt in default.formats.items():
         moved = narrow[name].frac_bits - fmt.frac_bits
         assert moved == (shift if name in filtered else 0), name
         assert narrow[name].int_bits == fmt.int_bits, name
 
 
-def test_guard_bits_out_of_range_are_refused():
+@pytest.mark.parametrize("dead_band_bits", [-1, 17])
+def test_guard_bits_out_of_range_are_refused(dead_band_bits):
     params, _ = load_params("traffic")
-    with pytest.raises(EvclustError, match="dead_band_bits = 17"):
-        build_formats(params, 480, 270, 50000.0, dead_band_bits=17)
+    with pytest.raises(EvclustError, match=f"dead_band_bits = {dead_band_bits}: expected 0..16"):
+        build_formats(params, 480, 270, 50000.0, dead_band_bits=dead_band_bits)
 
 
 @pytest.mark.parametrize(

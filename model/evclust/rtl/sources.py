@@ -19,3 +19,10 @@ def require_repository() -> None:
     missing = [p for p in (RTL_DIR / RTL_SOURCES[0], TB_DIR / "evclust_tb.v") if not p.exists()]
     if missing:
         raise EvclustError(f"{missing[0]}: the RTL is not here; run from a clone of the evclust repository (pip install -e .)")
+
+
+def params_header(params, width: int, height: int, t_frame_us: float, **formats) -> str:
+    """evclust_params.vh for a parameter set on a sensor (`formats`: build_formats's options)."""
+    from evclust.fixed.formats import build_formats, verilog_header
+
+    return verilog_header(build_formats(params, width, height, t_frame_us, **formats))

