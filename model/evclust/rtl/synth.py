@@ -178,6 +178,15 @@ def _figures(out: Path, wall: float, hier: bool) -> dict:
     }
 
 
+def cache_key(header: str, sources: dict[str, str], hier: bool, identity: str) -> str:
+    """Everything that decides the figures: the header, the named sources, the script, the
+    figures' reading (FLOW_VERSION) and the Yosys build."""
+    digest = hashlib.sha256(f"{FLOW_VERSION}\n{identity}\n{script(Path('SRC'), Path('OUT'), hier)}\n{header}".encode())
+    for name in sorted(sources):
+        digest.update(f"\n{name}\n{sources[name]}".encode())
+    return digest.hexdigest()[:12]
+
+
 def rtl_snapshot() -> tuple[dict[str, str], str | None]:
     """(file name: text, version) of rtl/ now: one snapshot for several runs, while others may
     edit rtl/."""
@@ -192,12 +201,7 @@ def synthesise(header: str, label: str, hier: bool = False, heartbeat=None, snap
     require_repository()
     sources, version = snapshot or rtl_snapshot()
     yosys, identity = yosys_command()
-    # The key: everything that decides the figures (the header, the sources, the script, the
-    # figures' reading and the Yosys build); the output folder is only named by its hash.
-    digest = hashlib.sha256(f"{FLOW_VERSION}\n{identity}\n{script(Path('SRC'), Path('OUT'), hier)}\n{header}".encode())
-    for name in sorted(sources):
-        digest.update(f"\n{name}\n{sources[name]}".encode())
-    out = BUILD / "synth" / f"{label}-{digest.hexdigest()[:12]}"
+    out = BUILD / "synth" / f"{label}-{cache_key(header, sources, hier, identity)}"
     done = out / "figures.json"
     if done.exists():
         return json.loads(done.read_text()) | {"cached": True}
