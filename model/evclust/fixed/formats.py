@@ -285,11 +285,8 @@ def precision_table(table: FormatTable, signals=None, frac_bits: dict[str, int] 
     for row, name in enumerate(PRECISION_SIGNALS):
         if name not in signals:
             continue
-        fmt = table.formats[name]
-        frac = frac_bits.get(name, fmt.frac_bits)
-        out[row, P_FRAC] = frac
-        out[row, P_LO] = -(2.0**fmt.int_bits) if fmt.signed else 0.0
-        out[row, P_HI] = 2.0**fmt.int_bits - 2.0**-frac
+        fmt = dataclasses.replace(table.formats[name], frac_bits=frac_bits.get(name, table.formats[name].frac_bits))
+        out[row, P_FRAC], out[row, P_LO], out[row, P_HI] = fmt.frac_bits, fmt.min, fmt.max
         out[row, P_NEAREST] = fmt.rounding == "nearest"
     return out
 

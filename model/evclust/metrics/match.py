@@ -108,7 +108,7 @@ def nearest_palette_class(ycbcr: np.ndarray, meta: TrackMeta) -> np.ndarray:
     return out
 
 
-def _assign(cost: np.ndarray, gate: float) -> tuple[np.ndarray, np.ndarray]:
+def gated_assignment(cost: np.ndarray, gate: float) -> tuple[np.ndarray, np.ndarray]:
     """Hungarian assignment with pairs beyond the gate forbidden.
 
     Out-of-gate pairs get a cost larger than any sum of in-gate costs, so the solver first
@@ -189,7 +189,7 @@ def match_with_counts(
                 centre[j, 1] += frac * (truth["cy"][nxt] - centre[j, 1])
         est = np.stack([tracks["x"][records], tracks["y"][records]], axis=1).astype(np.float64)
         cost = np.hypot(est[:, None, 0] - centre[None, :, 0], est[:, None, 1] - centre[None, :, 1])
-        r, c = _assign(cost, gate)
+        r, c = gated_assignment(cost, gate)
         if fully_visible_only:
             visible = truth["fully_visible"][objs[c]]
             n_excluded += int((~visible).sum())

@@ -89,16 +89,17 @@ def record_errors(reference: np.ndarray, tracks: np.ndarray, table: FormatTable)
 
 
 def paired_records(reference: np.ndarray, tracks: np.ndarray) -> list[tuple]:
-    """(reference record, record) pairs: per filter step, Hungarian on the centre distance."""
-    from scipy.optimize import linear_sum_assignment
+    """(reference record, record) pairs: per filter step, Hungarian on the centre distance
+    within PAIR_GATE_PX (the metrics' gated assignment)."""
+    from evclust.metrics.match import gated_assignment
 
     pairs = []
     ref_steps, steps = reference["step"], tracks["step"]
     for step in np.intersect1d(ref_steps, steps):
         a, b = reference[ref_steps == step], tracks[steps == step]
         cost = np.hypot(a["x"][:, None] - b["x"][None], a["y"][:, None] - b["y"][None])
-        rows, cols = linear_sum_assignment(cost)
-        pairs += [(a[i], b[j]) for i, j in zip(rows, cols) if cost[i, j] <= PAIR_GATE_PX]
+        rows, cols = gated_assignment(cost, PAIR_GATE_PX)
+        pairs += [(a[i], b[j]) for i, j in zip(rows, cols)]
     return pairs
 
 

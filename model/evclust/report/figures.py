@@ -11,6 +11,12 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 
+def _save(fig, path: Path) -> None:
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
 def noise_shares(rows: dict, sources, groups, path: Path, title: str) -> None:
     """Stacked bars: each source's share of the summed noise power, per output group."""
     fig, ax = plt.subplots(figsize=(8, 4.2))
@@ -25,9 +31,7 @@ def noise_shares(rows: dict, sources, groups, path: Path, title: str) -> None:
     ax.set_ylabel("share of the summed noise power")
     ax.set_title(title)
     ax.legend(bbox_to_anchor=(1.01, 1), loc="upper left", fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    _save(fig, path)
 
 
 def error_vs_bits(curves: dict, defaults: dict, path: Path, title: str) -> None:
@@ -46,9 +50,7 @@ def error_vs_bits(curves: dict, defaults: dict, path: Path, title: str) -> None:
     ax.set_title(title)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8, ncol=2)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    _save(fig, path)
 
 
 def ranges(rows: list[tuple[str, float, float, float, float]], path: Path, title: str) -> None:
@@ -61,9 +63,7 @@ def ranges(rows: list[tuple[str, float, float, float, float]], path: Path, title
     ax.set_xscale("symlog", linthresh=1e-2)
     ax.set_xlabel("value (light: the format's range; dark: the range the scene reached)")
     ax.set_title(title)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    _save(fig, path)
 
 
 def velocity_tradeoff(points, path: Path, title: str) -> None:
@@ -84,24 +84,25 @@ def velocity_tradeoff(points, path: Path, title: str) -> None:
     ax.grid(True, which="both", alpha=0.3)
     ax.set_title(title)
     ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    _save(fig, path)
+
+
+def _labelled_scatter(ax, labels, x, y, xlabel: str, ylabel: str) -> None:
+    """One labelled point per option."""
+    ax.scatter(x, y, color="#2b6cb0")
+    for label, xi, yi in zip(labels, x, y):
+        ax.annotate(label, (xi, yi), textcoords="offset points", xytext=(4, 3), fontsize=7)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.grid(True, alpha=0.3)
 
 
 def cost_against_accuracy(labels, seconds, accuracy, path: Path, title: str, xlabel: str, ylabel: str) -> None:
     """One point per option: its cost against its task error."""
     fig, ax = plt.subplots(figsize=(7.5, 4.5))
-    ax.scatter(seconds, accuracy, color="#2b6cb0")
-    for label, x, y in zip(labels, seconds, accuracy):
-        ax.annotate(label, (x, y), textcoords="offset points", xytext=(4, 3), fontsize=7)
-    ax.set_xlabel(xlabel)
-    ax.set_ylabel(ylabel)
-    ax.grid(True, alpha=0.3)
+    _labelled_scatter(ax, labels, seconds, accuracy, xlabel, ylabel)
     ax.set_title(title)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    _save(fig, path)
 
 
 def area_against_accuracy(labels, areas: list[dict], errors, path: Path, title: str, error_label: str) -> None:
@@ -119,16 +120,9 @@ def area_against_accuracy(labels, areas: list[dict], errors, path: Path, title: 
     bars.set_ylabel("cells (Yosys synth_xilinx)")
     bars.legend(fontsize=8)
     bars.grid(True, axis="y", alpha=0.3)
-    scatter.scatter(luts, errors, color="#2b6cb0")
-    for label, xi, yi in zip(labels, luts, errors):
-        scatter.annotate(label, (xi, yi), textcoords="offset points", xytext=(4, 3), fontsize=7)
-    scatter.set_xlabel("LUT (+INV)")
-    scatter.set_ylabel(error_label)
-    scatter.grid(True, alpha=0.3)
+    _labelled_scatter(scatter, labels, luts, errors, "LUT (+INV)", error_label)
     fig.suptitle(title)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    _save(fig, path)
 
 
 def runtime_bars(labels, ns_per_event, errors, path: Path, title: str, error_name: str) -> None:
@@ -145,6 +139,4 @@ def runtime_bars(labels, ns_per_event, errors, path: Path, title: str, error_nam
     ax.set_xlabel("ns per event (log)")
     ax.set_title(title)
     ax.grid(True, axis="x", alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    _save(fig, path)

@@ -57,7 +57,7 @@ def filtered_slot_bits(table) -> int:
 class SynthesisQueue:
     """Yosys runs in background threads while the report's other sections run: one worker at
     first (the other core runs the models), a second once nothing else is left to run. A report
-    that dies takes its Yosys processes with it."""
+    that ends in an error or Ctrl-C stops its Yosys processes."""
 
     def __init__(self, jobs: list[tuple[str, str]], heartbeat=None):
         """`jobs`: (label, header) pairs, run in this order."""
