@@ -13,7 +13,7 @@ import numba
 import numpy as np
 
 from evclust.clusterer.layout import (
-    ACT, BG_CB, BG_CR, BG_Y, CCB, CCR, CREATED, CY, DROPPED, EV_COUNT, EVENTS, EVER_REPORTED, EVICTED, EXITED,
+    ACT, BG_ACT, BG_CB, BG_CR, BG_T, BG_Y, CCB, CCR, MERGED, CREATED, CY, DROPPED, EV_COUNT, EVENTS, EVER_REPORTED, EVICTED, EXITED,
     EXPIRED, T_FIRST, FLAG_BORDER, FLAG_MOVING_INT, FLAG_MOVING_MCM, FLAG_NEW, GAMMA, ID, MCM_NORM, NEXT_ID, NOISE, PPX, PPY, PX,
     PY, RECORD_COLUMNS, REPORTED, RX, RY, SINCE_FILTER, STEP, T_FILTER, T_LAST, VALID, VI_COUNT, VIX, VIY, VMX,
     VMY,
@@ -25,8 +25,9 @@ from evclust.clusterer.layout import (
     B_VM, K_GAMMA, K_GAMMA_MODE, B_VI, K_TAU, K_T_FRAME, B_LUM, B_CHRO, B_BG, K_P, K_BG_FIXED,
     K_LUMA_W, K_H_MAX, K_V_MIN, K_EXIT_M, K_V_EXIT, K_COS_EXIT, K_WIDTH, K_HEIGHT, K_COLOUR,
     K_WARM_START, K_MCM_CORRECT, K_VOTE_CONTRAST, K_ASSIGN_MIXING, K_MIX_TOL,
-) = range(36)  # fmt: skip
-N_PARAMS = 36
+    K_SEEK_SCALE, K_MERGE, K_MERGE_SCALE, K_MERGE_V_TOL, K_MERGE_V_REL, K_NOISE_GATE,
+) = range(42)  # fmt: skip
+N_PARAMS = 42
 LN2 = math.log(2.0)
 
 # Quantisation points: the stores of the signals the formats table gives a format to. With a
@@ -55,6 +56,8 @@ def param_vector(p, width: int, height: int, t_frame_us: float, has_colour: bool
     v[K_WARM_START], v[K_MCM_CORRECT] = p.velocity_warm_start, p.mcm_bias_correction
     v[K_VOTE_CONTRAST] = p.palette_vote == "contrast"
     v[K_ASSIGN_MIXING], v[K_MIX_TOL] = p.palette_assign == "mixing", p.mixing_tolerance
+    v[K_SEEK_SCALE], v[K_MERGE], v[K_MERGE_V_TOL], v[K_MERGE_V_REL] = p.seek_scale, p.merge, p.merge_v_tol, p.merge_v_rel
+    v[K_NOISE_GATE], v[K_MERGE_SCALE] = p.noise_gate, p.merge_scale
     return v
 
 
@@ -122,16 +125,24 @@ def _mixing_palette(y, cb, cr, bg_y, bg_cb, bg_cr, palette, background_mask, lum
     return best if best >= 0 else _nearest_palette(y, cb, cr, palette, luma_w)
 
 
+@numba.njit(cache=True, nogil=True, inline="always")
+def _margin(S, s, k):
+    """The seek margin of a cluster: S, grown by seek_scale·max(Rx, Ry) (beyond the paper)."""
+    return k[K_SEEK] + k[K_SEEK_SCALE] * max(S[s, RX], S[s, RY])
+
+
 @numba.njit(cache=True, nogil=True)
-def _seek(S, x, y, seek):
-    """Step 1: the valid cluster whose box grown by S holds the event, nearest in L1; ties: lower slot."""
+def _seek(S, x, y, k):
+    """Step 1: the valid cluster whose box grown by its margin holds the event, nearest in L1;
+    ties: lower slot."""
     best, best_d = -1, np.inf
     for s in range(S.shape[0]):
         if S[s, VALID] == 0.0:
             continue
         dx = abs(x - S[s, PX])
         dy = abs(y - S[s, PY])
-        if dx <= S[s, RX] + seek and dy <= S[s, RY] + seek:
+        m = _margin(S, s, k)
+        if dx <= S[s, RX] + m and dy <= S[s, RY] + m:
             d = dx + dy
             if d < best_d:
                 best, best_d = s, d
@@ -250,6 +261,51 @@ def _exiting(S, s, k):
 
 
 @numba.njit(cache=True, nogil=True)
+def _mergeable(S, s, j, k):
+    """Two clusters are one object's when their boxes, each grown by merge_scale times its
+    larger half-size, overlap and, once both have measured an interval velocity, their
+    velocities agree."""
+    grow = k[K_MERGE_SCALE] * (max(S[s, RX], S[s, RY]) + max(S[j, RX], S[j, RY]))
+    if abs(S[s, PX] - S[j, PX]) > S[s, RX] + S[j, RX] + grow:
+        return False
+    if abs(S[s, PY] - S[j, PY]) > S[s, RY] + S[j, RY] + grow:
+        return False
+    if S[s, VI_COUNT] < 2.0 or S[j, VI_COUNT] < 2.0:
+        return True
+    dv = abs(S[s, VIX] - S[j, VIX]) + abs(S[s, VIY] - S[j, VIY])
+    fast = max(abs(S[s, VIX]) + abs(S[s, VIY]), abs(S[j, VIX]) + abs(S[j, VIY]))
+    return dv <= k[K_MERGE_V_TOL] + k[K_MERGE_V_REL] * fast
+
+
+@numba.njit(cache=True, nogil=True)
+def _merge(S, H, G, s, j, k, precision):
+    """Slot s absorbs slot j: the centre is the activity-weighted mean (where the two clusters'
+    events average), the box covers both boxes, activities and event counts add; identity,
+    velocities, colour and histogram are the survivor's (the one reported before, else the more
+    active). The previous centre moves with the centre: the jump is not motion."""
+    survivor = j if (S[j, EVER_REPORTED] > S[s, EVER_REPORTED]) or (S[j, EVER_REPORTED] == S[s, EVER_REPORTED] and S[j, ACT] > S[s, ACT]) else s
+    a_s, a_j = S[s, ACT], S[j, ACT]
+    px = _q((a_s * S[s, PX] + a_j * S[j, PX]) / (a_s + a_j), Q_CENTRE, precision)
+    py = _q((a_s * S[s, PY] + a_j * S[j, PY]) / (a_s + a_j), Q_CENTRE, precision)
+    lo_x, hi_x = min(S[s, PX] - S[s, RX], S[j, PX] - S[j, RX]), max(S[s, PX] + S[s, RX], S[j, PX] + S[j, RX])
+    lo_y, hi_y = min(S[s, PY] - S[s, RY], S[j, PY] - S[j, RY]), max(S[s, PY] + S[s, RY], S[j, PY] + S[j, RY])
+    ppx, ppy = S[survivor, PPX] + (px - S[survivor, PX]), S[survivor, PPY] + (py - S[survivor, PY])
+    act = _q(a_s + a_j, Q_ACT, precision)
+    count = S[s, EV_COUNT] + S[j, EV_COUNT]
+    if survivor == j:
+        t_last = S[s, T_LAST]
+        S[s, :] = S[j, :]
+        H[s, :] = H[j, :]
+        S[s, T_LAST] = t_last
+    S[s, PX], S[s, PY], S[s, PPX], S[s, PPY] = px, py, ppx, ppy
+    S[s, RX] = min(_q((hi_x - lo_x) / 2, Q_HALF, precision), k[K_R_MAX])
+    S[s, RY] = min(_q((hi_y - lo_y) / 2, Q_HALF, precision), k[K_R_MAX])
+    S[s, ACT], S[s, EV_COUNT] = act, count
+    S[j, VALID] = 0.0
+    G[MERGED] += 1
+
+
+@numba.njit(cache=True, nogil=True)
 def _filter_step(S, H, G, t, k, palette, background_mask, out, n_out, precision):
     """Every N_f events: decay, free, interval velocity, noise and exit decisions, records."""
     # τ boundaries crossed since the last step: usually 0 or 1, more when events are sparse.
@@ -257,6 +313,8 @@ def _filter_step(S, H, G, t, k, palette, background_mask, out, n_out, precision)
     interval_due = boundaries > 0
     per_frame = k[K_T_FRAME] / (max(boundaries, 1) * k[K_TAU])  # T_frame over the time measured
     v_min = k[K_V_MIN]
+    G[BG_ACT] = _q(_decayed(G[BG_ACT], t - G[BG_T], k[K_T_HALF], precision), Q_ACT, precision)
+    G[BG_T] = t
     for s in range(S.shape[0]):
         if S[s, VALID] == 0.0:
             continue
@@ -266,6 +324,11 @@ def _filter_step(S, H, G, t, k, palette, background_mask, out, n_out, precision)
             S[s, VALID] = 0.0
             G[EXPIRED] += 1
             continue
+        if k[K_MERGE] != 0.0:
+            for j in range(s + 1, S.shape[0]):
+                if S[j, VALID] != 0.0 and _mergeable(S, s, j, k):
+                    _merge(S, H, G, s, j, k, precision)
+                    break
         if k[K_GAMMA_MODE] != GAMMA_COUNT or S[s, VI_COUNT] == 0.0:
             S[s, GAMMA] = _q(_gamma(S[s, ACT], k), Q_GAMMA, precision)
         if interval_due:
@@ -292,6 +355,11 @@ def _filter_step(S, H, G, t, k, palette, background_mask, out, n_out, precision)
         vmx, vmy = _mcm_velocity(S, s, k)
         moving_int = math.hypot(S[s, VIX], S[s, VIY]) >= v_min
         reported = S[s, ACT] >= k[K_A_VALID] and (moving_mcm or moving_int)
+        if reported and k[K_NOISE_GATE] > 0.0:
+            # Beyond the paper: the background's events spread over the sensor would give the
+            # box A_bg·(box area / sensor area); an object's cluster holds noise_gate times more.
+            box = 4.0 * max(S[s, RX], 0.5) * max(S[s, RY], 0.5)
+            reported = S[s, ACT] * k[K_WIDTH] * k[K_HEIGHT] >= k[K_NOISE_GATE] * G[BG_ACT] * box
         if S[s, ACT] >= k[K_A_VALID] and not reported:
             G[NOISE] += 1
         S[s, REPORTED] = 1.0 if reported else 0.0
@@ -344,7 +412,7 @@ def run_events(S, H, G, k, palette, background_mask, t_us, xs, ys, lums, cbs, cr
             G[T_FILTER] = t  # the filter-step clock and the τ boundaries start at the first event
             G[T_FIRST] = t
         G[EVENTS] += 1
-        s = _seek(S, x, y, k[K_SEEK])
+        s = _seek(S, x, y, k)
         updated_reported = False
         if s < 0:
             s = _slot_for_new(S, G, t, k, precision)
@@ -356,6 +424,9 @@ def run_events(S, H, G, k, palette, background_mask, t_us, xs, ys, lums, cbs, cr
             _update(S, H, G, s, t, x, y, lum, cb, cr, k, palette, background_mask, precision)
             updated_reported = S[s, REPORTED] != 0.0
         # Step 4: events that do not update a reported cluster track the background colour.
+        if not updated_reported:  # the activity of the events no reported cluster takes
+            G[BG_ACT] = _q(_decayed(G[BG_ACT], t - G[BG_T], k[K_T_HALF], precision), Q_ACT, precision) + 1.0
+            G[BG_T] = t
         if k[K_COLOUR] != 0.0 and k[K_BG_FIXED] == 0.0 and not updated_reported:
             G[BG_Y] = _q(G[BG_Y] + k[B_BG] * (lum - G[BG_Y]), Q_BG, precision)
             G[BG_CB] = _q(G[BG_CB] + k[B_BG] * (cb - G[BG_CB]), Q_BG, precision)

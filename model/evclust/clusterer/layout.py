@@ -22,11 +22,13 @@ SLOT_COLUMNS = (
 # Global columns.
 (
     NEXT_ID, BG_Y, BG_CB, BG_CR, SINCE_FILTER, STEP, T_FILTER, EVENTS, CREATED, EVICTED, DROPPED, EXPIRED,
-    EXITED, NOISE, T_FIRST,
-) = range(15)  # fmt: skip
+    EXITED, NOISE, T_FIRST, BG_ACT, BG_T, BG_RESIDUAL, MERGED,
+) = range(19)  # fmt: skip
 GLOBAL_COLUMNS = (
     "next_id", "bg_Y", "bg_Cb", "bg_Cr", "since_filter", "step", "t_filter", "events",
     "created", "evicted", "dropped", "expired", "exited", "noise", "t_first",  # τ boundaries count from t_first
+    "bg_activity", "bg_t_last", "bg_decay_residual",  # the activity of the events no reported cluster takes
+    "merged",
 )  # fmt: skip
 
 # Track-record columns as the models write them (the order of evclust.tracks.TRACK_DTYPE).
@@ -41,4 +43,5 @@ def run_stats(g) -> dict:
     return {
         "events": int(g[EVENTS]), "steps": int(g[STEP]), "created": int(g[CREATED]), "evicted": int(g[EVICTED]),
         "dropped": int(g[DROPPED]), "expired": int(g[EXPIRED]), "exited": int(g[EXITED]), "noise_decisions": int(g[NOISE]),
+        "merged": int(g[MERGED]),
     }  # fmt: skip

@@ -56,6 +56,7 @@ class ClustererParams(BaseModel):
     alpha_size: Alpha = 0.99  # half-size
     # Activity: an event count decaying with half-life T_half.
     t_half_us: Positive = 20000.0
+    t_half_frames: Positive | None = None  # set: T_half in frame periods of the event file, overriding t_half_us
     a_min: NonNegative = 1.0  # below: the slot is freed at a filter step
     a_valid: NonNegative = 20.0  # at or above (and not noise): the cluster is reported
     filter_every: Annotated[int, Field(ge=1, le=1 << 20)] = 64  # N_f events between filter steps
@@ -68,6 +69,7 @@ class ClustererParams(BaseModel):
     gamma_mode: Literal["global", "activity", "count"] = "count"
     alpha_vel_int: Alpha = 0.7
     tau_us: Positive = 100000.0
+    tau_frames: Positive | None = None  # set: τ in frame periods (rounded to whole µs), overriding tau_us
     # Beyond the paper: both filters otherwise start at V = 0 and need ~1/β samples to forget it,
     # often longer than an object stays in view.
     velocity_warm_start: bool = True  # interval: skip the partial first τ, seed V_RI with the first full one
@@ -91,6 +93,13 @@ class ClustererParams(BaseModel):
     # those whose background-to-entry segment passes within mixing_tolerance of it.
     palette_assign: Literal["nearest", "mixing"] = "mixing"
     mixing_tolerance: NonNegative = 12.0  # L1 (luma weighted) distance to a mixing segment
+    # Beyond the paper: one cluster per object (docs/TUNING.md, "One cluster per object").
+    seek_scale: NonNegative = 0.0  # the seek margin grows by seek_scale·max(Rx, Ry): a large object's far edge is in reach
+    merge: bool = False  # filter step: merge two clusters whose grown boxes overlap and whose velocities agree
+    merge_scale: NonNegative = 1.0  # for merging, each box grows by merge_scale·max(Rx, Ry)
+    merge_v_tol: NonNegative = 0.5  # px/frame: the L1 velocity difference two merging clusters may have,
+    merge_v_rel: NonNegative = 0.25  # plus this fraction of the faster one's L1 speed
+    noise_gate: NonNegative = 0.0  # report a cluster only if its activity is noise_gate times what the background's events give its box
     # Decisions from velocity (§6.3).
     v_min: NonNegative = 0.3  # px/frame: a cluster whose MCM and interval speeds are both below is noise
     exit_margin: NonNegative = 10.0  # M, px: the border band where exit prediction acts
@@ -112,6 +121,16 @@ class ClustererParams(BaseModel):
         if len(self.palette_background) == len(names):
             raise ValueError("every palette entry is background: no class is left")
         return self
+
+    def resolved(self, t_frame_us: float) -> "ClustererParams":
+        """The parameters in µs on a stream of frame period `t_frame_us`: times given in frames
+        become µs (τ in whole µs, as the hardware counts it)."""
+        update = {}
+        if self.t_half_frames is not None:
+            update |= {"t_half_us": self.t_half_frames * t_frame_us, "t_half_frames": None}
+        if self.tau_frames is not None:
+            update |= {"tau_us": float(max(1, round(self.tau_frames * t_frame_us))), "tau_frames": None}
+        return self.model_copy(update=update) if update else self
 
     @property
     def palette_names(self) -> tuple[str, ...]:

@@ -45,7 +45,7 @@ class FloatClusterer:
                  precision: np.ndarray | None = None):  # fmt: skip
         """`precision` (evclust.fixed.formats.precision_table) rounds each quantisation point to
         its format: the float model then emulates chosen sources of the fixed model's error."""
-        self.params = params
+        self.params = params = params.resolved(t_frame_us)
         self.precision = precision
         self.k = float_model.param_vector(params, width, height, t_frame_us, has_colour)
         self.palette = params.palette_ycbcr()
@@ -96,6 +96,7 @@ def track_events(
     t_frame_us = params.t_frame_us or meta.t_frame_us
     if not t_frame_us:
         raise EvclustError(f"{meta.source or 'events'}: no frame period: set clusterer.t_frame_us (velocities are in px/frame)")
+    params = params.resolved(float(t_frame_us))
     has_colour = bool(meta.has_colour)
     clusterer = MODELS[model](params, meta.width, meta.height, float(t_frame_us), has_colour, **options)
     start = time.perf_counter()

@@ -13,7 +13,7 @@ import numpy as np
 
 from evclust.clusterer.layout import (
     ACT, BG_CB, BG_CR, BG_Y, CCB, CCR, CREATED, CY, DROPPED, EV_COUNT, EVENTS, EVER_REPORTED, EVICTED,
-    DECAY_RESIDUAL, EXITED, EXPIRED, T_FIRST, FLAG_BORDER, FLAG_MOVING_INT, FLAG_MOVING_MCM, FLAG_NEW, GAMMA, ID, MCM_NORM,
+    DECAY_RESIDUAL, EXITED, EXPIRED, GLOBAL_COLUMNS, T_FIRST, FLAG_BORDER, FLAG_MOVING_INT, FLAG_MOVING_MCM, FLAG_NEW, GAMMA, ID, MCM_NORM,
     NEXT_ID, NOISE, PPX, PPY, PX, PY, REPORTED, RX, RY, SINCE_FILTER, STEP, T_FILTER,
     T_LAST, VALID, VI_COUNT, VIX, VIY, VMX, VMY,
 )  # fmt: skip
@@ -22,8 +22,8 @@ from evclust.fixed.formats import DECAY_FRAC_BITS, DECAY_TABLE_BITS
 
 TIME_MASK = (1 << 32) - 1
 # Globals beyond the float model's: the τ phase (µs since the last boundary).
-TAU_PHASE = 15
-N_GLOBALS = 16
+TAU_PHASE = len(GLOBAL_COLUMNS)
+N_GLOBALS = TAU_PHASE + 1
 
 # Signals of the overflow log and the range instrumentation.
 SIGNALS = (

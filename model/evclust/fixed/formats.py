@@ -147,7 +147,7 @@ def build_formats(
     1/β, so each filtered signal's fraction moves with it."""
     if not 0 <= dead_band_bits <= 16:
         raise EvclustError(f"dead_band_bits = {dead_band_bits}: expected 0..16 guard bits beyond 1/β")
-    p = params
+    p = params.resolved(t_frame_us)
     coord = _bits_for(max(width, height) - 1)
     seek_int = _bits_for(p.r_max + p.seek_margin + max(width, height))
     betas = {

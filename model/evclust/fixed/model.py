@@ -28,7 +28,7 @@ class FixedClusterer:
         self, params: ClustererParams, width: int, height: int, t_frame_us: float, has_colour: bool = True,
         ranges: bool = False, beta_shift_only: bool = False, dead_band_bits: int = DEAD_BAND_BITS,
     ):  # fmt: skip
-        self.params = params
+        self.params = params = params.resolved(t_frame_us)
         # beta_shift_only: every β a power of two, so each α filter multiplies by shifting;
         # dead_band_bits: the filters' guard bits, the formats table's word-length knob.
         self.table = build_formats(params, width, height, t_frame_us, beta_shift_only=beta_shift_only, dead_band_bits=dead_band_bits)

@@ -33,8 +33,10 @@ class SensorSpec(Strict):
 
 
 class BackgroundSpec(Strict):
-    kind: Literal["uniform", "texture", "image"] = "uniform"
+    kind: Literal["uniform", "texture", "gradient", "image"] = "uniform"
     colour: Colour = (128.0, 128.0, 128.0)
+    colour_to: Colour = (128.0, 128.0, 128.0)  # gradient: from colour to colour_to across the view
+    angle_deg: float = 0.0  # gradient: its direction, degrees from +x towards +y
     contrast: Annotated[float, Field(ge=0, le=128)] = 10.0  # texture: standard deviation, grey levels
     scale: Annotated[float, Field(gt=0, le=1000)] = 4.0  # texture: correlation length, px
     image: str | None = None

@@ -15,6 +15,8 @@ from evclust.errors import EvclustError
 from evclust.scenes.schema import BackgroundSpec, ObjectSpec, SceneSpec
 
 TRUTH_COLUMNS = ("frame", "t_us", "id", "cx", "cy", "w", "h", "vx", "vy", "Y", "Cb", "Cr", "label", "fully_visible")
+# Written by the simulator, optional when read (a hand-made CSV may leave it out: 1.0).
+TRUTH_OPTIONAL = {"visible": 1.0}  # the fraction of the object's area in view and not hidden by an object in front
 
 
 def make_background(spec: BackgroundSpec, width: int, height: int, seed: int, base_dir: Path) -> np.ndarray:
@@ -22,6 +24,14 @@ def make_background(spec: BackgroundSpec, width: int, height: int, seed: int, ba
     colour = np.asarray(spec.colour, dtype=np.float32)
     if spec.kind == "uniform":
         return np.broadcast_to(colour, (height, width, 3)).astype(np.float32)
+    if spec.kind == "gradient":
+        # Linear in the position along the direction, from `colour` at one corner to `colour_to`
+        # at the opposite one.
+        a = np.radians(spec.angle_deg)
+        u = np.cos(a) * np.arange(width)[None, :] + np.sin(a) * np.arange(height)[:, None]
+        u = (u - u.min()) / max(float(u.max() - u.min()), 1e-12)
+        end = np.asarray(spec.colour_to, dtype=np.float32)
+        return (colour + (end - colour) * u[..., None].astype(np.float32)).astype(np.float32)
     if spec.kind == "texture":
         noise = np.random.default_rng(seed).standard_normal((height, width)).astype(np.float32)
         smooth = cv2.GaussianBlur(noise, (0, 0), sigmaX=spec.scale, borderType=cv2.BORDER_REFLECT)
@@ -78,7 +88,8 @@ class RigidObject:
             starts.append(starts[-1] + leg.frames)
         self.leg_starts = np.asarray(starts)
         self.leg_points = np.asarray(points)
-        self.mean_ycbcr = rgb_to_ycbcr(self._mean_rgb())
+        rgb_sum, self.area = self._whole()
+        self.mean_ycbcr = rgb_to_ycbcr(rgb_sum / self.area)
 
     def state(self, frame: float):
         """(centre, velocity) at `frame`, or None when the object is not in the scene.
@@ -106,12 +117,13 @@ class RigidObject:
             alpha = alpha * (1 - m) + m
         return (slice(y0, y1), slice(x0, x1)), colour, alpha
 
-    def _mean_rgb(self) -> np.ndarray:
-        # Rendered at an integer offset on a canvas that holds the whole object.
+    def _whole(self) -> tuple[np.ndarray, float]:
+        """The summed RGB and the area (px) of the object rendered whole, at an integer offset on
+        a canvas that holds it."""
         w, h = (int(np.ceil(v)) + 4 for v in self.box_size)
         centre = np.array([w / 2, h / 2]) - self.box_offset
         _, colour, alpha = self.layer(centre, w, h)
-        return colour.reshape(-1, 3).sum(axis=0) / alpha.sum()
+        return colour.reshape(-1, 3).sum(axis=0), float(alpha.sum())
 
     def fully_visible(self, centre, width: int, height: int) -> bool:
         lo = centre + self.box_offset - self.box_size / 2
@@ -159,9 +171,25 @@ class SyntheticSource:
         for j in range(self.n_samples):
             yield self.render(j / self.substeps)
 
+    def _visible_fractions(self, k: int) -> dict[int, float]:
+        """Per object present at frame k, the fraction of its area inside the view and not
+        covered by the objects drawn after it (in front of it)."""
+        covered = np.zeros((self.height, self.width))
+        out = {}
+        for obj in reversed(self.objects):
+            state = obj.state(k)
+            layer = obj.layer(state[0], self.width, self.height) if state is not None else None
+            if layer is None:
+                continue
+            window, _, alpha = layer
+            out[obj.spec.id] = float((alpha * (1.0 - covered[window])).sum()) / obj.area
+            covered[window] += alpha * (1.0 - covered[window])
+        return out
+
     def truth(self) -> list[dict]:
         rows = []
         for k in range(self.n_frames):
+            visible = self._visible_fractions(k)
             for obj in self.objects:
                 state = obj.state(k)
                 if state is None or not obj.partly_visible(state[0], self.width, self.height):
@@ -184,6 +212,7 @@ class SyntheticSource:
                         "Cr": round(float(obj.mean_ycbcr[2]), 3),
                         "label": obj.spec.label,
                         "fully_visible": int(obj.fully_visible(centre, self.width, self.height)),
+                        "visible": round(min(visible.get(obj.spec.id, 0.0), 1.0), 4),
                     }
                 )
         return rows

@@ -9,13 +9,13 @@ from pathlib import Path
 import numpy as np
 
 from evclust.errors import EvclustError, atomic_output
-from evclust.scenes.synthetic import TRUTH_COLUMNS
+from evclust.scenes.synthetic import TRUTH_COLUMNS, TRUTH_OPTIONAL
 
 
 def write_truth(path: str | Path, rows: list[dict]) -> None:
     with atomic_output(path) as tmp:
         with open(tmp, "w", newline="") as f:
-            writer = csv.DictWriter(f, fieldnames=TRUTH_COLUMNS)
+            writer = csv.DictWriter(f, fieldnames=TRUTH_COLUMNS + tuple(TRUTH_OPTIONAL))
             writer.writeheader()
             writer.writerows(rows)
 
@@ -40,9 +40,10 @@ TRUTH_DTYPE = np.dtype(
         ("Cr", np.float64),
         ("label", f"U{LABEL_CHARS}"),  # colour label, compared with the palette entry names
         ("fully_visible", np.bool_),  # the whole box is inside the sensor
+        ("visible", np.float64),  # optional: area fraction in view and not occluded (default 1)
     ]
 )
-assert TRUTH_DTYPE.names == TRUTH_COLUMNS
+assert TRUTH_DTYPE.names == TRUTH_COLUMNS + tuple(TRUTH_OPTIONAL)
 _INTEGER_COLUMNS = ("frame", "id")
 _TEXT_COLUMNS = ("label",)
 _BOOL_WORDS = {"0": False, "1": True, "false": False, "true": True}
@@ -72,6 +73,8 @@ def _parse_value(name: str, text: str):
         raise ValueError(f"column {name}: '{text[:40]}' is not a number") from None
     if not np.isfinite(value):
         raise ValueError(f"column {name}: '{text[:40]}' is not a finite number")
+    if name == "visible" and not 0.0 <= value <= 1.0:
+        raise ValueError(f"column visible: {text[:40]} is not a fraction in [0, 1]")
     if name in _INTEGER_COLUMNS:
         if value != int(value):
             raise ValueError(f"column {name}: '{text[:40]}' is not an integer")
@@ -93,6 +96,8 @@ def truth_array(rows) -> np.ndarray:
         out = np.zeros(rows.size, dtype=TRUTH_DTYPE)
         for name in TRUTH_COLUMNS:
             out[name] = rows[name]
+        for name, default in TRUTH_OPTIONAL.items():
+            out[name] = rows[name] if name in rows.dtype.names else default
         return out
     out = np.zeros(len(rows), dtype=TRUTH_DTYPE)
     for i, row in enumerate(rows):
@@ -100,7 +105,9 @@ def truth_array(rows) -> np.ndarray:
         if missing:
             raise EvclustError(f"ground truth: row {i}: missing field(s) {', '.join(missing)}")
         try:
-            out[i] = tuple(_parse_value(c, str(row[c])) for c in TRUTH_COLUMNS)
+            out[i] = tuple(_parse_value(c, str(row[c])) for c in TRUTH_COLUMNS) + tuple(
+                _parse_value(c, str(row.get(c, default))) for c, default in TRUTH_OPTIONAL.items()
+            )
         except ValueError as exc:
             raise EvclustError(f"ground truth: row {i}: {exc}") from None
     return out
@@ -111,7 +118,7 @@ def read_truth(path: str | Path) -> np.ndarray:
 
     Returns a numpy structured array of dtype TRUTH_DTYPE, one element per data row, in file
     order. The header must name every column of TRUTH_COLUMNS (in any order; extra columns are
-    ignored). Numbers must be finite, `frame` and `id` integers, `frame` >= 0, `fully_visible`
+    ignored; `visible` is optional, 1.0 when absent, and must lie in [0, 1]). Numbers must be finite, `frame` and `id` integers, `frame` >= 0, `fully_visible`
     0/1 or true/false, `label` at most 32 characters; one (frame, id) pair per file. Any fault
     raises EvclustError with one line naming the file, the line number and the fault.
     """
@@ -134,6 +141,7 @@ def read_truth(path: str | Path) -> np.ndarray:
     if missing:
         raise EvclustError(f"{path}: line 1: missing column(s) {', '.join(missing)}")
     index = [header.index(c) for c in TRUTH_COLUMNS]
+    optional = [(header.index(c) if c in header else None, c, default) for c, default in TRUTH_OPTIONAL.items()]
     rows = []
     seen: dict[tuple[int, int], int] = {}
     line_no = 1
@@ -145,7 +153,9 @@ def read_truth(path: str | Path) -> np.ndarray:
             if len(row) < len(header):
                 raise EvclustError(f"{path}: line {line_no}: {len(row)} values, the header names {len(header)} columns")
             try:
-                values = tuple(_parse_value(c, row[i]) for i, c in zip(index, TRUTH_COLUMNS))
+                values = tuple(_parse_value(c, row[i]) for i, c in zip(index, TRUTH_COLUMNS)) + tuple(
+                    default if i is None else _parse_value(c, row[i]) for i, c, default in optional
+                )
             except ValueError as exc:
                 raise EvclustError(f"{path}: line {line_no}: {exc}") from None
             key = (values[0], values[2])

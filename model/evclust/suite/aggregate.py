@@ -1,0 +1,105 @@
+"""Figures over many scenes: pooled counts (not means of per-scene ratios), overall and per
+category (docs/GENERALIZATION.md).
+
+Object categories come from the ground truth and the generator: small or large (larger side
+under SMALL_PX), slow or fast (mean speed under SLOW_PX_PER_FRAME), uniform or textured. Scene
+categories: codec or clean, with or without sensor noise. Precision and the TrackEval figures
+are properties of a scene's whole output, so they are given per scene category only.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from evclust.metrics import tracking
+
+SMALL_PX = 32.0
+SLOW_PX_PER_FRAME = 1.0
+
+OBJECT_CATEGORIES = {
+    "small": lambda o, f: o.size < SMALL_PX, "large": lambda o, f: o.size >= SMALL_PX,
+    "slow": lambda o, f: o.speed < SLOW_PX_PER_FRAME, "fast": lambda o, f: o.speed >= SLOW_PX_PER_FRAME,
+    "uniform": lambda o, f: not f["textured"], "textured": lambda o, f: f["textured"],
+}  # fmt: skip
+SCENE_CATEGORIES = {
+    "codec": lambda r: r.facts["codec"], "clean": lambda r: not r.facts["codec"],
+    "noise": lambda r: r.facts["noise"], "no noise": lambda r: not r.facts["noise"],
+}  # fmt: skip
+
+
+def _object_facts(result) -> dict:
+    return {o["id"]: o for o in result.facts["objects"]}
+
+
+def _tracks_per_object(results) -> float | None:
+    counts = []
+    for r in results:
+        m = r.matches
+        for g in np.unique(m["gt_id"]):
+            counts.append(np.unique(m["track_id"][m["gt_id"] == g]).size)
+    return float(np.mean(counts)) if counts else None
+
+
+def figures(results, objects=None, trackeval: bool = True) -> dict:
+    """Pooled figures of `results` (SceneResult); with `objects` (a predicate on an object's
+    ObjectSummary and its generator facts), over those objects only, without precision."""
+    selected = []
+    n_objects = n_records = 0
+    for r in results:
+        facts = _object_facts(r)
+        if objects is None:
+            keep_ids = set(r.objects)
+            n_records += r.n_records
+        else:
+            keep_ids = {i for i, o in r.objects.items() if objects(o, facts[i])}
+        n_objects += sum(r.objects[i].samples for i in keep_ids)
+        m = r.matches[np.isin(r.matches["gt_id"], list(keep_ids))] if keep_ids else r.matches[:0]
+        selected.append(dataclass_copy(r, m))
+    matches = np.concatenate([r.matches for r in selected]) if selected else np.zeros(0, tracking.MATCH_FIELDS)
+    meta = results[0].meta if results else None
+    out = {
+        "scenes": len(results),
+        "objects": int(sum(len(r.objects) for r in results) if objects is None else sum(
+            sum(1 for i, o in r.objects.items() if objects(o, _object_facts(r)[i])) for r in results)),
+        "recall": matches.size / n_objects if n_objects else None,
+        "precision": (matches.size / n_records if n_records else None) if objects is None else None,
+        "tracks_per_object": _tracks_per_object(selected),
+    }
+    if objects is None and results and trackeval:
+        out |= tracking.headline(tracking.combine_sequences([r.trackeval for r in results]))
+    out |= tracking.accuracy(matches, meta) if meta is not None else {}
+    return out
+
+
+def dataclass_copy(result, matches):
+    import dataclasses
+
+    return dataclasses.replace(result, matches=matches)
+
+
+def by_category(results) -> dict[str, dict]:
+    out = {"all": figures(results)}
+    for name, keep in SCENE_CATEGORIES.items():
+        chosen = [r for r in results if keep(r)]
+        if chosen:
+            out[name] = figures(chosen)
+    for name, keep in OBJECT_CATEGORIES.items():
+        out[name] = figures(results, objects=keep)
+    return out
+
+
+def objective(f: dict) -> float:
+    """The number the suite's tuning minimises (docs/TUNING.md): each term is one target's
+    shortfall, clipped to [0, 1] so that one wild figure cannot drown the others."""
+
+    def term(value, worst=1.0):
+        return worst if value is None or not np.isfinite(value) else float(min(max(value, 0.0), worst))
+
+    velocity = min(term(f.get("mcm_nrmse")), term(f.get("interval_nrmse")))
+    angle = min(term(f.get("mcm_angle_deg"), 90.0), term(f.get("interval_angle_deg"), 90.0)) / 90.0
+    return (
+        2.0 * (1.0 - term(f.get("recall"), 1.0)) + 2.0 * (1.0 - term(f.get("precision"), 1.0))
+        + term((f.get("tracks_per_object") or 2.0) - 1.0) + term(f.get("position_rel_rmse"))
+        + velocity + angle + term(f.get("luminance_nrmse")) + 2.0 * term(f.get("chrominance_nrmse"))
+        + (1.0 - term(f.get("class_palette"), 1.0))
+    )  # fmt: skip
