@@ -13,7 +13,7 @@ import numba
 import numpy as np
 
 from evclust.clusterer.layout import (
-    ACT, BG_ACT, BG_CB, BG_CR, BG_T, BG_Y, CCB, CCR, MERGED, CREATED, CY, DROPPED, EV_COUNT, EVENTS, EVER_REPORTED, EVICTED, EXITED,
+    ACT, BG_ACT, BG_CB, BG_CR, BG_T, BG_Y, CCB, CCR, MERGED, UNSUPPORTED, CREATED, CY, DROPPED, EV_COUNT, EVENTS, EVER_REPORTED, EVICTED, EXITED,
     EXPIRED, T_FIRST, FLAG_BORDER, FLAG_MOVING_INT, FLAG_MOVING_MCM, FLAG_NEW, GAMMA, ID, MCM_NORM, NEXT_ID, NOISE, PPX, PPY, PX,
     PY, RECORD_COLUMNS, REPORTED, RX, RY, SINCE_FILTER, STEP, T_FILTER, T_LAST, VALID, VI_COUNT, VIX, VIY, VMX,
     VMY,
@@ -26,8 +26,9 @@ from evclust.clusterer.layout import (
     K_LUMA_W, K_H_MAX, K_V_MIN, K_EXIT_M, K_V_EXIT, K_COS_EXIT, K_WIDTH, K_HEIGHT, K_COLOUR,
     K_WARM_START, K_MCM_CORRECT, K_VOTE_CONTRAST, K_ASSIGN_MIXING, K_MIX_TOL,
     K_SEEK_SCALE, K_MERGE, K_MERGE_SCALE, K_MERGE_V_TOL, K_MERGE_V_REL, K_NOISE_GATE,
-) = range(42)  # fmt: skip
-N_PARAMS = 42
+    K_SUPPORT, K_SUPPORT_BITS, K_SUPPORT_WINDOW,
+) = range(45)  # fmt: skip
+N_PARAMS = 45
 LN2 = math.log(2.0)
 
 # Quantisation points: the stores of the signals the formats table gives a format to. With a
@@ -58,6 +59,7 @@ def param_vector(p, width: int, height: int, t_frame_us: float, has_colour: bool
     v[K_ASSIGN_MIXING], v[K_MIX_TOL] = p.palette_assign == "mixing", p.mixing_tolerance
     v[K_SEEK_SCALE], v[K_MERGE], v[K_MERGE_V_TOL], v[K_MERGE_V_REL] = p.seek_scale, p.merge, p.merge_v_tol, p.merge_v_rel
     v[K_NOISE_GATE], v[K_MERGE_SCALE] = p.noise_gate, p.merge_scale
+    v[K_SUPPORT], v[K_SUPPORT_BITS], v[K_SUPPORT_WINDOW] = p.create_support, p.support_cell_bits, p.support_window_us
     return v
 
 
@@ -262,19 +264,20 @@ def _exiting(S, s, k):
 
 @numba.njit(cache=True, nogil=True)
 def _mergeable(S, s, j, k):
-    """Two clusters are one object's when their boxes, each grown by merge_scale times its
-    larger half-size, overlap and, once both have measured an interval velocity, their
-    velocities agree."""
+    """Two clusters are one object's when their boxes overlap and their velocities do not
+    disagree (a young cluster has none yet), or when their boxes grown by merge_scale times
+    their larger half-sizes overlap and both have measured velocities that agree."""
+    dx, dy = abs(S[s, PX] - S[j, PX]), abs(S[s, PY] - S[j, PY])
+    sx, sy = S[s, RX] + S[j, RX], S[s, RY] + S[j, RY]
     grow = k[K_MERGE_SCALE] * (max(S[s, RX], S[s, RY]) + max(S[j, RX], S[j, RY]))
-    if abs(S[s, PX] - S[j, PX]) > S[s, RX] + S[j, RX] + grow:
+    if dx > sx + grow or dy > sy + grow:
         return False
-    if abs(S[s, PY] - S[j, PY]) > S[s, RY] + S[j, RY] + grow:
-        return False
-    if S[s, VI_COUNT] < 2.0 or S[j, VI_COUNT] < 2.0:
-        return True
-    dv = abs(S[s, VIX] - S[j, VIX]) + abs(S[s, VIY] - S[j, VIY])
-    fast = max(abs(S[s, VIX]) + abs(S[s, VIY]), abs(S[j, VIX]) + abs(S[j, VIY]))
-    return dv <= k[K_MERGE_V_TOL] + k[K_MERGE_V_REL] * fast
+    measured = S[s, VI_COUNT] >= 2.0 and S[j, VI_COUNT] >= 2.0
+    if measured:
+        dv = abs(S[s, VIX] - S[j, VIX]) + abs(S[s, VIY] - S[j, VIY])
+        fast = max(abs(S[s, VIX]) + abs(S[s, VIY]), abs(S[j, VIX]) + abs(S[j, VIY]))
+        return dv <= k[K_MERGE_V_TOL] + k[K_MERGE_V_REL] * fast
+    return dx <= sx and dy <= sy
 
 
 @numba.njit(cache=True, nogil=True)
@@ -324,11 +327,13 @@ def _filter_step(S, H, G, t, k, palette, background_mask, out, n_out, precision)
             S[s, VALID] = 0.0
             G[EXPIRED] += 1
             continue
-        if k[K_MERGE] != 0.0:
-            for j in range(s + 1, S.shape[0]):
+        if k[K_MERGE] != 0.0:  # absorb every later slot that is the same object, lowest first
+            j = s + 1
+            while j < S.shape[0]:
                 if S[j, VALID] != 0.0 and _mergeable(S, s, j, k):
                     _merge(S, H, G, s, j, k, precision)
-                    break
+                    j = s  # the merged box may now reach a slot passed over
+                j += 1
         if k[K_GAMMA_MODE] != GAMMA_COUNT or S[s, VI_COUNT] == 0.0:
             S[s, GAMMA] = _q(_gamma(S[s, ACT], k), Q_GAMMA, precision)
         if interval_due:
@@ -358,7 +363,7 @@ def _filter_step(S, H, G, t, k, palette, background_mask, out, n_out, precision)
         if reported and k[K_NOISE_GATE] > 0.0:
             # Beyond the paper: the background's events spread over the sensor would give the
             # box A_bg·(box area / sensor area); an object's cluster holds noise_gate times more.
-            box = 4.0 * max(S[s, RX], 0.5) * max(S[s, RY], 0.5)
+            box = (2.0 * math.floor(S[s, RX]) + 1.0) * (2.0 * math.floor(S[s, RY]) + 1.0)  # its pixels
             reported = S[s, ACT] * k[K_WIDTH] * k[K_HEIGHT] >= k[K_NOISE_GATE] * G[BG_ACT] * box
         if S[s, ACT] >= k[K_A_VALID] and not reported:
             G[NOISE] += 1
@@ -398,10 +403,24 @@ def _filter_step(S, H, G, t, k, palette, background_mask, out, n_out, precision)
     return n_out
 
 
+@numba.njit(cache=True, nogil=True, inline="always")
+def _supported(support, cx, cy, t, window):
+    """Beyond the paper: some event of the 3x3 cells around (cx, cy) (map coordinates, border
+    included) is at most `window` µs old."""
+    for dy in range(-1, 2):
+        for dx in range(-1, 2):
+            if t - support[cy + dy, cx + dx] <= window:
+                return True
+    return False
+
+
 @numba.njit(cache=True, nogil=True)
-def run_events(S, H, G, k, palette, background_mask, t_us, xs, ys, lums, cbs, crs, out, precision=None):
+def run_events(S, H, G, k, palette, background_mask, support, t_us, xs, ys, lums, cbs, crs, out, precision=None):
     """Feed events through the table; write track records into `out`; return how many. With a
-    `precision` table (PRECISION_SIGNALS x 4) each quantisation point rounds to its format."""
+    `precision` table (PRECISION_SIGNALS x 4) each quantisation point rounds to its format.
+    `support` is the creation-support map (layout.support_shape), each cell the time of its
+    latest event (-inf: none)."""
+    bits = int(k[K_SUPPORT_BITS])
     n_out = 0
     every = int(k[K_EVERY])
     for i in range(t_us.size):
@@ -414,15 +433,20 @@ def run_events(S, H, G, k, palette, background_mask, t_us, xs, ys, lums, cbs, cr
         G[EVENTS] += 1
         s = _seek(S, x, y, k)
         updated_reported = False
+        cx, cy = (int(xs[i]) >> bits) + 1, (int(ys[i]) >> bits) + 1
         if s < 0:
-            s = _slot_for_new(S, G, t, k, precision)
-            if s >= 0:
-                _create(S, H, G, s, t, x, y, lum, cb, cr, k, precision)
+            if k[K_SUPPORT] != 0.0 and not _supported(support, cx, cy, t, k[K_SUPPORT_WINDOW]):
+                G[UNSUPPORTED] += 1
             else:
-                G[DROPPED] += 1
+                s = _slot_for_new(S, G, t, k, precision)
+                if s >= 0:
+                    _create(S, H, G, s, t, x, y, lum, cb, cr, k, precision)
+                else:
+                    G[DROPPED] += 1
         else:
             _update(S, H, G, s, t, x, y, lum, cb, cr, k, palette, background_mask, precision)
             updated_reported = S[s, REPORTED] != 0.0
+        support[cy, cx] = t
         # Step 4: events that do not update a reported cluster track the background colour.
         if not updated_reported:  # the activity of the events no reported cluster takes
             G[BG_ACT] = _q(_decayed(G[BG_ACT], t - G[BG_T], k[K_T_HALF], precision), Q_ACT, precision) + 1.0

@@ -22,13 +22,13 @@ SLOT_COLUMNS = (
 # Global columns.
 (
     NEXT_ID, BG_Y, BG_CB, BG_CR, SINCE_FILTER, STEP, T_FILTER, EVENTS, CREATED, EVICTED, DROPPED, EXPIRED,
-    EXITED, NOISE, T_FIRST, BG_ACT, BG_T, BG_RESIDUAL, MERGED,
-) = range(19)  # fmt: skip
+    EXITED, NOISE, T_FIRST, BG_ACT, BG_T, BG_RESIDUAL, MERGED, UNSUPPORTED,
+) = range(20)  # fmt: skip
 GLOBAL_COLUMNS = (
     "next_id", "bg_Y", "bg_Cb", "bg_Cr", "since_filter", "step", "t_filter", "events",
     "created", "evicted", "dropped", "expired", "exited", "noise", "t_first",  # τ boundaries count from t_first
     "bg_activity", "bg_t_last", "bg_decay_residual",  # the activity of the events no reported cluster takes
-    "merged",
+    "merged", "unsupported",  # clusters merged into another; events that found no cluster and no support
 )  # fmt: skip
 
 # Track-record columns as the models write them (the order of evclust.tracks.TRACK_DTYPE).
@@ -43,5 +43,11 @@ def run_stats(g) -> dict:
     return {
         "events": int(g[EVENTS]), "steps": int(g[STEP]), "created": int(g[CREATED]), "evicted": int(g[EVICTED]),
         "dropped": int(g[DROPPED]), "expired": int(g[EXPIRED]), "exited": int(g[EXITED]), "noise_decisions": int(g[NOISE]),
-        "merged": int(g[MERGED]),
+        "merged": int(g[MERGED]), "unsupported": int(g[UNSUPPORTED]),
     }  # fmt: skip
+
+
+def support_shape(width: int, height: int, cell_bits: int) -> tuple[int, int]:
+    """The creation-support map: one cell per 2^cell_bits px square, with a border of one cell
+    all round so that every 3x3 neighbourhood lies inside."""
+    return ((height - 1) >> cell_bits) + 3, ((width - 1) >> cell_bits) + 3

@@ -100,6 +100,12 @@ class ClustererParams(BaseModel):
     merge_v_tol: NonNegative = 0.5  # px/frame: the L1 velocity difference two merging clusters may have,
     merge_v_rel: NonNegative = 0.25  # plus this fraction of the faster one's L1 speed
     noise_gate: NonNegative = 0.0  # report a cluster only if its activity is noise_gate times what the background's events give its box
+    # A new cluster needs support: another event in its 3x3 neighbourhood of cells (2^support_cell_bits
+    # px square) within the support window; isolated noise events then create nothing.
+    create_support: bool = False
+    support_cell_bits: Annotated[int, Field(ge=0, le=4)] = 1
+    support_window_us: Positive = 20000.0
+    support_window_frames: Positive | None = None  # set: the window in frame periods, overriding support_window_us
     # Decisions from velocity (§6.3).
     v_min: NonNegative = 0.3  # px/frame: a cluster whose MCM and interval speeds are both below is noise
     exit_margin: NonNegative = 10.0  # M, px: the border band where exit prediction acts
@@ -130,6 +136,8 @@ class ClustererParams(BaseModel):
             update |= {"t_half_us": self.t_half_frames * t_frame_us, "t_half_frames": None}
         if self.tau_frames is not None:
             update |= {"tau_us": float(max(1, round(self.tau_frames * t_frame_us))), "tau_frames": None}
+        if self.support_window_frames is not None:
+            update |= {"support_window_us": float(max(1, round(self.support_window_frames * t_frame_us))), "support_window_frames": None}
         return self.model_copy(update=update) if update else self
 
     @property

@@ -9,7 +9,7 @@ import numpy as np
 from tqdm import tqdm
 
 from evclust.clusterer import float_model
-from evclust.clusterer.layout import BG_CB, BG_CR, BG_Y, GLOBAL_COLUMNS, RECORD_COLUMNS, SLOT_COLUMNS, run_stats
+from evclust.clusterer.layout import BG_CB, BG_CR, BG_Y, GLOBAL_COLUMNS, RECORD_COLUMNS, SLOT_COLUMNS, run_stats, support_shape
 from evclust.clusterer.params import ClustererParams
 from evclust.errors import EvclustError
 from evclust.events import EventMeta
@@ -55,13 +55,14 @@ class FloatClusterer:
         self.globals = np.zeros(len(GLOBAL_COLUMNS))
         bg = params.background if params.background is not None else (128.0, 128.0, 128.0)
         self.globals[[BG_Y, BG_CB, BG_CR]] = bg
+        self.support = np.full(support_shape(width, height, params.support_cell_bits), -np.inf)
 
     def feed(self, events: np.ndarray) -> np.ndarray:
         """Process events; return the (n, RECORD_COLUMNS) float64 records of the filter steps they completed."""
         every = self.params.filter_every
         out = np.empty(((events.size // every + 1) * self.params.n_clusters, RECORD_COLUMNS))
         n = float_model.run_events(
-            self.slots, self.hist, self.globals, self.k, self.palette, self.background_mask,
+            self.slots, self.hist, self.globals, self.k, self.palette, self.background_mask, self.support,
             events["t"], events["x"], events["y"], events["Y"], events["Cb"], events["Cr"], out, self.precision,
         )  # fmt: skip
         return out[:n]

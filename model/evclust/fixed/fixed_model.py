@@ -12,13 +12,14 @@ import numba
 import numpy as np
 
 from evclust.clusterer.layout import (
-    ACT, BG_CB, BG_CR, BG_Y, CCB, CCR, CREATED, CY, DROPPED, EV_COUNT, EVENTS, EVER_REPORTED, EVICTED,
+    ACT, BG_ACT, BG_CB, BG_CR, BG_RESIDUAL, BG_T, BG_Y, CCB, CCR, CREATED, CY, DROPPED, EV_COUNT, EVENTS, EVER_REPORTED, EVICTED,
+    MERGED, UNSUPPORTED,
     DECAY_RESIDUAL, EXITED, EXPIRED, GLOBAL_COLUMNS, T_FIRST, FLAG_BORDER, FLAG_MOVING_INT, FLAG_MOVING_MCM, FLAG_NEW, GAMMA, ID, MCM_NORM,
     NEXT_ID, NOISE, PPX, PPY, PX, PY, REPORTED, RX, RY, SINCE_FILTER, STEP, T_FILTER,
     T_LAST, VALID, VI_COUNT, VIX, VIY, VMX, VMY,
 )  # fmt: skip
 from evclust.fixed.arith import FLOOR, NEAREST, alpha_step_nb, decay_apply_nb, decay_nb, decay_steps_nb
-from evclust.fixed.formats import DECAY_FRAC_BITS, DECAY_TABLE_BITS
+from evclust.fixed.formats import DECAY_FRAC_BITS, DECAY_TABLE_BITS, NOISE_GATE_FRAC_BITS, SCALE_FRAC_BITS
 
 TIME_MASK = (1 << 32) - 1
 # Globals beyond the float model's: the τ phase (µs since the last boundary).
@@ -48,8 +49,10 @@ SIGNALS = (
     C_WIDTH, C_HEIGHT, C_COLOUR, C_WARM, C_MCM_CORRECT, C_VOTE_CONTRAST, C_MIXING, C_MIX_TOL,
     C_MAX_ACT, C_MAX_V, C_MIN_V, C_MAX_VI, C_MIN_VI, C_MAX_GAMMA,
     C_MAX_EVCOUNT, C_MAX_SIZE_TARGET, C_V_FULL_BITS, C_MAX_SPEED_SQ,
-) = range(71)  # fmt: skip
-N_CONSTANTS = 71
+    C_SEEK_SCALE, C_MERGE, C_MERGE_SCALE, C_MERGE_V_TOL, C_MERGE_V_REL, C_SCALE_F, C_NOISE_GATE, C_NOISE_GATE_F,
+    C_SUPPORT, C_SUPPORT_BITS, C_SUPPORT_WINDOW, C_MAX_CENTRE, C_R_MAX_RAW,
+) = range(84)  # fmt: skip
+N_CONSTANTS = 84
 
 
 def constant_vector(table, params, has_colour: bool) -> np.ndarray:
@@ -94,6 +97,11 @@ def constant_vector(table, params, has_colour: bool) -> np.ndarray:
     k[C_MAX_V], k[C_MIN_V] = f["v_mcm"].raw_max, f["v_mcm"].raw_min
     k[C_MAX_VI], k[C_MIN_VI] = f["v_int"].raw_max, f["v_int"].raw_min
     k[C_MAX_GAMMA], k[C_MAX_EVCOUNT] = f["gamma"].raw_max, f["events_in_interval"].raw_max
+    k[C_SEEK_SCALE], k[C_MERGE], k[C_MERGE_SCALE] = raw("seek_scale"), params.merge, raw("merge_scale")
+    k[C_MERGE_V_TOL], k[C_MERGE_V_REL], k[C_SCALE_F] = raw("merge_v_tol"), raw("merge_v_rel"), SCALE_FRAC_BITS
+    k[C_NOISE_GATE], k[C_NOISE_GATE_F] = raw("noise_gate"), NOISE_GATE_FRAC_BITS
+    k[C_SUPPORT], k[C_SUPPORT_BITS], k[C_SUPPORT_WINDOW] = params.create_support, params.support_cell_bits, raw("support_window")
+    k[C_MAX_CENTRE], k[C_R_MAX_RAW] = f["centre"].raw_max, raw("r_max")
     return k
 
 
@@ -151,10 +159,24 @@ def _decay_slot(S, s, t, k, table):
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
+def _decay_background(G, t, k, table):
+    """The background's activity decayed to t, as a slot's (its residual carried)."""
+    m, G[BG_RESIDUAL] = decay_steps_nb((t - G[BG_T]) & TIME_MASK, G[BG_RESIDUAL], k[C_INV_TH], k[C_INV_TH_F], DECAY_TABLE_BITS)
+    G[BG_ACT] = decay_apply_nb(G[BG_ACT], m, table, DECAY_TABLE_BITS, DECAY_FRAC_BITS, FLOOR)
+    G[BG_T] = t
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
 def _gamma_from_activity(a, k):
     if k[C_GAMMA_MODE] == 0:
         return k[C_GAMMA_GLOBAL]
     return (a * k[C_GPA]) >> (k[C_FA] + k[C_GPA_F] - k[C_FG])  # A · ln2·T_frame/T_half, in γ's format
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _margin(S, s, k):
+    """The seek margin in P's format: S + seek_scale·max(Rx, Ry), the product floored."""
+    return k[C_SEEK] + _align(k[C_SEEK_SCALE] * max(S[s, RX], S[s, RY]), k[C_SCALE_F] + k[C_FR], k[C_FP])
 
 
 @numba.njit(cache=True, nogil=True)
@@ -163,13 +185,13 @@ def _seek(S, x, y, k):
     fraction bits with one fixed shift (hoisted out of the loop)."""
     best, best_d = -1, np.int64(1) << 62
     up = k[C_FP] - k[C_FR]  # the formats table gives the centre at least R's fraction bits
-    seek = k[C_SEEK]
     for s in range(S.shape[0]):
         if S[s, VALID] == 0:
             continue
         dx = abs(x - S[s, PX])
         dy = abs(y - S[s, PY])
-        if dx <= (S[s, RX] << up) + seek and dy <= (S[s, RY] << up) + seek:
+        m = _margin(S, s, k)
+        if dx <= (S[s, RX] << up) + m and dy <= (S[s, RY] << up) + m:
             d = dx + dy
             if d < best_d:
                 best, best_d = s, d
@@ -337,6 +359,64 @@ def _corrected(colour, background, k):
 
 
 @numba.njit(cache=True, nogil=True)
+def _mergeable(S, s, j, k):
+    """As the float model's: boxes that overlap (velocities not disagreeing), or boxes grown by
+    merge_scale·max(R) that overlap with measured velocities that agree. In P's format; the
+    grown reach and the relative velocity tolerance floored."""
+    up = k[C_FP] - k[C_FR]
+    dx, dy = abs(S[s, PX] - S[j, PX]), abs(S[s, PY] - S[j, PY])
+    sx, sy = (S[s, RX] + S[j, RX]) << up, (S[s, RY] + S[j, RY]) << up
+    grow = _align(k[C_MERGE_SCALE] * (max(S[s, RX], S[s, RY]) + max(S[j, RX], S[j, RY])), k[C_SCALE_F] + k[C_FR], k[C_FP])
+    if dx > sx + grow or dy > sy + grow:
+        return False
+    if S[s, VI_COUNT] >= 2 and S[j, VI_COUNT] >= 2:
+        dv = abs(S[s, VIX] - S[j, VIX]) + abs(S[s, VIY] - S[j, VIY])
+        fast = max(abs(S[s, VIX]) + abs(S[s, VIY]), abs(S[j, VIX]) + abs(S[j, VIY]))
+        return dv <= k[C_MERGE_V_TOL] + ((k[C_MERGE_V_REL] * fast) >> k[C_SCALE_F])
+    return dx <= sx and dy <= sy
+
+
+@numba.njit(cache=True, nogil=True)
+def _merge(S, H, G, s, j, k, log, ranges):
+    """Slot s absorbs slot j (the float model's _merge): the centre is the activity-weighted
+    mean, floored (the sweep's one division); the box covers both boxes; activities and
+    event counts add, saturated; the survivor's identity, velocities, colour and histogram."""
+    up = k[C_FP] - k[C_FR]
+    survivor = j if (S[j, EVER_REPORTED] > S[s, EVER_REPORTED]) or (S[j, EVER_REPORTED] == S[s, EVER_REPORTED] and S[j, ACT] > S[s, ACT]) else s
+    a_s, a_j = S[s, ACT], S[j, ACT]
+    weight = a_s + a_j
+    px, py = S[s, PX], S[s, PY]
+    if weight > 0:
+        px = (a_s * S[s, PX] + a_j * S[j, PX]) // weight
+        py = (a_s * S[s, PY] + a_j * S[j, PY]) // weight
+    lo_x = min(S[s, PX] - (S[s, RX] << up), S[j, PX] - (S[j, RX] << up))
+    hi_x = max(S[s, PX] + (S[s, RX] << up), S[j, PX] + (S[j, RX] << up))
+    lo_y = min(S[s, PY] - (S[s, RY] << up), S[j, PY] - (S[j, RY] << up))
+    hi_y = max(S[s, PY] + (S[s, RY] << up), S[j, PY] + (S[j, RY] << up))
+    ppx = _store(S[survivor, PPX] + (px - S[survivor, PX]), 0, k[C_MAX_CENTRE], S_CENTRE, log, ranges)
+    ppy = _store(S[survivor, PPY] + (py - S[survivor, PY]), 0, k[C_MAX_CENTRE], S_CENTRE, log, ranges)
+    act = _store(a_s + a_j, 0, k[C_MAX_ACT], S_ACT, log, ranges)
+    count = _store(S[s, EV_COUNT] + S[j, EV_COUNT], 0, k[C_MAX_EVCOUNT], S_EVCOUNT, log, ranges)
+    if survivor == j:  # its state, with s's decay reference (s is decayed to now)
+        t_last, residual = S[s, T_LAST], S[s, DECAY_RESIDUAL]
+        S[s, :] = S[j, :]
+        H[s, :] = H[j, :]
+        S[s, T_LAST], S[s, DECAY_RESIDUAL] = t_last, residual
+    S[s, PX], S[s, PY], S[s, PPX], S[s, PPY] = px, py, ppx, ppy
+    S[s, RX] = min((hi_x - lo_x) >> (up + 1), k[C_R_MAX_RAW])
+    S[s, RY] = min((hi_y - lo_y) >> (up + 1), k[C_R_MAX_RAW])
+    S[s, ACT], S[s, EV_COUNT] = act, count
+    S[j, VALID] = 0
+    G[MERGED] += 1
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _box_pixels(S, s, k):
+    """The pixels of a cluster's box, (2·floor(Rx) + 1)·(2·floor(Ry) + 1)."""
+    return (2 * (S[s, RX] >> k[C_FR]) + 1) * (2 * (S[s, RY] >> k[C_FR]) + 1)
+
+
+@numba.njit(cache=True, nogil=True)
 def _filter_step(S, H, G, t, k, table, palette, inv_ww, background_mask, out, n_out, log, ranges):
     # τ boundaries since the last step, from a phase counter (no division of the wrapping time).
     phase = G[TAU_PHASE] + ((t - G[T_FILTER]) & TIME_MASK)
@@ -344,6 +424,8 @@ def _filter_step(S, H, G, t, k, table, palette, inv_ww, background_mask, out, n_
     G[TAU_PHASE] = phase - boundaries * k[C_TAU_US]
     per_frame = k[C_FPT] // max(boundaries, 1)  # T_frame/(n·τ), Q?.F_fpt
     fp, fv, fw, fi, fc = k[C_FP], k[C_FV], k[C_FW], k[C_FI], k[C_FC]
+    _decay_background(G, t, k, table)
+    sensor = k[C_WIDTH] * k[C_HEIGHT]
     for s in range(S.shape[0]):
         if S[s, VALID] == 0:
             continue
@@ -352,6 +434,13 @@ def _filter_step(S, H, G, t, k, table, palette, inv_ww, background_mask, out, n_
             S[s, VALID] = 0
             G[EXPIRED] += 1
             continue
+        if k[C_MERGE] != 0:  # absorb every later slot that is the same object, lowest first
+            j = s + 1
+            while j < S.shape[0]:
+                if S[j, VALID] != 0 and _mergeable(S, s, j, k):
+                    _merge(S, H, G, s, j, k, log, ranges)
+                    j = s
+                j += 1
         if k[C_GAMMA_MODE] != 2 or S[s, VI_COUNT] == 0:
             S[s, GAMMA] = _store(_gamma_from_activity(S[s, ACT], k), 0, k[C_MAX_GAMMA], S_GAMMA, log, ranges)
         if boundaries > 0:
@@ -388,6 +477,8 @@ def _filter_step(S, H, G, t, k, table, palette, inv_ww, background_mask, out, n_
         moving_mcm = _speed_sq(S[s, VMX], S[s, VMY], fv, k) >= k[C_V_MIN_SQ]
         moving_int = _speed_sq(S[s, VIX], S[s, VIY], fi, k) >= k[C_V_MIN_SQ]
         reported = S[s, ACT] >= k[C_A_VALID] and (moving_mcm or moving_int)
+        if reported and k[C_NOISE_GATE] != 0:  # A·W·H >= γ_n·A_bg·box, γ_n in Q.4
+            reported = (S[s, ACT] * sensor) << k[C_NOISE_GATE_F] >= k[C_NOISE_GATE] * G[BG_ACT] * _box_pixels(S, s, k)
         if S[s, ACT] >= k[C_A_VALID] and not reported:
             G[NOISE] += 1
         S[s, REPORTED] = 1 if reported else 0
@@ -431,16 +522,30 @@ def _filter_step(S, H, G, t, k, table, palette, inv_ww, background_mask, out, n_
     return n_out
 
 
-# Trace actions (golden vectors): what each event did, and to which slot.
-TRACE_UPDATE, TRACE_CREATE, TRACE_EVICT, TRACE_DROP = range(4)
+# Trace actions (golden vectors): what each event did, and to which slot. An unsupported event
+# found no cluster and no support to create one.
+TRACE_UPDATE, TRACE_CREATE, TRACE_EVICT, TRACE_DROP, TRACE_UNSUPPORTED = range(5)
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _supported(support, seen, cx, cy, t, window):
+    """Some cell of the 3x3 around (cx, cy) had an event at most `window` µs ago (mod 2^32)."""
+    for dy in range(-1, 2):
+        for dx in range(-1, 2):
+            if seen[cy + dy, cx + dx] and ((t - support[cy + dy, cx + dx]) & TIME_MASK) <= window:
+                return True
+    return False
 
 
 @numba.njit(cache=True, nogil=True)
-def run_events(S, H, G, k, table, palette, inv_ww, background_mask, t_us, xs, ys, lums, cbs, crs, out, log, ranges, trace=None):
+def run_events(S, H, G, k, table, palette, inv_ww, background_mask, support, seen, t_us, xs, ys, lums, cbs, crs, out, log, ranges,
+               trace=None):  # fmt: skip
     """Feed events; write records into `out`; with `trace` (an int64 array), write each event's
-    action << 16 | slot there (a None trace compiles without it)."""
+    action << 16 | slot there (a None trace compiles without it). `support` holds each map
+    cell's latest event time (32-bit), `seen` whether it has one."""
     n_out = 0
     fb = k[C_FB]
+    bits = k[C_SUPPORT_BITS]
     for i in range(t_us.size):
         t = np.int64(t_us[i]) & TIME_MASK  # the 32-bit timestamp counter
         ex, ey = np.int64(xs[i]), np.int64(ys[i])
@@ -453,7 +558,11 @@ def run_events(S, H, G, k, table, palette, inv_ww, background_mask, t_us, xs, ys
         s = _seek(S, ex << k[C_FP], ey << k[C_FP], k)
         updated_reported = False
         action = TRACE_UPDATE
-        if s < 0:
+        cx, cy = (ex >> bits) + 1, (ey >> bits) + 1
+        if s < 0 and k[C_SUPPORT] != 0 and not _supported(support, seen, cx, cy, t, k[C_SUPPORT_WINDOW]):
+            G[UNSUPPORTED] += 1
+            action = TRACE_UNSUPPORTED
+        elif s < 0:
             evicted_before = G[EVICTED]
             s = _slot_for_new(S, G, t, k, table)
             if s >= 0:
@@ -467,6 +576,11 @@ def run_events(S, H, G, k, table, palette, inv_ww, background_mask, t_us, xs, ys
             updated_reported = S[s, REPORTED] != 0
         if trace is not None:
             trace[i] = (action << 16) | max(s, 0)
+        support[cy, cx] = t
+        seen[cy, cx] = True
+        if not updated_reported:
+            _decay_background(G, t, k, table)
+            G[BG_ACT] = _store(G[BG_ACT] + (np.int64(1) << k[C_FA]), 0, k[C_MAX_ACT], S_ACT, log, ranges)
         if k[C_COLOUR] != 0 and k[C_BG_FIXED] == 0 and not updated_reported:
             G[BG_Y] = _seen(alpha_step_nb(G[BG_Y], lum, k[C_B_BG], k[C_BB_BG], fb, FLOOR), S_BG, ranges)
             G[BG_CB] = _seen(alpha_step_nb(G[BG_CB], cb, k[C_B_BG], k[C_BB_BG], fb, FLOOR), S_BG, ranges)

@@ -26,6 +26,8 @@ MAX_BETA_FRAC_BITS = 32  # a β·x product then fits an int64 for every state fo
 DEAD_BAND_BITS = 6  # guard bits beyond 1/β: an α filter's dead band stays under 2^-6 of its input LSB
 DECAY_TABLE_BITS = 6  # 2^-f for f in [0, 1) in 64 steps
 DECAY_FRAC_BITS = 16
+SCALE_FRAC_BITS = 6  # seek, merge and velocity-agreement scales: steps of 1/64
+NOISE_GATE_FRAC_BITS = 4
 
 
 @dataclasses.dataclass(frozen=True)
@@ -198,6 +200,10 @@ def build_formats(
         Format("inv_ww", False, 33, 0, "intermediate", "2^32 / |palette_j - BG|², refreshed at filter steps"),
         Format("mixing_q", False, 1, 16, "intermediate", "mixing fraction q, clamped to [0, 1]"),
         Format("dt", False, 32, 0, "intermediate", "t - t_last, µs (modulo 2^32)", overflow="wrap"),
+        Format("support_time", False, 32, 0, "state", "creation-support map cell: time of its latest event, µs", overflow="wrap"),
+        Format("merge_moment", False, _bits_for((1 << 16)) + 8 + coord + pos_frac + 1, 8 + pos_frac, "intermediate",
+               "A_s·P_s + A_j·P_j of a merge (activity × centre)"),
+        Format("noise_count", False, 2 * (_bits_for(1 << 16) + 8) + 2, 8, "intermediate", "A·W·H against γ_n·A_bg·box (activity × px²)"),
     ]
     formats = {fmt.name: fmt for fmt in f}
     # |V|^2 squares a full-scale velocity in the speed's fraction bits: it must fit an int64.
@@ -242,6 +248,17 @@ def build_formats(
             const(name, value, False, sq.int_bits, sq.frac_bits, param, f"{name[:-3]}², (px/frame)²")
     const("cos_sq_exit", math.cos(math.radians(p.theta_exit_deg)) ** 2, False, 0, 16, "clusterer.theta_exit_deg", "cos²θ_exit") if p.theta_exit_deg < 90 else None
     const("mixing_tolerance", p.mixing_tolerance, False, 11, 0, "clusterer.mixing_tolerance", "palette mixing tolerance") if p.mixing_tolerance > 0 else None
+    # One cluster per object (beyond the paper).
+    # A scale below half a step is 0: the constant is left out, as a zero margin is.
+    some = lambda v: round(v * (1 << SCALE_FRAC_BITS)) > 0  # noqa: E731
+    const("seek_scale", p.seek_scale, False, _bits_for(p.seek_scale), SCALE_FRAC_BITS, "clusterer.seek_scale", "seek margin per px of max(Rx, Ry)") if some(p.seek_scale) else None
+    const("merge_scale", p.merge_scale, False, _bits_for(p.merge_scale), SCALE_FRAC_BITS, "clusterer.merge_scale", "merge reach per px of max(Rx, Ry)") if some(p.merge_scale) else None
+    vi = formats["v_int"]
+    const("merge_v_tol", p.merge_v_tol, False, vi.int_bits, vi.frac_bits, "clusterer.merge_v_tol", "merge: L1 velocity difference, px/frame") if p.merge_v_tol > 0 else None
+    const("merge_v_rel", p.merge_v_rel, False, _bits_for(p.merge_v_rel), SCALE_FRAC_BITS, "clusterer.merge_v_rel", "merge: velocity difference per px/frame of speed") if some(p.merge_v_rel) else None
+    const("noise_gate", p.noise_gate, False, _bits_for(p.noise_gate), NOISE_GATE_FRAC_BITS, "clusterer.noise_gate", "activity over the background's, per box") if p.noise_gate > 0 else None
+    # t - T <= window for whole µs differences is t - T <= floor(window): the floor is exact.
+    const("support_window", math.floor(p.support_window_us), False, 32, 0, "clusterer.support_window_us", "creation support window, µs") if p.support_window_us >= 1 else None
     for i, (name, ycc) in enumerate(zip(p.palette_names, p.palette_ycbcr())):
         for channel, value in zip(("Y", "CB", "CR"), ycc):
             const(f"palette_{i}_{channel.lower()}", value, False, 8, 0, f"clusterer.palette.{name}", f"palette entry {name} {channel}")
@@ -254,7 +271,10 @@ def build_formats(
 
 # Constants a parameter set may leave out (a zero margin, no luminance weight, ...): the RTL
 # reads them as 0, exactly as the model's constant vector does.
-OPTIONAL_CONSTANTS = ("seek_margin", "exit_margin", "a_min", "a_valid", "v_min_sq", "v_exit_sq", "cos_sq_exit", "mixing_tolerance", "luma_weight")
+OPTIONAL_CONSTANTS = (
+    "seek_margin", "exit_margin", "a_min", "a_valid", "v_min_sq", "v_exit_sq", "cos_sq_exit", "mixing_tolerance", "luma_weight",
+    "seek_scale", "merge_scale", "merge_v_tol", "merge_v_rel", "noise_gate", "support_window",
+)  # fmt: skip
 
 
 def _options(p: ClustererParams, background: Format) -> tuple[tuple[str, int], ...]:
@@ -266,6 +286,7 @@ def _options(p: ClustererParams, background: Format) -> tuple[tuple[str, int], .
         ("WARM_START", int(p.velocity_warm_start)), ("MCM_CORRECT", int(p.mcm_bias_correction)),
         ("VOTE_CONTRAST", int(p.palette_vote == "contrast")), ("MIXING", int(p.palette_assign == "mixing")),
         ("BG_FIXED", int(p.background is not None)), ("BACKGROUND_MASK", mask),
+        ("MERGE", int(p.merge)), ("CREATE_SUPPORT", int(p.create_support)), ("SUPPORT_CELL_BITS", p.support_cell_bits),
         *((f"BG_INIT_{c}", int(round(v * 2**background.frac_bits))) for c, v in zip(("Y", "CB", "CR"), bg)),
     )  # fmt: skip
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from evclust.clusterer.layout import BG_CB, BG_CR, BG_Y, RECORD_COLUMNS, SLOT_COLUMNS, run_stats
+from evclust.clusterer.layout import BG_CB, BG_CR, BG_Y, RECORD_COLUMNS, SLOT_COLUMNS, run_stats, support_shape
 from evclust.clusterer.params import ClustererParams
 from evclust.fixed import fixed_model
 from evclust.fixed.formats import DEAD_BAND_BITS, build_formats, decay_table
@@ -42,6 +42,8 @@ class FixedClusterer:
         fb = self.table["background"].frac_bits
         bg = params.background if params.background is not None else (128.0, 128.0, 128.0)
         self.globals[[BG_Y, BG_CB, BG_CR]] = [int(round(v * 2**fb)) for v in bg]
+        self.support = np.zeros(support_shape(width, height, params.support_cell_bits), dtype=np.int64)
+        self.seen = np.zeros(self.support.shape, dtype=np.bool_)
         self.inv_ww = np.zeros(len(params.palette), dtype=np.int64)
         fixed_model.refresh_mixing(self.globals, self.palette, self.inv_ww, self.k)
         self.overflow = np.zeros(len(fixed_model.SIGNALS), dtype=np.int64)
@@ -58,7 +60,7 @@ class FixedClusterer:
         out = np.empty(((events.size // every + 1) * self.params.n_clusters, RECORD_COLUMNS))
         n = fixed_model.run_events(
             self.slots, self.hist, self.globals, self.k, self.decay, self.palette, self.inv_ww, self.background_mask,
-            events["t"], events["x"], events["y"], events["Y"], events["Cb"], events["Cr"], out, self.overflow, self.ranges,
+            self.support, self.seen, events["t"], events["x"], events["y"], events["Y"], events["Cb"], events["Cr"], out, self.overflow, self.ranges,
             trace,
         )  # fmt: skip
         return out[:n]

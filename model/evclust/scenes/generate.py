@@ -41,6 +41,7 @@ MIN_LOG_CONTRAST = 0.35  # |ln(Y_obj + 1) - ln(Y_bg + 1)| over the whole backgro
 DURATION_S = (3.0, 8.0)
 MIN_FRAMES = 30
 MAX_PIXEL_FRAMES = 2e8  # keeps a scene to a few seconds of simulation
+NOISE_HZ = (0.01, 0.2)  # background activity per pixel, on a third of the scenes: a modern sensor in fair light
 CODEC = ("mp4v", ".mp4")  # OpenCV's MPEG-4 part 2 writer: lossy, in every OpenCV build we ship with
 
 
@@ -220,7 +221,7 @@ def generate_scene(seed: int) -> GeneratedScene:
         objects[max(i, j)] = _cross(rng, objects[min(i, j)], objects[max(i, j)], frames)
 
     noise = bool(rng.random() < 1 / 3)
-    effects = {"background_activity": {"rate_hz": round(_log_uniform(rng, 0.05, 1.0), 4)}} if noise else {}
+    effects = {"background_activity": {"rate_hz": round(_log_uniform(rng, *NOISE_HZ), 4)}} if noise else {}
     threshold = round(float(rng.uniform(0.15, 0.3)), 3)
     max_speed = max((math.hypot(*leg.velocity) for o in objects for leg in o.legs), default=1.0)
     codec = seed % 2 == 0

@@ -43,9 +43,12 @@ SUITE_SPACE = (
     ("beta_chro", 1e-3, 1e-1, "log"),
     ("p_correction", 0.3, 1.0, "linear"),
     ("exit_margin", 0.0, 20.0, "linear"),
+    ("support_window_frames", 0.005, 1.0, "log"),
 )
 SUITE_CATEGORICAL = (
     ("merge", (True, False)),
+    ("create_support", (True, False)),
+    ("support_cell_bits", (0, 1, 2)),
     ("gamma_mode", ("global", "activity", "count")),
     ("palette_vote", ("count", "contrast")),
 )

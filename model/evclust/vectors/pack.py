@@ -10,7 +10,7 @@ from evclust.fixed.formats import FormatTable
 from evclust.tracks import TRACK_DTYPE
 
 # (name, width, signed) per field; events and trace have fixed layouts apart from the coordinates.
-TRACE_FIELDS = (("action", 2, False), ("slot", 8, False))  # action: 0 update, 1 create, 2 evict, 3 drop
+TRACE_FIELDS = (("action", 3, False), ("slot", 8, False))  # action: 0 update, 1 create, 2 evict, 3 drop, 4 unsupported
 
 
 def event_fields(table: FormatTable):
