@@ -9,7 +9,9 @@
 // over all N slots, and applied in EXEC: 2 cycles per event. An event that finds no slot
 // and no free one scans the N slots for the weakest (N + 1 cycles more). Every FILTER_EVERY
 // events the filter step sweeps the table, one slot per cycle, while the mixing palette's
-// 1/|w|^2 entries are refreshed alongside: max(N, PALETTE_SIZE) cycles plus output stalls.
+// 1/|w|^2 entries are refreshed alongside: max(N, PALETTE_SIZE) cycles plus output stalls,
+// plus MERGE_MOMENT_W + 2 cycles per merge (the weighted centre's iterative division).
+// After a reset, INIT fills the mixing table and clears the creation-support map.
 //
 // N, every width and every constant come from evclust_params.vh, generated from the model's
 // formats table (`evclust formats --verilog`).
@@ -36,7 +38,7 @@ module evclust_core (
     localparam integer EV_W = 32 + 2 * EV_XY_W + 1 + 24;
     localparam integer REC_W = 32 + 32 + SLOT_W + 32 + 2 * CENTRE_W + 2 * HALF_SIZE_W + ACTIVITY_W
                              + 2 * V_MCM_W + 2 * V_INT_W + 3 * COLOUR_W + 8 + 4;
-    localparam integer TRACE_W = 10;
+    localparam integer TRACE_W = 11;
     localparam integer SWEEP_LEN = N > P ? N : P;
     localparam integer SWEEP_W = $clog2(SWEEP_LEN + 1);
     localparam integer EVERY_W = $clog2(FILTER_EVERY + 1);
@@ -87,9 +89,19 @@ module evclust_core (
     localparam [SWEEP_W-1:0] LAST_SWEEP = LAST_SWEEP_I[SWEEP_W-1:0];
     localparam [SWEEP_W-1:0] N_SLOTS = N[SWEEP_W-1:0], N_ENTRIES = P[SWEEP_W-1:0];
     localparam integer COS_SQ_F = 16;
+    // One cluster per object (beyond the paper): scaled seek, merging, noise gate, creation support.
+    localparam signed [63:0] K_SEEK_SCALE = $signed({{(64 - SEEK_SCALE_W){1'b0}}, SEEK_SCALE});
+    localparam signed [63:0] K_MERGE_SCALE = $signed({{(64 - MERGE_SCALE_W){1'b0}}, MERGE_SCALE});
+    localparam signed [63:0] K_MERGE_V_TOL = $signed({{(64 - MERGE_V_TOL_W){1'b0}}, MERGE_V_TOL});
+    localparam signed [63:0] K_MERGE_V_REL = $signed({{(64 - MERGE_V_REL_W){1'b0}}, MERGE_V_REL});
+    localparam signed [63:0] K_NOISE_GATE = $signed({{(64 - NOISE_GATE_W){1'b0}}, NOISE_GATE});
+    localparam [31:0] K_SUPPORT_WINDOW = {{(32 - SUPPORT_WINDOW_W){1'b0}}, SUPPORT_WINDOW};
+    localparam signed [63:0] MAX_CENTRE = (64'sd1 <<< CENTRE_W) - 1;
+    localparam signed [63:0] SENSOR_PIXELS = $signed({32'd0, SENSOR_WIDTH[31:0]}) * $signed({32'd0, SENSOR_HEIGHT[31:0]});
+    localparam integer UP = FP - FR;  // R to P's fraction bits
     localparam integer W20_W = MCM_NORM_W - (FW - 20);  // w with 20 fraction bits: the divisor
 
-    localparam [1:0] TRACE_UPDATE = 2'd0, TRACE_CREATE = 2'd1, TRACE_EVICT = 2'd2, TRACE_DROP = 2'd3;
+    localparam [2:0] TRACE_UPDATE = 3'd0, TRACE_CREATE = 3'd1, TRACE_EVICT = 3'd2, TRACE_DROP = 3'd3, TRACE_UNSUPPORTED = 3'd4;
     localparam [3:0] FLAG_NEW = 4'd1, FLAG_BORDER = 4'd2, FLAG_MOVING_MCM = 4'd4, FLAG_MOVING_INT = 4'd8;
 
     // Words of the 64-bit datapath from unsigned and signed fields.
@@ -97,6 +109,17 @@ module evclust_core (
         input [62:0] v;
         begin
             u64 = {1'b0, v};
+        end
+    endfunction
+
+    // The seek margin of a slot in P's format: S + seek_scale * max(Rx, Ry) (model: _margin).
+    function automatic signed [63:0] margin;
+        input [HALF_SIZE_W-1:0] r_x;
+        input [HALF_SIZE_W-1:0] r_y;
+        reg   [HALF_SIZE_W-1:0] r;
+        begin
+            r = r_x > r_y ? r_x : r_y;
+            margin = K_SEEK + align(u64({{(63 - HALF_SIZE_W){1'b0}}, r}) * K_SEEK_SCALE, SEEK_SCALE_FRAC + FR, FP);
         end
     endfunction
 
@@ -195,9 +218,25 @@ module evclust_core (
     reg [TAU_PHASE_W-1:0]      tau_phase;
     reg [EVERY_W-1:0]          since_filter;
     reg                        started;
+    reg [ACTIVITY_W-1:0]       bg_act;       // the activity of the events no reported cluster takes
+    reg [DECAY_RESIDUAL_W-1:0] bg_residual;
+    reg [31:0]                 bg_t;
+
+    // ---------------------------------------------------------------- the creation-support map
+    // One cell per 2^SUPPORT_CELL_BITS px square, a border cell all round (model: layout.support_shape):
+    // the time of the cell's latest event and whether it has one.
+    localparam integer MAP_W = ((SENSOR_WIDTH - 1) >> SUPPORT_CELL_BITS) + 3;
+    localparam integer MAP_H = ((SENSOR_HEIGHT - 1) >> SUPPORT_CELL_BITS) + 3;
+    localparam integer CELLS = CREATE_SUPPORT != 0 ? MAP_W * MAP_H : 1;
+    localparam integer CELL_W = CELLS > 1 ? $clog2(CELLS) : 1;
+    localparam integer LAST_CELL_I = CELLS - 1;
+    localparam [CELL_W-1:0] LAST_CELL = LAST_CELL_I[CELL_W-1:0];
+    reg [SUPPORT_TIME_W-1:0] support_t    [0:CELLS-1];
+    reg                      support_seen [0:CELLS-1];
+    reg [CELL_W-1:0]         init_cell;  // INIT: the cell being cleared
 
     // ---------------------------------------------------------------- control
-    localparam [2:0] ST_INIT = 3'd0, ST_IDLE = 3'd1, ST_EXEC = 3'd2, ST_SCAN = 3'd3, ST_EVICT = 3'd4, ST_SWEEP = 3'd5;
+    localparam [2:0] ST_INIT = 3'd0, ST_IDLE = 3'd1, ST_EXEC = 3'd2, ST_SCAN = 3'd3, ST_EVICT = 3'd4, ST_SWEEP = 3'd5, ST_MERGE = 3'd6;
     reg [2:0]              state;
     reg [SWEEP_W-1:0]      index;        // INIT: palette entry; SCAN: slot; SWEEP: slot and palette entry
     reg [31:0]             e_t;
@@ -246,8 +285,8 @@ module evclust_core (
             seek_dx = abs64(seek_x - u64({{(63 - CENTRE_W){1'b0}}, px[s]}));
             seek_dy = abs64(seek_y - u64({{(63 - CENTRE_W){1'b0}}, py[s]}));
             if (valid[s]
-                    && seek_dx <= (u64({{(63 - HALF_SIZE_W){1'b0}}, rx[s]}) <<< (FP - FR)) + K_SEEK
-                    && seek_dy <= (u64({{(63 - HALF_SIZE_W){1'b0}}, ry[s]}) <<< (FP - FR)) + K_SEEK
+                    && seek_dx <= (u64({{(63 - HALF_SIZE_W){1'b0}}, rx[s]}) <<< (FP - FR)) + margin(rx[s], ry[s])
+                    && seek_dy <= (u64({{(63 - HALF_SIZE_W){1'b0}}, ry[s]}) <<< (FP - FR)) + margin(rx[s], ry[s])
                     && seek_dx + seek_dy < seek_best_d) begin
                 seek_hit = 1'b1;
                 seek_slot = s[SLOT_W-1:0];
@@ -258,7 +297,7 @@ module evclust_core (
 
     // ---------------------------------------------------------------- the decay unit
     // Shared: the updated slot (EXEC), the scanned slot (SCAN, without the residual, as the
-    // model's eviction compares), the swept slot (SWEEP).
+    // model's eviction compares), the swept or merging slot (SWEEP, MERGE).
     wire [SLOT_W-1:0] dec_slot = state == ST_EXEC ? e_slot : index[SLOT_W-1:0];
     wire [ACTIVITY_W-1:0] dec_a;
     wire [DECAY_RESIDUAL_W-1:0] dec_residual;
@@ -271,6 +310,41 @@ module evclust_core (
         .residual_out(dec_residual)
     );
     wire signed [63:0] a_decayed = u64({{(63 - ACTIVITY_W){1'b0}}, dec_a});
+
+    // The background's activity decayed to the event's time (model: _decay_background).
+    wire [ACTIVITY_W-1:0] bg_dec_a;
+    wire [DECAY_RESIDUAL_W-1:0] bg_dec_residual;
+    evclust_decay bg_decay_unit (
+        .activity(bg_act),
+        .dt(e_t - bg_t),
+        .residual(bg_residual),
+        .use_residual(1'b1),
+        .decayed(bg_dec_a),
+        .residual_out(bg_dec_residual)
+    );
+    wire signed [63:0] bg_counted = saturate(u64({{(63 - ACTIVITY_W){1'b0}}, bg_dec_a}) + ONE_A, 0, MAX_ACT);
+
+    // ---------------------------------------------------------------- creation support
+    // Some event of the 3x3 cells around the event's cell at most SUPPORT_WINDOW us old (mod 2^32).
+    wire [31:0] cell_x = {{(32 - EV_XY_W){1'b0}}, e_x} >> SUPPORT_CELL_BITS;
+    wire [31:0] cell_y = {{(32 - EV_XY_W){1'b0}}, e_y} >> SUPPORT_CELL_BITS;
+    wire [31:0] cell_index = (cell_y + 32'd1) * MAP_W + cell_x + 32'd1;
+    wire [CELL_W-1:0] ev_cell = cell_index[CELL_W-1:0];
+    integer ny, nx;
+    reg [31:0] neighbour;
+    reg supported;
+    always @* begin
+        supported = CREATE_SUPPORT == 0;
+        if (CREATE_SUPPORT != 0) begin
+            for (ny = 0; ny < 3; ny = ny + 1) begin
+                for (nx = 0; nx < 3; nx = nx + 1) begin
+                    neighbour = (cell_y + ny) * MAP_W + cell_x + nx;
+                    if (support_seen[neighbour[CELL_W-1:0]] && e_t - support_t[neighbour[CELL_W-1:0]] <= K_SUPPORT_WINDOW)
+                        supported = 1'b1;
+                end
+            end
+        end
+    end
 
     // ---------------------------------------------------------------- step 3: the update
     wire [CLASS_W-1:0] vote_class;
@@ -342,6 +416,7 @@ module evclust_core (
     reg [W20_W-1:0]   f_w20;
     reg [1:0]         f_vi_count;
     reg               f_expire, f_exit, f_left, f_right, f_top, f_bottom, f_moving_mcm, f_moving_int, f_report;
+    reg signed [63:0] f_box;
     reg signed [63:0] f_best;
     reg [7:0]         f_class;
     reg [3:0]         f_flags;
@@ -399,6 +474,10 @@ module evclust_core (
         f_moving_mcm = speed_sq({1'b0, square(f_vmx_raw, FV)} + {1'b0, square(f_vmy_raw, FV)}, FV) >= K_V_MIN_SQ;
         f_moving_int = speed_sq({1'b0, square(f_vix, FI)} + {1'b0, square(f_viy, FI)}, FI) >= K_V_MIN_SQ;
         f_report = a_decayed >= K_A_VALID && (f_moving_mcm || f_moving_int);
+        // The noise gate: A * W * H >= gate * A_bg * (pixels of the box), the gate in Q.NOISE_GATE_FRAC.
+        f_box = (2 * u64({{(63 - HALF_SIZE_W){1'b0}}, rx[k] >> FR}) + 1) * (2 * u64({{(63 - HALF_SIZE_W){1'b0}}, ry[k] >> FR}) + 1);
+        if (K_NOISE_GATE != 0 && f_report)
+            f_report = (a_decayed * SENSOR_PIXELS) <<< NOISE_GATE_FRAC >= K_NOISE_GATE * u64({{(63 - ACTIVITY_W){1'b0}}, bg_act}) * f_box;
         // The class: the strongest non-background histogram entry, none while all are zero.
         f_class = 8'hff;
         f_best = 0;
@@ -421,6 +500,98 @@ module evclust_core (
         f_vmx[V_MCM_W-1:0], f_vmy[V_MCM_W-1:0], f_vix[V_INT_W-1:0], f_viy[V_INT_W-1:0],
         r_cy[COLOUR_W-1:0], r_cb[COLOUR_W-1:0], r_cr[COLOUR_W-1:0], f_class, f_flags
     };
+
+    // ---------------------------------------------------------------- merging (model: _mergeable, _merge)
+    // The swept slot k absorbs the lowest later slot j that is the same object: boxes that
+    // overlap (velocities not disagreeing), or boxes grown by merge_scale * max(R) that overlap
+    // with measured velocities that agree. k stays in the sweep until no such j is left.
+    function automatic signed [63:0] s64v;  // a v_int word, sign-extended
+        input [V_INT_W-1:0] v;
+        begin
+            s64v = $signed({{(64 - V_INT_W){v[V_INT_W-1]}}, v});
+        end
+    endfunction
+    function automatic signed [63:0] c64;  // a centre word
+        input [CENTRE_W-1:0] v;
+        begin
+            c64 = u64({{(63 - CENTRE_W){1'b0}}, v});
+        end
+    endfunction
+    function automatic signed [63:0] r64;  // a half-size word
+        input [HALF_SIZE_W-1:0] v;
+        begin
+            r64 = u64({{(63 - HALF_SIZE_W){1'b0}}, v});
+        end
+    endfunction
+    integer mj;
+    reg signed [63:0] m_dx, m_dy, m_sx, m_sy, m_grow, m_dv, m_fast_k, m_fast_j;
+    reg               m_ok, merge_found;
+    reg [SLOT_W-1:0]  merge_j;
+    always @* begin
+        merge_found = 1'b0;
+        merge_j = {SLOT_W{1'b0}};
+        for (mj = N - 1; mj >= 0; mj = mj - 1) begin
+            m_dx = abs64(c64(px[k]) - c64(px[mj]));
+            m_dy = abs64(c64(py[k]) - c64(py[mj]));
+            m_sx = (r64(rx[k]) + r64(rx[mj])) <<< UP;
+            m_sy = (r64(ry[k]) + r64(ry[mj])) <<< UP;
+            m_grow = align(K_MERGE_SCALE * (r64(rx[k] > ry[k] ? rx[k] : ry[k]) + r64(rx[mj] > ry[mj] ? rx[mj] : ry[mj])), MERGE_SCALE_FRAC + FR, FP);
+            m_dv = abs64(s64v(vix[k]) - s64v(vix[mj])) + abs64(s64v(viy[k]) - s64v(viy[mj]));
+            m_fast_k = abs64(s64v(vix[k])) + abs64(s64v(viy[k]));
+            m_fast_j = abs64(s64v(vix[mj])) + abs64(s64v(viy[mj]));
+            m_ok = m_dx <= m_sx + m_grow && m_dy <= m_sy + m_grow;
+            if (vi_count[k] == 2'd2 && vi_count[mj] == 2'd2)
+                m_ok = m_ok && m_dv <= K_MERGE_V_TOL + ((K_MERGE_V_REL * (m_fast_k > m_fast_j ? m_fast_k : m_fast_j)) >>> MERGE_V_REL_FRAC);
+            else
+                m_ok = m_ok && m_dx <= m_sx && m_dy <= m_sy;
+            if (MERGE != 0 && mj > k && valid[mj] && m_ok) begin
+                merge_found = 1'b1;
+                merge_j = mj[SLOT_W-1:0];
+            end
+        end
+    end
+
+    // The weighted centre (A_k P_k + A_j P_j) / (A_k + A_j), floored, by two iterative dividers.
+    localparam integer MOMENT_W = MERGE_MOMENT_W;
+    reg  [SLOT_W-1:0]     m_j;          // the slot being absorbed
+    reg                   m_started;    // MERGE: the dividers have their operands
+    wire signed [63:0]    m_act_j = u64({{(63 - ACTIVITY_W){1'b0}}, act[m_j]});
+    wire signed [63:0]    m_weight = a_decayed + m_act_j;
+    wire signed [63:0]    m_moment_x = a_decayed * c64(px[k]) + m_act_j * c64(px[m_j]);
+    wire signed [63:0]    m_moment_y = a_decayed * c64(py[k]) + m_act_j * c64(py[m_j]);
+    wire                  div_start = state == ST_MERGE && !m_started;
+    wire                  div_x_done, div_y_done;
+    wire [MOMENT_W-1:0]   div_x_q, div_y_q;
+    evclust_udiv #(.NUM_W(MOMENT_W), .DEN_W(ACTIVITY_W + 1)) div_x (
+        .clk(clk), .rst(rst), .start(div_start),
+        .numerator(m_moment_x[MOMENT_W-1:0]), .denominator(m_weight[ACTIVITY_W:0]),
+        .done(div_x_done), .quotient(div_x_q)
+    );
+    evclust_udiv #(.NUM_W(MOMENT_W), .DEN_W(ACTIVITY_W + 1)) div_y (
+        .clk(clk), .rst(rst), .start(div_start),
+        .numerator(m_moment_y[MOMENT_W-1:0]), .denominator(m_weight[ACTIVITY_W:0]),
+        .done(div_y_done), .quotient(div_y_q)
+    );
+    wire m_write = state == ST_MERGE && m_started && div_x_done && div_y_done;  // the merge's last cycle
+
+    // The merged slot: the survivor (reported before, else the more active) gives the identity,
+    // velocities, colour and histogram; the box covers both boxes; activities and counts add.
+    wire                  m_from_j = (ever_reported[m_j] && !ever_reported[k])
+                                  || (ever_reported[m_j] == ever_reported[k] && m_act_j > a_decayed);
+    wire [SLOT_W-1:0]     m_surv = m_from_j ? m_j : k;
+    wire signed [63:0]    m_px = m_weight == 0 ? c64(px[k]) : u64({{(63 - CENTRE_W){1'b0}}, div_x_q[CENTRE_W-1:0]});
+    wire signed [63:0]    m_py = m_weight == 0 ? c64(py[k]) : u64({{(63 - CENTRE_W){1'b0}}, div_y_q[CENTRE_W-1:0]});
+    wire signed [63:0]    m_lo_x = min64(c64(px[k]) - (r64(rx[k]) <<< UP), c64(px[m_j]) - (r64(rx[m_j]) <<< UP));
+    wire signed [63:0]    m_hi_x = -min64(-(c64(px[k]) + (r64(rx[k]) <<< UP)), -(c64(px[m_j]) + (r64(rx[m_j]) <<< UP)));
+    wire signed [63:0]    m_lo_y = min64(c64(py[k]) - (r64(ry[k]) <<< UP), c64(py[m_j]) - (r64(ry[m_j]) <<< UP));
+    wire signed [63:0]    m_hi_y = -min64(-(c64(py[k]) + (r64(ry[k]) <<< UP)), -(c64(py[m_j]) + (r64(ry[m_j]) <<< UP)));
+    wire signed [63:0]    m_rx = min64((m_hi_x - m_lo_x) >>> (UP + 1), K_R_MAX);
+    wire signed [63:0]    m_ry = min64((m_hi_y - m_lo_y) >>> (UP + 1), K_R_MAX);
+    wire signed [63:0]    m_ppx = saturate(c64(ppx[m_surv]) + m_px - c64(px[m_surv]), 0, MAX_CENTRE);
+    wire signed [63:0]    m_ppy = saturate(c64(ppy[m_surv]) + m_py - c64(py[m_surv]), 0, MAX_CENTRE);
+    wire signed [63:0]    m_act = saturate(m_weight, 0, MAX_ACT);
+    wire signed [63:0]    m_evc = saturate(u64({{(63 - EVENTS_IN_INTERVAL_W){1'b0}}, ev_count[k]})
+                                           + u64({{(63 - EVENTS_IN_INTERVAL_W){1'b0}}, ev_count[m_j]}), 0, MAX_EVCOUNT);
 
     // tau boundaries since the last filter step, from the phase counter; T_frame/(n tau).
     // Dividers sized to their operands: a 33-bit phase by the constant tau, T_frame/tau by a
@@ -450,7 +621,7 @@ module evclust_core (
     wire evict = u64({{(63 - ACTIVITY_W){1'b0}}, weakest_a}) < K_A_VALID;
     reg              do_update, do_create, finish;
     reg [SLOT_W-1:0] create_slot;
-    reg [1:0]        action;
+    reg [2:0]        action;
     reg [SLOT_W-1:0] action_slot;
     always @* begin
         do_update = 1'b0;
@@ -463,6 +634,10 @@ module evclust_core (
             if (e_hit) begin
                 do_update = 1'b1;
                 finish = 1'b1;
+            end else if (!supported) begin  // no cluster, and nothing nearby to start one with
+                finish = 1'b1;
+                action = TRACE_UNSUPPORTED;
+                action_slot = {SLOT_W{1'b0}};
             end else if (e_free) begin
                 do_create = 1'b1;
                 finish = 1'b1;
@@ -486,7 +661,9 @@ module evclust_core (
     // An update of a reported cluster is the object's colour, not the background's.
     wire bg_learns = finish && BG_FIXED == 0 && !(do_update && reported[e_slot]);
     wire sweep_advance = state == ST_SWEEP && (!rec_valid || rec_ready);
-    wire sweep_slot = sweep_advance && index < N_SLOTS && valid[k];
+    wire sweep_live = sweep_advance && index < N_SLOTS && valid[k];
+    wire sweep_merge = sweep_live && !f_expire && merge_found;  // k absorbs merge_j first
+    wire sweep_slot = sweep_live && !sweep_merge;
 
     integer i;
     always @(posedge clk) begin
@@ -499,6 +676,12 @@ module evclust_core (
             rec_valid <= 1'b0;
             rec_data <= {REC_W{1'b0}};
             trace_data <= {TRACE_W{1'b0}};
+            bg_act <= {ACTIVITY_W{1'b0}};
+            bg_residual <= {DECAY_RESIDUAL_W{1'b0}};
+            bg_t <= 32'd0;
+            init_cell <= {CELL_W{1'b0}};
+            m_j <= {SLOT_W{1'b0}};
+            m_started <= 1'b0;
             bg_y <= BG_INIT_Y[BACKGROUND_W-1:0];
             bg_cb <= BG_INIT_CB[BACKGROUND_W-1:0];
             bg_cr <= BG_INIT_CR[BACKGROUND_W-1:0];
@@ -517,10 +700,16 @@ module evclust_core (
             end
         end else begin
             case (state)
-                ST_INIT: begin  // the mixing rule's table for the initial background
-                    inv_ww[refresh_j * INV_WW_W +: INV_WW_W] <= refreshed;
-                    index <= index + 1'b1;
-                    if (index == LAST_ENTRY) begin
+                ST_INIT: begin  // the mixing rule's table for the initial background; the support map cleared
+                    if (index <= LAST_ENTRY) begin
+                        inv_ww[refresh_j * INV_WW_W +: INV_WW_W] <= refreshed;
+                        index <= index + 1'b1;
+                    end
+                    if (CREATE_SUPPORT != 0) begin
+                        support_seen[init_cell] <= 1'b0;
+                        init_cell <= init_cell + 1'b1;
+                    end
+                    if (index >= LAST_ENTRY && (CREATE_SUPPORT == 0 || init_cell == LAST_CELL)) begin
                         index <= {SWEEP_W{1'b0}};
                         state <= ST_IDLE;
                     end
@@ -556,7 +745,10 @@ module evclust_core (
                     if (scan_last)
                         state <= ST_EVICT;
                 end
-                ST_SWEEP: if (sweep_advance) begin
+                ST_SWEEP: if (sweep_merge) begin
+                    m_j <= merge_j;
+                    state <= ST_MERGE;
+                end else if (sweep_advance) begin
                     if (index < N_ENTRIES && MIXING != 0 && BG_FIXED == 0)
                         inv_ww[refresh_j * INV_WW_W +: INV_WW_W] <= refreshed;
                     index <= index + 1'b1;
@@ -566,6 +758,13 @@ module evclust_core (
                         state <= ST_IDLE;
                     end
                 end
+                ST_MERGE: begin  // the dividers started in the first cycle; the slot written in the last
+                    m_started <= 1'b1;
+                    if (m_write) begin
+                        m_started <= 1'b0;
+                        state <= ST_SWEEP;  // the same slot again: it may absorb another
+                    end
+                end
                 default: ;
             endcase
 
@@ -573,6 +772,21 @@ module evclust_core (
             if (finish) begin
                 trace_valid <= 1'b1;
                 trace_data <= {action, {(8 - SLOT_W){1'b0}}, action_slot};
+                if (CREATE_SUPPORT != 0) begin
+                    support_t[ev_cell] <= e_t;
+                    support_seen[ev_cell] <= 1'b1;
+                end
+                // The background's activity counts the event if no reported cluster took it, and
+                // is decayed to the filter step's time before a sweep.
+                if (!(do_update && reported[e_slot])) begin
+                    bg_act <= bg_counted[ACTIVITY_W-1:0];
+                    bg_residual <= bg_dec_residual;
+                    bg_t <= e_t;
+                end else if (sweep_due) begin
+                    bg_act <= bg_dec_a;
+                    bg_residual <= bg_dec_residual;
+                    bg_t <= e_t;
+                end
                 if (bg_learns) begin
                     bg_y <= bg_y_next[BACKGROUND_W-1:0];
                     bg_cb <= bg_cb_next[BACKGROUND_W-1:0];
@@ -638,6 +852,37 @@ module evclust_core (
                 ever_reported[create_slot] <= 1'b0;
                 for (i = 0; i < P; i = i + 1)
                     hist[create_slot * P + i] <= {HIST_W{1'b0}};
+            end
+
+            if (m_write) begin  // k absorbs m_j
+                act[k] <= m_act[ACTIVITY_W-1:0];
+                residual[k] <= dec_residual;
+                t_last[k] <= e_t;
+                px[k] <= m_px[CENTRE_W-1:0];
+                py[k] <= m_py[CENTRE_W-1:0];
+                ppx[k] <= m_ppx[CENTRE_W-1:0];
+                ppy[k] <= m_ppy[CENTRE_W-1:0];
+                rx[k] <= m_rx[HALF_SIZE_W-1:0];
+                ry[k] <= m_ry[HALF_SIZE_W-1:0];
+                ev_count[k] <= m_evc[EVENTS_IN_INTERVAL_W-1:0];
+                if (m_from_j) begin
+                    id[k] <= id[m_j];
+                    gamma[k] <= gamma[m_j];
+                    vmx[k] <= vmx[m_j];
+                    vmy[k] <= vmy[m_j];
+                    norm[k] <= norm[m_j];
+                    vix[k] <= vix[m_j];
+                    viy[k] <= viy[m_j];
+                    vi_count[k] <= vi_count[m_j];
+                    col_y[k] <= col_y[m_j];
+                    col_cb[k] <= col_cb[m_j];
+                    col_cr[k] <= col_cr[m_j];
+                    reported[k] <= reported[m_j];
+                    ever_reported[k] <= ever_reported[m_j];
+                    for (i = 0; i < P; i = i + 1)
+                        hist[k * P + i] <= hist[m_j * P + i];
+                end
+                valid[m_j] <= 1'b0;
             end
 
             if (sweep_slot) begin

@@ -33,7 +33,7 @@ module evclust_tb #(
     reg [EV_W-1:0]  ev_mem    [0:DEPTH-1];
     reg [REC_W-1:0] rec_mem   [0:REC_DEPTH-1];
     reg [31:0]      rec_tag   [0:REC_DEPTH-1];  // events traced when the record left
-    reg [9:0]       trace_mem [0:DEPTH-1];
+    reg [10:0]      trace_mem [0:DEPTH-1];
 
     reg              running;
     reg [31:0]       random;
@@ -43,7 +43,7 @@ module evclust_tb #(
     wire             rec_valid;
     wire [REC_W-1:0] rec_data;
     wire             trace_valid;
-    wire [9:0]       trace_data;
+    wire [10:0]      trace_data;
     wire             filter_active;
     reg              filter_was_active;
     wire             rec_ready = running && random[15:8] >= stall_threshold;

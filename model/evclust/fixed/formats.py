@@ -201,7 +201,7 @@ def build_formats(
         Format("mixing_q", False, 1, 16, "intermediate", "mixing fraction q, clamped to [0, 1]"),
         Format("dt", False, 32, 0, "intermediate", "t - t_last, µs (modulo 2^32)", overflow="wrap"),
         Format("support_time", False, 32, 0, "state", "creation-support map cell: time of its latest event, µs", overflow="wrap"),
-        Format("merge_moment", False, _bits_for((1 << 16)) + 8 + coord + pos_frac + 1, 8 + pos_frac, "intermediate",
+        Format("merge_moment", False, _bits_for((1 << 16)) + coord + 1, 8 + pos_frac, "intermediate",
                "A_s·P_s + A_j·P_j of a merge (activity × centre)"),
         Format("noise_count", False, 2 * (_bits_for(1 << 16) + 8) + 2, 8, "intermediate", "A·W·H against γ_n·A_bg·box (activity × px²)"),
     ]

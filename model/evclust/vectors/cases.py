@@ -133,6 +133,77 @@ def palette_tie() -> Case:
                 source="directed")  # fmt: skip
 
 
+def _bar(x0: float, speed: float, steps: int, dt: int, rows: range, length: int, t0: int = 1000):
+    """Events of a uniform bar `length` px long moving right at `speed` px per step: its leading
+    and trailing edges only, one event per edge pixel and step (a uniform object's events)."""
+    out = []
+    for i in range(steps):
+        lead = int(round(x0 + speed * i))
+        for y in rows:
+            out.append((t0 + dt * i, lead, y, 200, 90, 160))
+            out.append((t0 + dt * i, lead - length, y, 200, 90, 160))
+    return out
+
+
+def merge_edges() -> Case:
+    # A 24 px bar: its two edges start two clusters, which merge once their interval velocities,
+    # measured over 2 ms, agree (the reach of merge_scale·max(R) spans the bar).
+    rows = _bar(x0=30, speed=0.25, steps=120, dt=100, rows=range(18, 30), length=24)
+    return Case("the two edges of a uniform bar: two clusters, merged once their velocities agree", _events(rows), **SMALL,
+                params=_small_params(merge=True, merge_scale=2.0, merge_v_tol=2.0, merge_v_rel=0.25, r_init=2.0, seek_margin=2.0,
+                                     size_gain=2.0, tau_us=2000.0, t_half_us=5000.0), source="directed")  # fmt: skip
+
+
+def merge_overlap() -> Case:
+    # Two blobs side by side grow until their boxes overlap; young (no velocity measured yet),
+    # they merge on the overlap alone. The later blob is the more active: it survives.
+    rng = np.random.default_rng(5)
+    rows = []
+    for i in range(900):
+        left = i % 3 == 0
+        cx = 22 if left else 38
+        rows.append((1000 + 4 * i, cx + int(rng.integers(-5, 6)), 24 + int(rng.integers(-5, 6)), 120 if left else 220, 128, 128))
+    return Case("two growing blobs whose boxes come to overlap: a merge on overlap, the more active survives", _events(rows), **SMALL,
+                params=_small_params(merge=True, merge_scale=0.0, r_init=2.0, seek_margin=1.0, size_gain=2.0, tau_us=1_000_000.0),
+                source="directed")  # fmt: skip
+
+
+def scaled_seek() -> Case:
+    # Events spread over a 30 px square reach a cluster whose margin grows with its size.
+    rng = np.random.default_rng(8)
+    rows = [(1000 + 3 * i, 32 + int(rng.integers(-15, 16)), 24 + int(rng.integers(-15, 16)), 180, 100, 150) for i in range(1500)]
+    return Case("a wide blob caught by a seek margin that grows with the cluster", _events(rows), **SMALL,
+                params=_small_params(seek_scale=0.75, seek_margin=1.0, r_init=2.0, size_gain=1.5), source="directed")  # fmt: skip
+
+
+def noise_gate() -> Case:
+    # A dense blob in sparse noise: the noise gate reports the blob, not the noise clusters.
+    rng = np.random.default_rng(9)
+    rows = []
+    for i in range(3000):
+        if i % 4 == 0:
+            rows.append((1000 + 2 * i, 40 + int(rng.integers(-3, 4)), 20 + int(rng.integers(-3, 4)), 230, 100, 140))
+        else:
+            rows.append((1000 + 2 * i, int(rng.integers(0, 64)), int(rng.integers(0, 48)), 90, 128, 128))
+    return Case("a dense blob in noise: clusters reported only above noise_gate times the background's activity", _events(rows), **SMALL,
+                params=_small_params(noise_gate=6.0, a_valid=2.0, r_init=3.0, seek_margin=3.0, n_clusters=8), source="directed")  # fmt: skip
+
+
+def creation_support() -> Case:
+    # Isolated noise events create nothing; events with a neighbour within 300 µs start clusters.
+    rng = np.random.default_rng(10)
+    rows = []
+    t = 1000
+    for i in range(1500):
+        if i % 5 == 0:  # a small cluster of events: supported by its neighbours
+            rows.append((t, 12 + int(rng.integers(0, 3)), 12 + int(rng.integers(0, 3)), 200, 128, 128))
+        else:
+            rows.append((t, int(rng.integers(0, 64)), int(rng.integers(0, 48)), 60, 128, 128))
+        t += 37
+    return Case("isolated events find no support; neighbouring ones start a cluster (2x2 px cells, 300 µs)", _events(rows), **SMALL,
+                params=_small_params(create_support=True, support_cell_bits=1, support_window_us=300.0), source="directed")  # fmt: skip
+
+
 CASES = {
     "traffic_clip": traffic_clip,
     "pedestrian_clip": pedestrian_clip,
@@ -144,4 +215,9 @@ CASES = {
     "gaps": gaps,
     "borders": borders,
     "palette_tie": palette_tie,
+    "merge_edges": merge_edges,
+    "merge_overlap": merge_overlap,
+    "scaled_seek": scaled_seek,
+    "noise_gate": noise_gate,
+    "creation_support": creation_support,
 }
