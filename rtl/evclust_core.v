@@ -99,6 +99,11 @@ module evclust_core (
     localparam signed [63:0] MAX_CENTRE = (64'sd1 <<< CENTRE_W) - 1;
     localparam signed [63:0] SENSOR_PIXELS = $signed({32'd0, SENSOR_WIDTH[31:0]}) * $signed({32'd0, SENSOR_HEIGHT[31:0]});
     localparam integer UP = FP - FR;  // R to P's fraction bits
+    localparam integer VI_COUNT_MAX_I = VI_CAP > 2 ? VI_CAP : 2;  // vi_count saturates here
+    localparam integer GAIN_W = BETA_VEL_INT_W;
+    localparam [INTERVAL_UPDATES_W-1:0] VI_COUNT_MAX = VI_COUNT_MAX_I[INTERVAL_UPDATES_W-1:0];
+    localparam [INTERVAL_UPDATES_W-1:0] VI_WARM_END = VI_CAP[INTERVAL_UPDATES_W-1:0];
+    localparam [INTERVAL_UPDATES_W-1:0] VI_NONE = 0, VI_FIRST = 1, VI_MEASURED = 2;
     localparam integer W20_W = MCM_NORM_W - (FW - 20);  // w with 20 fraction bits: the divisor
 
     localparam [2:0] TRACE_UPDATE = 3'd0, TRACE_CREATE = 3'd1, TRACE_EVICT = 3'd2, TRACE_DROP = 3'd3, TRACE_UNSUPPORTED = 3'd4;
@@ -120,6 +125,14 @@ module evclust_core (
         begin
             r = r_x > r_y ? r_x : r_y;
             margin = K_SEEK + align(u64({{(63 - HALF_SIZE_W){1'b0}}, r}) * K_SEEK_SCALE, SEEK_SCALE_FRAC + FR, FP);
+        end
+    endfunction
+
+    // The interval filter's warm-up gain 1/n (model: FormatTable.warmup_gains), for 2 <= n < VI_CAP.
+    function automatic signed [63:0] warmup_gain;
+        input [INTERVAL_UPDATES_W-1:0] n;
+        begin
+            warmup_gain = $signed({{(64 - GAIN_W){1'b0}}, WARMUP_GAINS[n * GAIN_W +: GAIN_W]});
         end
     endfunction
 
@@ -200,7 +213,7 @@ module evclust_core (
     reg [MCM_NORM_W-1:0]           norm          [0:N-1];
     reg [V_INT_W-1:0]              vix           [0:N-1];
     reg [V_INT_W-1:0]              viy           [0:N-1];
-    reg [1:0]                      vi_count      [0:N-1];
+    reg [INTERVAL_UPDATES_W-1:0]   vi_count      [0:N-1];  // interval measurements + 1, up to the warm-up's end
     reg [EVENTS_IN_INTERVAL_W-1:0] ev_count      [0:N-1];
     reg [COLOUR_W-1:0]             col_y         [0:N-1];
     reg [COLOUR_W-1:0]             col_cb        [0:N-1];
@@ -414,7 +427,7 @@ module evclust_core (
     reg signed [63:0] f_speed_sq, f_limit, f_per_frame, f_evc;
     reg [2*SQ_MAG_W-1:0] f_sq_x, f_sq_y;
     reg [W20_W-1:0]   f_w20;
-    reg [1:0]         f_vi_count;
+    reg [INTERVAL_UPDATES_W-1:0] f_vi_count;
     reg               f_expire, f_exit, f_left, f_right, f_top, f_bottom, f_moving_mcm, f_moving_int, f_report;
     reg signed [63:0] f_box;
     reg signed [63:0] f_best;
@@ -425,7 +438,7 @@ module evclust_core (
         f_expire = a_decayed < K_A_MIN;
         f_vi_count = vi_count[k];
         f_gamma = u64({{(63 - GAMMA_W){1'b0}}, gamma[k]});
-        if (GAMMA_MODE != 2 || vi_count[k] == 2'd0)
+        if (GAMMA_MODE != 2 || vi_count[k] == VI_NONE)
             f_gamma = saturate(gamma_from_activity(a_decayed), 0, MAX_GAMMA);
         f_px = u64({{(63 - CENTRE_W){1'b0}}, px[k]});
         f_py = u64({{(63 - CENTRE_W){1'b0}}, py[k]});
@@ -435,17 +448,20 @@ module evclust_core (
         f_mx = saturate(align((f_px - u64({{(63 - CENTRE_W){1'b0}}, ppx[k]})) * f_per_frame, FP + FPT_F, FI), MIN_VI, MAX_VI);
         f_my = saturate(align((f_py - u64({{(63 - CENTRE_W){1'b0}}, ppy[k]})) * f_per_frame, FP + FPT_F, FI), MIN_VI, MAX_VI);
         if (boundaries != 33'd0) begin
-            if (GAMMA_MODE == 2 && vi_count[k] != 2'd0)
+            if (GAMMA_MODE == 2 && vi_count[k] != VI_NONE)
                 f_gamma = saturate((f_evc * f_per_frame) >>> (FPT_F - FG), 0, MAX_GAMMA);
             f_evc = 0;
-            if (WARM_START == 0 || vi_count[k] == 2'd2) begin
+            if (WARM_START == 0 || vi_count[k] >= VI_WARM_END) begin
                 f_vix = alpha_step(f_vix, f_mx, K_B_VI, BETA_VEL_INT_FRAC, 0, 1'b0);
                 f_viy = alpha_step(f_viy, f_my, K_B_VI, BETA_VEL_INT_FRAC, 0, 1'b0);
-            end else if (vi_count[k] == 2'd1) begin
+            end else if (vi_count[k] == VI_FIRST) begin  // the first full interval: as it is
                 f_vix = f_mx;
                 f_viy = f_my;
+            end else if (vi_count[k] >= VI_MEASURED) begin  // the warm-up's running mean: gain 1/n
+                f_vix = alpha_step(f_vix, f_mx, warmup_gain(vi_count[k]), BETA_VEL_INT_FRAC, 0, 1'b0);
+                f_viy = alpha_step(f_viy, f_my, warmup_gain(vi_count[k]), BETA_VEL_INT_FRAC, 0, 1'b0);
             end
-            f_vi_count = vi_count[k] == 2'd2 ? 2'd2 : vi_count[k] + 2'd1;
+            f_vi_count = vi_count[k] >= VI_COUNT_MAX ? VI_COUNT_MAX : vi_count[k] + 1'b1;
         end
         // The reported MCM velocity: V / w.
         f_vmx_raw = $signed({{(64 - V_MCM_W){vmx[k][V_MCM_W-1]}}, vmx[k]});
@@ -540,7 +556,7 @@ module evclust_core (
             m_fast_k = abs64(s64v(vix[k])) + abs64(s64v(viy[k]));
             m_fast_j = abs64(s64v(vix[mj])) + abs64(s64v(viy[mj]));
             m_ok = m_dx <= m_sx + m_grow && m_dy <= m_sy + m_grow;
-            if (vi_count[k] == 2'd2 && vi_count[mj] == 2'd2)
+            if (vi_count[k] >= VI_MEASURED && vi_count[mj] >= VI_MEASURED)
                 m_ok = m_ok && m_dv <= K_MERGE_V_TOL + ((K_MERGE_V_REL * (m_fast_k > m_fast_j ? m_fast_k : m_fast_j)) >>> MERGE_V_REL_FRAC);
             else
                 m_ok = m_ok && m_dx <= m_sx && m_dy <= m_sy;
@@ -843,7 +859,7 @@ module evclust_core (
                 norm[create_slot] <= {MCM_NORM_W{1'b0}};
                 vix[create_slot] <= {V_INT_W{1'b0}};
                 viy[create_slot] <= {V_INT_W{1'b0}};
-                vi_count[create_slot] <= 2'd0;
+                vi_count[create_slot] <= {INTERVAL_UPDATES_W{1'b0}};
                 ev_count[create_slot] <= {EVENTS_IN_INTERVAL_W{1'b0}};
                 col_y[create_slot] <= {e_lum, {FC{1'b0}}};
                 col_cb[create_slot] <= {e_cb, {FC{1'b0}}};

@@ -16,7 +16,9 @@ def add_parser(sub) -> None:
         description=(
             "Run the event-by-event clusterer over an event file and write one track record per reported "
             "cluster per filter step (SPEC §4). Parameters come from --params (a TOML file with a [clusterer] "
-            "table, or a preset name), else from the preset of the events' source scene, else the defaults. "
+            "table, or a preset name), else from the preset of the events' source scene, else the defaults, which "
+            "hold across the generalization suite: their time constants are in frames of the event file's frame "
+            "period (printed with the summary). "
             "DVS-only event files run with colour off."
         ),
     )
@@ -38,7 +40,8 @@ def run(args) -> int:
     options = {"ranges": args.ranges, "beta_shift_only": args.beta_shift} if args.model == "fixed" else {}
     result = track_events(events, meta, params, model=args.model, progress=not args.quiet, **options)
     write_tracks(args.output, result.tracks, result.meta)
-    print(f"{args.events}: parameters from {origin}; {result.summary()}")
+    times = params.times(result.meta.t_frame_us)
+    print(f"{args.events}: parameters from {origin} ({times}); {result.summary()}")
     if args.ranges:
         table = result.clusterer.table
         print(f"{'signal':<20} {'format':<9} {'range of the format':<24} {'seen':<26} saturations")

@@ -26,9 +26,9 @@ from evclust.clusterer.layout import (
     K_LUMA_W, K_H_MAX, K_V_MIN, K_EXIT_M, K_V_EXIT, K_COS_EXIT, K_WIDTH, K_HEIGHT, K_COLOUR,
     K_WARM_START, K_MCM_CORRECT, K_VOTE_CONTRAST, K_ASSIGN_MIXING, K_MIX_TOL,
     K_SEEK_SCALE, K_MERGE, K_MERGE_SCALE, K_MERGE_V_TOL, K_MERGE_V_REL, K_NOISE_GATE,
-    K_SUPPORT, K_SUPPORT_BITS, K_SUPPORT_WINDOW,
-) = range(45)  # fmt: skip
-N_PARAMS = 45
+    K_SUPPORT, K_SUPPORT_BITS, K_SUPPORT_WINDOW, K_VI_CAP,
+) = range(46)  # fmt: skip
+N_PARAMS = 46
 LN2 = math.log(2.0)
 
 # Quantisation points: the stores of the signals the formats table gives a format to. With a
@@ -60,6 +60,7 @@ def param_vector(p, width: int, height: int, t_frame_us: float, has_colour: bool
     v[K_SEEK_SCALE], v[K_MERGE], v[K_MERGE_V_TOL], v[K_MERGE_V_REL] = p.seek_scale, p.merge, p.merge_v_tol, p.merge_v_rel
     v[K_NOISE_GATE], v[K_MERGE_SCALE] = p.noise_gate, p.merge_scale
     v[K_SUPPORT], v[K_SUPPORT_BITS], v[K_SUPPORT_WINDOW] = p.create_support, p.support_cell_bits, p.support_window_us
+    v[K_VI_CAP] = p.interval_warmup()
     return v
 
 
@@ -343,13 +344,17 @@ def _filter_step(S, H, G, t, k, palette, background_mask, out, n_out, precision)
             # Eq. (4): V_RI += β_vi ((P - P_prev) · T_frame / τ - V_RI); P_prev = P.
             mx = _q((S[s, PX] - S[s, PPX]) * per_frame, Q_VI, precision)
             my = _q((S[s, PY] - S[s, PPY]) * per_frame, Q_VI, precision)
-            if k[K_WARM_START] == 0.0 or S[s, VI_COUNT] >= 2.0:
+            n = S[s, VI_COUNT]  # full intervals measured before this one, plus one
+            if k[K_WARM_START] == 0.0 or n >= k[K_VI_CAP]:
                 S[s, VIX] = _q(S[s, VIX] + k[B_VI] * (mx - S[s, VIX]), Q_VI, precision)
                 S[s, VIY] = _q(S[s, VIY] + k[B_VI] * (my - S[s, VIY]), Q_VI, precision)
-            elif S[s, VI_COUNT] == 1.0:  # the first full interval: take it as it is
+            elif n == 1.0:  # the first full interval: take it as it is
                 S[s, VIX], S[s, VIY] = mx, my
+            elif n >= 2.0:  # the running mean of the first measurements, until 1/n falls to β
+                S[s, VIX] = _q(S[s, VIX] + (mx - S[s, VIX]) / n, Q_VI, precision)
+                S[s, VIY] = _q(S[s, VIY] + (my - S[s, VIY]) / n, Q_VI, precision)
             # (VI_COUNT 0: the cluster was born inside this interval; its displacement is partial.)
-            S[s, VI_COUNT] = min(S[s, VI_COUNT] + 1.0, 2.0)
+            S[s, VI_COUNT] = min(n + 1.0, max(k[K_VI_CAP], 2.0))
             S[s, PPX], S[s, PPY] = S[s, PX], S[s, PY]
         if _exiting(S, s, k):
             S[s, VALID] = 0.0

@@ -120,6 +120,7 @@ def track_events(
         palette_background=tuple(params.palette_background),
         luma_weight=params.luma_weight,
         seek_margin=params.seek_margin,
+        seek_scale=params.seek_scale,
         exit_margin=params.exit_margin,
         has_colour=has_colour,
     )

@@ -50,9 +50,9 @@ SIGNALS = (
     C_MAX_ACT, C_MAX_V, C_MIN_V, C_MAX_VI, C_MIN_VI, C_MAX_GAMMA,
     C_MAX_EVCOUNT, C_MAX_SIZE_TARGET, C_V_FULL_BITS, C_MAX_SPEED_SQ,
     C_SEEK_SCALE, C_MERGE, C_MERGE_SCALE, C_MERGE_V_TOL, C_MERGE_V_REL, C_SCALE_F, C_NOISE_GATE, C_NOISE_GATE_F,
-    C_SUPPORT, C_SUPPORT_BITS, C_SUPPORT_WINDOW, C_MAX_CENTRE, C_R_MAX_RAW,
-) = range(84)  # fmt: skip
-N_CONSTANTS = 84
+    C_SUPPORT, C_SUPPORT_BITS, C_SUPPORT_WINDOW, C_MAX_CENTRE, C_R_MAX_RAW, C_VI_CAP,
+) = range(85)  # fmt: skip
+N_CONSTANTS = 85
 
 
 def constant_vector(table, params, has_colour: bool) -> np.ndarray:
@@ -102,6 +102,7 @@ def constant_vector(table, params, has_colour: bool) -> np.ndarray:
     k[C_NOISE_GATE], k[C_NOISE_GATE_F] = raw("noise_gate"), NOISE_GATE_FRAC_BITS
     k[C_SUPPORT], k[C_SUPPORT_BITS], k[C_SUPPORT_WINDOW] = params.create_support, params.support_cell_bits, raw("support_window")
     k[C_MAX_CENTRE], k[C_R_MAX_RAW] = f["centre"].raw_max, raw("r_max")
+    k[C_VI_CAP] = params.interval_warmup()
     return k
 
 
@@ -417,7 +418,7 @@ def _box_pixels(S, s, k):
 
 
 @numba.njit(cache=True, nogil=True)
-def _filter_step(S, H, G, t, k, table, palette, inv_ww, background_mask, out, n_out, log, ranges):
+def _filter_step(S, H, G, t, k, table, gains, palette, inv_ww, background_mask, out, n_out, log, ranges):
     # τ boundaries since the last step, from a phase counter (no division of the wrapping time).
     phase = G[TAU_PHASE] + ((t - G[T_FILTER]) & TIME_MASK)
     boundaries = phase // k[C_TAU_US]
@@ -450,12 +451,16 @@ def _filter_step(S, H, G, t, k, table, palette, inv_ww, background_mask, out, n_
             S[s, EV_COUNT] = 0
             mx = _store(_align((S[s, PX] - S[s, PPX]) * per_frame, fp + k[C_FPT_F], fi), k[C_MIN_VI], k[C_MAX_VI], S_VI, log, ranges)
             my = _store(_align((S[s, PY] - S[s, PPY]) * per_frame, fp + k[C_FPT_F], fi), k[C_MIN_VI], k[C_MAX_VI], S_VI, log, ranges)
-            if k[C_WARM] == 0 or S[s, VI_COUNT] >= 2:
+            n = S[s, VI_COUNT]
+            if k[C_WARM] == 0 or n >= k[C_VI_CAP]:
                 S[s, VIX] = alpha_step_nb(S[s, VIX], mx, k[C_B_VI], k[C_BB_VI], 0, FLOOR)
                 S[s, VIY] = alpha_step_nb(S[s, VIY], my, k[C_B_VI], k[C_BB_VI], 0, FLOOR)
-            elif S[s, VI_COUNT] == 1:
+            elif n == 1:
                 S[s, VIX], S[s, VIY] = mx, my
-            S[s, VI_COUNT] = min(S[s, VI_COUNT] + 1, 2)
+            elif n >= 2:  # the warm-up's running mean: gain 1/n from the table
+                S[s, VIX] = alpha_step_nb(S[s, VIX], mx, gains[n], k[C_BB_VI], 0, FLOOR)
+                S[s, VIY] = alpha_step_nb(S[s, VIY], my, gains[n], k[C_BB_VI], 0, FLOOR)
+            S[s, VI_COUNT] = min(n + 1, max(k[C_VI_CAP], 2))
             S[s, PPX], S[s, PPY] = S[s, PX], S[s, PY]
         # The reported MCM velocity: V / w, the sweep's one division.
         vmx, vmy = S[s, VMX], S[s, VMY]
@@ -538,8 +543,8 @@ def _supported(support, seen, cx, cy, t, window):
 
 
 @numba.njit(cache=True, nogil=True)
-def run_events(S, H, G, k, table, palette, inv_ww, background_mask, support, seen, t_us, xs, ys, lums, cbs, crs, out, log, ranges,
-               trace=None):  # fmt: skip
+def run_events(S, H, G, k, table, gains, palette, inv_ww, background_mask, support, seen, t_us, xs, ys, lums, cbs, crs, out, log,
+               ranges, trace=None):  # fmt: skip
     """Feed events; write records into `out`; with `trace` (an int64 array), write each event's
     action << 16 | slot there (a None trace compiles without it). `support` holds each map
     cell's latest event time (32-bit), `seen` whether it has one."""
@@ -588,5 +593,5 @@ def run_events(S, H, G, k, table, palette, inv_ww, background_mask, support, see
         G[SINCE_FILTER] += 1
         if G[SINCE_FILTER] >= k[C_EVERY]:
             G[SINCE_FILTER] = 0
-            n_out = _filter_step(S, H, G, t, k, table, palette, inv_ww, background_mask, out, n_out, log, ranges)
+            n_out = _filter_step(S, H, G, t, k, table, gains, palette, inv_ww, background_mask, out, n_out, log, ranges)
     return n_out

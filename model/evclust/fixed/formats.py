@@ -92,6 +92,9 @@ class FormatTable:
     height: int
     beta_shift_only: bool = False  # every β is a power of two: the filters multiply by shifting
     options: tuple[tuple[str, int], ...] = ()  # the algorithm's switches and counts, as the RTL reads them
+    # The interval filter's warm-up gains 1/n in β_vel_int's format, indexed by n up to the
+    # warm-up's end (VI_CAP); entries 0 and 1 unused (0 skips, 1 takes the measurement as it is).
+    warmup_gains: tuple[int, ...] = (0, 0)
 
     def __getitem__(self, name: str) -> Format:
         return self.formats[name]
@@ -196,7 +199,8 @@ def build_formats(
         Format("vote", False, 10, 0, "intermediate", "palette vote: 1, or |e - BG|₁ rounded"),
         Format("decay_residual", False, 0, 0, "state", "Δt/T_half below one decay-table step (fraction bits set below)"),
         Format("tau_phase", False, _bits_for(p.tau_us), 0, "state", "µs since the last τ boundary"),
-        Format("interval_updates", False, 2, 0, "state", "interval velocity warm-start state: 0, 1, 2"),
+        Format("interval_updates", False, _bits_for(max(p.interval_warmup(), 2)), 0, "state",
+               "interval measurements so far + 1, up to the warm-up's end (0: born in this interval)"),
         Format("inv_ww", False, 33, 0, "intermediate", "2^32 / |palette_j - BG|², refreshed at filter steps"),
         Format("mixing_q", False, 1, 16, "intermediate", "mixing fraction q, clamped to [0, 1]"),
         Format("dt", False, 32, 0, "intermediate", "t - t_last, µs (modulo 2^32)", overflow="wrap"),
@@ -266,7 +270,10 @@ def build_formats(
     residual_bits = table["inv_t_half"].fmt.frac_bits - DECAY_TABLE_BITS
     formats["decay_residual"] = dataclasses.replace(formats["decay_residual"], frac_bits=residual_bits)
     formats["decay_table"] = Format("decay_table", False, 1, DECAY_FRAC_BITS, "constant", "2^-(i/64), i = 0..63 (entry 0 is 1.0)", rounding="nearest")
-    return FormatTable(formats, table, p.n_clusters, len(p.palette), width, height, beta_shift_only, _options(p, formats["background"]))
+    vi_frac = table["beta_vel_int"].fmt.frac_bits
+    gains = (0, 0) + tuple(int(round((1 << vi_frac) / n)) for n in range(2, max(p.interval_warmup(), 2)))
+    return FormatTable(formats, table, p.n_clusters, len(p.palette), width, height, beta_shift_only,
+                       _options(p, formats["background"]), gains)  # fmt: skip
 
 
 # Constants a parameter set may leave out (a zero margin, no luminance weight, ...): the RTL
@@ -287,6 +294,7 @@ def _options(p: ClustererParams, background: Format) -> tuple[tuple[str, int], .
         ("VOTE_CONTRAST", int(p.palette_vote == "contrast")), ("MIXING", int(p.palette_assign == "mixing")),
         ("BG_FIXED", int(p.background is not None)), ("BACKGROUND_MASK", mask),
         ("MERGE", int(p.merge)), ("CREATE_SUPPORT", int(p.create_support)), ("SUPPORT_CELL_BITS", p.support_cell_bits),
+        ("VI_CAP", p.interval_warmup()),
         *((f"BG_INIT_{c}", int(round(v * 2**background.frac_bits))) for c, v in zip(("Y", "CB", "CR"), bg)),
     )  # fmt: skip
 
@@ -389,6 +397,7 @@ def _verilog_lines(table: FormatTable) -> str:
         out.append(f"localparam [{DECAY_FRAC_BITS}:0] DECAY_{i} = {DECAY_FRAC_BITS + 1}'d{raw};")
     # Packed copies for indexing, entry 0 in the lowest bits: TABLE[i*W +: W].
     out.append(_packed("DECAY_TABLE", entries, DECAY_FRAC_BITS + 1))
+    out.append(_packed("WARMUP_GAINS", list(table.warmup_gains), table.formats["beta_vel_int"].word_bits))
     for channel in ("y", "cb", "cr"):
         out.append(_packed(f"PALETTE_{channel.upper()}", [table.constants[f"palette_{j}_{channel}"].raw for j in range(table.palette_size)], 8))
     for name, value in table.options:

@@ -34,6 +34,7 @@ class FixedClusterer:
         self.table = build_formats(params, width, height, t_frame_us, beta_shift_only=beta_shift_only, dead_band_bits=dead_band_bits)
         self.k = fixed_model.constant_vector(self.table, params, has_colour)
         self.decay = np.asarray(decay_table(self.table), dtype=np.int64)
+        self.gains = np.asarray(self.table.warmup_gains, dtype=np.int64)
         self.palette = np.array([[self.table.constants[f"palette_{j}_{c}"].raw for c in ("y", "cb", "cr")] for j in range(len(params.palette))], dtype=np.int64)
         self.background_mask = params.background_mask()
         self.slots = np.zeros((params.n_clusters, len(SLOT_COLUMNS)), dtype=np.int64)
@@ -59,7 +60,7 @@ class FixedClusterer:
         every = self.params.filter_every
         out = np.empty(((events.size // every + 1) * self.params.n_clusters, RECORD_COLUMNS))
         n = fixed_model.run_events(
-            self.slots, self.hist, self.globals, self.k, self.decay, self.palette, self.inv_ww, self.background_mask,
+            self.slots, self.hist, self.globals, self.k, self.decay, self.gains, self.palette, self.inv_ww, self.background_mask,
             self.support, self.seen, events["t"], events["x"], events["y"], events["Y"], events["Cb"], events["Cr"], out, self.overflow, self.ranges,
             trace,
         )  # fmt: skip

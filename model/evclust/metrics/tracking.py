@@ -36,6 +36,8 @@ class FramePairs:
     similarity: list  # per sample: (n_gt, n_track) in [0, 1]
     matches: np.ndarray  # one row per pair with similarity >= MATCH_SIMILARITY (MATCH_FIELDS)
     objects: dict  # object id -> ObjectSummary over its care samples
+    frames: np.ndarray  # the frame of each sample
+    failures: np.ndarray  # (samples, len(FAILURES)): each sample's unmatched objects and records, by kind
 
     @property
     def n_objects(self) -> int:
@@ -56,12 +58,38 @@ class ObjectSummary:
     size: float  # mean larger side, px
 
 
+# What an unmatched object or record was: an object with no record within its radius (missed),
+# one whose nearest record is within its radius but off-centre (sim < MATCH_SIMILARITY); a record
+# within some object's radius that is not its match (a fragment or an off-centre cluster), one
+# near no object at all (a ghost).
+FAILURES = ("missed", "off_centre", "fragment", "ghost")
+
+
+def _failures(sim: np.ndarray, gi: np.ndarray, ti: np.ndarray, ok: np.ndarray) -> list[int]:
+    matched_g, matched_t = set(gi[ok].tolist()), set(ti[ok].tolist())
+    missed = off = fragment = ghost = 0
+    for g in range(sim.shape[0]):
+        if g not in matched_g:
+            if sim.shape[1] == 0 or sim[g].max() == 0:
+                missed += 1
+            else:
+                off += 1
+    for t in range(sim.shape[1]):
+        if t not in matched_t:
+            if sim.shape[0] and sim[:, t].max() > 0:
+                fragment += 1
+            else:
+                ghost += 1
+    return [missed, off, fragment, ghost]
+
+
 MATCH_FIELDS = np.dtype([
     ("frame", np.int64), ("gt_id", np.int64), ("track_id", np.int64), ("d", np.float64), ("radius", np.float64),
     ("vx_mcm", np.float64), ("vy_mcm", np.float64), ("vx_int", np.float64), ("vy_int", np.float64),
     ("gt_vx", np.float64), ("gt_vy", np.float64), ("Y", np.float64), ("Cb", np.float64), ("Cr", np.float64),
     ("gt_Y", np.float64), ("gt_Cb", np.float64), ("gt_Cr", np.float64), ("class_palette", np.int32),
     ("class_direct", np.int32), ("gt_label", "U32"),
+    ("steady", np.bool_),  # the object moves, with the velocity it had one second earlier
 ])  # fmt: skip
 
 
@@ -73,14 +101,24 @@ def radius(w, h):
 def frame_pairs(tracks: np.ndarray, meta: TrackMeta, truth, min_visible: float = MIN_VISIBLE) -> FramePairs:
     truth = truth_array(truth)
     t_frame = float(meta.t_frame_us)
-    step_times = np.unique(tracks["t_us"]) if tracks.size else np.empty(0, np.uint64)
-    order = np.argsort(tracks["t_us"], kind="stable")
-    sorted_t = tracks["t_us"][order]
+    # Filter steps in order, each with its time: several steps can share a microsecond (a burst
+    # of simultaneous events), so a sample takes the last step, not every record of that time.
+    order = np.lexsort((tracks["step"], tracks["t_us"]))
+    sorted_step = tracks["step"][order].astype(np.int64)
+    starts = np.flatnonzero(np.r_[True, sorted_step[1:] != sorted_step[:-1]]) if order.size else np.empty(0, np.int64)
+    step_times = tracks["t_us"][order][starts].astype(np.float64)
+    bounds = np.r_[starts, order.size]
     by_frame: dict[int, np.ndarray] = {}
     for k in np.unique(truth["frame"]):
         by_frame[int(k)] = np.flatnonzero(truth["frame"] == k)
     where = {(int(f), int(i)): r for r, (f, i) in enumerate(zip(truth["frame"], truth["id"]))}
-    gt_ids, track_ids, sims, rows = [], [], [], []
+    second = max(1, int(round(1e6 / t_frame)))  # frames in one second
+
+    def steady(row) -> bool:
+        back = where.get((int(truth["frame"][row]) - second, int(truth["id"][row])))
+        v = (truth["vx"][row], truth["vy"][row])
+        return back is not None and (v[0] or v[1]) and (truth["vx"][back], truth["vy"][back]) == v
+    gt_ids, track_ids, sims, rows, frames, failures = [], [], [], [], [], []
     objects: dict[int, list] = {}
     for k in sorted(by_frame):
         if k < 1:
@@ -90,8 +128,7 @@ def frame_pairs(tracks: np.ndarray, meta: TrackMeta, truth, min_visible: float =
         j = int(np.searchsorted(step_times, t_k, side="right")) - 1
         if j >= 0:
             t_s = int(step_times[j])
-            lo, hi = np.searchsorted(sorted_t, t_s), np.searchsorted(sorted_t, t_s, side="right")
-            records = order[lo:hi]
+            records = order[bounds[j] : bounds[j + 1]]
         else:
             t_s, records = t_k, np.empty(0, np.int64)
         # True centres at the step's time, interpolated between the rows around it.
@@ -127,9 +164,11 @@ def frame_pairs(tracks: np.ndarray, meta: TrackMeta, truth, min_visible: float =
             objects.setdefault(int(truth["id"][row]), []).append(
                 (float(radius(truth["w"][row], truth["h"][row])), math.hypot(truth["vx"][row], truth["vy"][row]), max(truth["w"][row], truth["h"][row]))
             )
+        gi, ti = linear_sum_assignment(-sim_c) if sim_c.size else (np.empty(0, np.int64), np.empty(0, np.int64))
+        ok = sim_c[gi, ti] >= MATCH_SIMILARITY
+        frames.append(k)
+        failures.append(_failures(sim_c, gi, ti, ok))
         if sim_c.size:
-            gi, ti = linear_sum_assignment(-sim_c)
-            ok = sim_c[gi, ti] >= MATCH_SIMILARITY
             for g, t in zip(gi[ok].tolist(), ti[ok].tolist()):
                 row, rec = objs[care][g], recs_c[t]
                 rows.append((
@@ -137,12 +176,14 @@ def frame_pairs(tracks: np.ndarray, meta: TrackMeta, truth, min_visible: float =
                     tracks["vx_mcm"][rec], tracks["vy_mcm"][rec], tracks["vx_int"][rec], tracks["vy_int"][rec],
                     truth["vx"][row], truth["vy"][row], tracks["Y"][rec], tracks["Cb"][rec], tracks["Cr"][rec],
                     truth["Y"][row], truth["Cb"][row], truth["Cr"][row], tracks["class"][rec], -1, truth["label"][row],
+                    steady(row),
                 ))  # fmt: skip
     matches = np.array(rows, dtype=MATCH_FIELDS) if rows else np.zeros(0, MATCH_FIELDS)
     if matches.size:
         matches["class_direct"] = nearest_palette_class(np.stack([matches["Y"], matches["Cb"], matches["Cr"]], axis=1), meta)
     summary = {i: ObjectSummary(len(vals), *(float(np.mean([v[c] for v in vals])) for c in range(3))) for i, vals in objects.items()}
-    return FramePairs(gt_ids, track_ids, sims, matches, summary)
+    return FramePairs(gt_ids, track_ids, sims, matches, summary, np.array(frames, np.int64),
+                      np.array(failures, np.int64).reshape(-1, len(FAILURES)))
 
 
 def trackeval_data(pairs: FramePairs) -> dict:
@@ -213,21 +254,24 @@ def accuracy(matches: np.ndarray, meta: TrackMeta) -> dict:
     out = {"n_matches": int(m.size)}
     if m.size == 0:
         return out | {k: None for k in ("position_rel_rmse", "mcm_nrmse", "interval_nrmse", "mcm_angle_deg", "interval_angle_deg",
-                                         "luminance_nrmse", "chrominance_nrmse", "class_palette", "class_direct")}  # fmt: skip
+                                         "mcm_nrmse_steady", "interval_nrmse_steady", "mcm_angle_deg_steady", "interval_angle_deg_steady",
+                                         "steady_share", "luminance_nrmse", "chrominance_nrmse", "class_palette", "class_direct")}  # fmt: skip
     out["position_rel_rmse"] = float(np.sqrt(np.mean((m["d"] / m["radius"]) ** 2)))
     gt = np.stack([m["gt_vx"], m["gt_vy"]], axis=1)
     moving = np.hypot(gt[:, 0], gt[:, 1]) > 0
-    for method, (vx, vy) in (("mcm", ("vx_mcm", "vy_mcm")), ("interval", ("vx_int", "vy_int"))):
-        est = np.stack([m[vx], m[vy]], axis=1)[moving]
-        g = gt[moving]
-        if g.size == 0:
-            out[f"{method}_nrmse"] = out[f"{method}_angle_deg"] = None
-            continue
-        rmse = float(np.sqrt(np.mean(((est - g) ** 2).sum(axis=1))))
-        out[f"{method}_nrmse"] = rmse / float(np.mean(np.hypot(g[:, 0], g[:, 1])))
-        norm = np.hypot(est[:, 0], est[:, 1])
-        cos = np.where(norm > 0, (est * g).sum(axis=1) / np.maximum(norm * np.hypot(g[:, 0], g[:, 1]), 1e-300), 0.0)
-        out[f"{method}_angle_deg"] = float(np.degrees(np.arccos(np.clip(cos, -1, 1))).mean())
+    for suffix, chosen in (("", moving), ("_steady", moving & m["steady"])):
+        for method, (vx, vy) in (("mcm", ("vx_mcm", "vy_mcm")), ("interval", ("vx_int", "vy_int"))):
+            est = np.stack([m[vx], m[vy]], axis=1)[chosen]
+            g = gt[chosen]
+            if g.size == 0:
+                out[f"{method}_nrmse{suffix}"] = out[f"{method}_angle_deg{suffix}"] = None
+                continue
+            rmse = float(np.sqrt(np.mean(((est - g) ** 2).sum(axis=1))))
+            out[f"{method}_nrmse{suffix}"] = rmse / float(np.mean(np.hypot(g[:, 0], g[:, 1])))
+            norm = np.hypot(est[:, 0], est[:, 1])
+            cos = np.where(norm > 0, (est * g).sum(axis=1) / np.maximum(norm * np.hypot(g[:, 0], g[:, 1]), 1e-300), 0.0)
+            out[f"{method}_angle_deg{suffix}"] = float(np.degrees(np.arccos(np.clip(cos, -1, 1))).mean())
+    out["steady_share"] = float(np.count_nonzero(moving & m["steady"]) / max(1, np.count_nonzero(moving)))
     if meta.has_colour:
         out["luminance_nrmse"] = float(np.sqrt(np.mean((m["Y"] - m["gt_Y"]) ** 2)) / np.mean(m["gt_Y"]))
         chro = np.sqrt(np.mean(((m["Cb"] - m["gt_Cb"]) ** 2 + (m["Cr"] - m["gt_Cr"]) ** 2) / 2))

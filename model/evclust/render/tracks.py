@@ -134,7 +134,7 @@ def draw_tracks(canvas: np.ndarray, records: np.ndarray, meta: TrackMeta, scale:
     h, w = canvas.shape[:2]
     for r in records:
         x, y, rx, ry = float(r["x"]), float(r["y"]), float(r["rx"]), float(r["ry"])
-        s = float(meta.seek_margin)
+        s = float(meta.seek_margin) + float(meta.seek_scale) * max(rx, ry)
         if s > 0:
             x0, y0 = to_canvas([x - rx - s, y - ry - s], scale)
             x1, y1 = to_canvas([x + rx + s, y + ry + s], scale)

@@ -28,6 +28,8 @@ class SceneResult:
     matches: np.ndarray  # tracking.MATCH_FIELDS
     objects: dict  # object id -> tracking.ObjectSummary
     meta: object  # the track file's TrackMeta (palette, colour)
+    frames: np.ndarray  # the frame of each sample
+    failures: np.ndarray  # per sample, unmatched objects and records by kind (tracking.FAILURES)
 
     @property
     def recall(self) -> float | None:
@@ -55,5 +57,5 @@ def evaluate_scene(files: SceneFiles, params: ClustererParams, model: str = "flo
     return SceneResult(
         name=files.name, facts=files.facts, model=model, events=int(events.size), wall_s=wall, stats=run.stats,
         trackeval=tracking.evaluate_sequence(pairs) if trackeval else None, n_objects=pairs.n_objects, n_records=pairs.n_records,
-        matches=pairs.matches, objects=pairs.objects, meta=run.meta,
+        matches=pairs.matches, objects=pairs.objects, meta=run.meta, frames=pairs.frames, failures=pairs.failures,
     )  # fmt: skip

@@ -61,6 +61,7 @@ class TrackMeta:
     palette_background: tuple[str, ...] = ()  # entries that are background, never a class
     luma_weight: float = 1.0  # weight of |ΔY| in the palette's L1 distance
     seek_margin: float = 0.0  # S: the seek region is the box grown by S on every side, px
+    seek_scale: float = 0.0  # ... plus seek_scale·max(rx, ry) (beyond the paper)
     exit_margin: float = 0.0  # M: the border band where exit prediction acts, px
     has_colour: bool = True
 

@@ -90,6 +90,7 @@ def tune(
 
     optuna.logging.set_verbosity(optuna.logging.WARNING)
     t_frame_us = float(base.t_frame_us or meta.t_frame_us)
+    base = base.resolved(t_frame_us)  # the search moves times in µs (τ in frames of this stream)
     start = trial_values(base, t_frame_us)
     # Each range grows to hold the starting value, so the first trial is exactly the base set.
     space = [

@@ -44,7 +44,11 @@ SUITE_SPACE = (
     ("p_correction", 0.3, 1.0, "linear"),
     ("exit_margin", 0.0, 20.0, "linear"),
     ("support_window_frames", 0.005, 1.0, "log"),
+    ("gamma", 10.0, 2000.0, "log"),
 )
+# Scales the fixed model holds in steps of 1/64 (formats.SCALE_FRAC_BITS): searched on that grid,
+# so that the float and the fixed model use the same value.
+ON_SCALE_GRID = ("seek_scale", "merge_scale", "merge_v_rel")
 SUITE_CATEGORICAL = (
     ("merge", (True, False)),
     ("create_support", (True, False)),
@@ -80,7 +84,8 @@ def values_of(p: ClustererParams) -> dict:
 def suggest(trial, base: ClustererParams) -> ClustererParams:
     values = {}
     for name, low, high, scale in SUITE_SPACE:
-        values[name] = trial.suggest_float(name, low, high, log=scale == "log")
+        step = 1 / 64 if name in ON_SCALE_GRID else None
+        values[name] = trial.suggest_float(name, low, high, log=scale == "log", step=step)
     for name, choices in SUITE_CATEGORICAL:
         values[name] = trial.suggest_categorical(name, list(choices))
     return params_from_values(values, base)
@@ -139,6 +144,8 @@ def tune_suite(
     import optuna
 
     optuna.logging.set_verbosity(optuna.logging.WARNING)
+    if storage.startswith("sqlite:///"):
+        Path(storage[len("sqlite:///"):]).parent.mkdir(parents=True, exist_ok=True)
     try:
         study = optuna.create_study(study_name=study_name, storage=storage, direction="minimize", load_if_exists=True)
     except Exception as exc:  # a bad URL, an unreachable database
