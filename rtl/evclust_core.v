@@ -96,7 +96,8 @@ module evclust_core (
     localparam signed [63:0] K_MERGE_V_REL = $signed({{(64 - MERGE_V_REL_W){1'b0}}, MERGE_V_REL});
     localparam signed [63:0] K_NOISE_GATE = $signed({{(64 - NOISE_GATE_W){1'b0}}, NOISE_GATE});
     localparam [31:0] K_SUPPORT_WINDOW = {{(32 - SUPPORT_WINDOW_W){1'b0}}, SUPPORT_WINDOW};
-    localparam signed [63:0] MAX_CENTRE = (64'sd1 <<< CENTRE_W) - 1;
+    localparam signed [63:0] LAST_X = ($signed({32'd0, SENSOR_WIDTH[31:0]}) - 64'sd1) <<< FP;  // the last column, in P's format
+    localparam signed [63:0] LAST_Y = ($signed({32'd0, SENSOR_HEIGHT[31:0]}) - 64'sd1) <<< FP;
     localparam signed [63:0] SENSOR_PIXELS = $signed({32'd0, SENSOR_WIDTH[31:0]}) * $signed({32'd0, SENSOR_HEIGHT[31:0]});
     localparam integer UP = FP - FR;  // R to P's fraction bits
     localparam integer VI_COUNT_MAX_I = VI_CAP > 2 ? VI_CAP : 2;  // vi_count saturates here
@@ -603,8 +604,8 @@ module evclust_core (
     wire signed [63:0]    m_hi_y = -min64(-(c64(py[k]) + (r64(ry[k]) <<< UP)), -(c64(py[m_j]) + (r64(ry[m_j]) <<< UP)));
     wire signed [63:0]    m_rx = min64((m_hi_x - m_lo_x) >>> (UP + 1), K_R_MAX);
     wire signed [63:0]    m_ry = min64((m_hi_y - m_lo_y) >>> (UP + 1), K_R_MAX);
-    wire signed [63:0]    m_ppx = saturate(c64(ppx[m_surv]) + m_px - c64(px[m_surv]), 0, MAX_CENTRE);
-    wire signed [63:0]    m_ppy = saturate(c64(ppy[m_surv]) + m_py - c64(py[m_surv]), 0, MAX_CENTRE);
+    wire signed [63:0]    m_ppx = saturate(c64(ppx[m_surv]) + m_px - c64(px[m_surv]), 0, LAST_X);  // inside the sensor
+    wire signed [63:0]    m_ppy = saturate(c64(ppy[m_surv]) + m_py - c64(py[m_surv]), 0, LAST_Y);
     wire signed [63:0]    m_act = saturate(m_weight, 0, MAX_ACT);
     wire signed [63:0]    m_evc = saturate(u64({{(63 - EVENTS_IN_INTERVAL_W){1'b0}}, ev_count[k]})
                                            + u64({{(63 - EVENTS_IN_INTERVAL_W){1'b0}}, ev_count[m_j]}), 0, MAX_EVCOUNT);

@@ -25,7 +25,10 @@ def selected_simulators() -> tuple[str, ...]:
 # set different guard bits, hence different widths), and a small sensor whose parameters switch
 # on what the presets leave off (a learning background with the mixing table refreshed at every
 # filter step, γ counted per interval, frequent filter steps). Name: (width, height, T_frame).
-CONFIGURATIONS = {"traffic": (480, 270, 50000.0), "pedestrian": (270, 480, 40000.0), "small": (64, 48, 10000.0)}
+# "defaults": the default configuration (every one-cluster-per-object addition on, times in
+# frames) on a suite-sized sensor, with the creation-support map switched on too.
+CONFIGURATIONS = {"traffic": (480, 270, 50000.0), "pedestrian": (270, 480, 40000.0), "small": (64, 48, 10000.0),
+                  "defaults": (160, 120, 16666.0)}  # fmt: skip
 # The formats table's other shapes (build_formats options), on the traffic parameters: every β a
 # power of two, and the narrowest filter states (no guard bits beyond 1/β).
 FORMAT_VARIANTS = {"shift_only": {"beta_shift_only": True}, "no_guard_bits": {"dead_band_bits": 0}}
@@ -37,6 +40,10 @@ def configuration_params(name: str, n_clusters: int):
 
     if name == "small":
         return _small_params(n_clusters=n_clusters, gamma_mode="count", a_valid=6.0)
+    if name == "defaults":
+        from evclust.clusterer import ClustererParams
+
+        return ClustererParams(n_clusters=n_clusters, create_support=True)
     params, _ = load_params(name)
     return params.model_copy(update={"n_clusters": n_clusters})
 

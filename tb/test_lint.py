@@ -20,9 +20,11 @@ def test_the_reference_rtl_is_lint_clean():
     assert lint() == ""
 
 
-@pytest.mark.parametrize("case", ["table_full", "palette_tie", "pedestrian_clip"])
+@pytest.mark.parametrize("case", ["table_full", "palette_tie", "pedestrian_clip", "suite_clip", "creation_support", "merge_edges"])
 def test_the_rtl_is_lint_clean_for_other_parameter_sets(case):
-    # N = 4; nearest palette with a fixed background; another sensor and other formats.
+    # N = 4; nearest palette with a fixed background; another sensor and other formats; the
+    # default configuration (merging, scaled seek, noise gate, warm-up); the support map; merging
+    # with a warm-up table.
     assert lint(load_case(VECTORS / case).header) == ""
 
 

@@ -13,7 +13,7 @@ from evclust.errors import EvclustError
 from evclust.events import EVENT_DTYPE, EventMeta
 from evclust.metrics.convergence import converged_after
 
-from conftest import simulate_toml
+from conftest import classic_params, simulate_toml
 
 FPS = 100.0
 T_FRAME = 1e6 / FPS
@@ -44,7 +44,7 @@ legs = [{leg_text}]
 
 def run(text, **overrides):
     sim = simulate_toml(text)
-    params = ClustererParams(**{"v_min": 0.0, **overrides})
+    params = classic_params(**{"v_min": 0.0, **overrides})
     return sim, track_events(sim.events, sim.meta, params)
 
 
@@ -126,11 +126,11 @@ def test_pure_background_noise_is_never_reported_when_the_velocity_filter_is_on(
     meta = EventMeta(width=width, height=height, source="noise", t_frame_us=T_FRAME)
     params = dict(alpha_vel_mcm=0.999, alpha_vel_int=0.9, a_valid=5.0, seek_margin=4.0, r_max=10.0)
     # The filter must be what hides the noise: without it, noise clusters are reported.
-    without = track_events(ev, meta, ClustererParams(v_min=0.0, **params))
+    without = track_events(ev, meta, classic_params(v_min=0.0, **params))
     assert without.tracks.size > 0
     # Noise moves a cluster's centre at random: its velocity estimates average to zero, with a
     # spread far below 1 px/frame for these memories.
-    with_filter = track_events(ev, meta, ClustererParams(v_min=1.0, **params))
+    with_filter = track_events(ev, meta, classic_params(v_min=1.0, **params))
     assert with_filter.tracks.size == 0
 
 
@@ -155,7 +155,7 @@ def table_events(points):
 
 
 def test_full_table_evicts_the_least_active_cluster_below_a_valid_and_drops_otherwise():
-    params = ClustererParams(n_clusters=2, a_valid=5.0, a_min=0.0, filter_every=10**6, seek_margin=2.0, t_half_us=1e9, r_init=3.0)
+    params = classic_params(n_clusters=2, a_valid=5.0, a_min=0.0, filter_every=10**6, seek_margin=2.0, t_half_us=1e9, r_init=3.0)
     model = FloatClusterer(params, 100, 100, T_FRAME)
     # Slot 0: 6 events at (10, 10) -> activity 6 (no decay). Slot 1: 2 events at (50, 50) -> 2.
     model.feed(table_events([(i, 10, 10) for i in range(6)] + [(10 + i, 50, 50) for i in range(2)]))
@@ -175,7 +175,7 @@ def test_full_table_evicts_the_least_active_cluster_below_a_valid_and_drops_othe
 
 
 def test_ties_go_to_the_lower_slot():
-    params = ClustererParams(n_clusters=4, seek_margin=10.0, filter_every=10**6, r_init=2.0)
+    params = classic_params(n_clusters=4, seek_margin=10.0, filter_every=10**6, r_init=2.0)
     model = FloatClusterer(params, 100, 100, T_FRAME)
     model.feed(table_events([(0, 20, 20), (1, 40, 20)]))  # two clusters, 20 px apart
     model.feed(table_events([(2, 30, 20)]))  # equidistant: L1 10 from both
@@ -209,7 +209,7 @@ def test_p_correction_recovers_the_object_colour_on_a_uniform_background():
     q = (sim.events["Y"].astype(float) - bg_ycc[0]) / (obj_ycc[0] - bg_ycc[0])
     p = float(np.mean(q))
     assert 0.2 < p < 0.9
-    params = ClustererParams(v_min=0.0, p_correction=p, background=tuple(bg_ycc), alpha_lum=0.999, alpha_chro=0.999)
+    params = classic_params(v_min=0.0, p_correction=p, background=tuple(bg_ycc), alpha_lum=0.999, alpha_chro=0.999)
     result = track_events(sim.events, sim.meta, params)
     track = single_track(result)
     late = track[track["t_us"] > 80 * T_FRAME]
@@ -220,7 +220,7 @@ def test_p_correction_recovers_the_object_colour_on_a_uniform_background():
 def test_dvs_only_events_run_with_colour_off():
     sim = simulate_toml(square_scene([(40, (2.0, 0.0))]))
     meta = EventMeta(width=sim.meta.width, height=sim.meta.height, source="dvs", t_frame_us=T_FRAME, has_colour=False)
-    result = track_events(sim.events, meta, ClustererParams(v_min=0.0))
+    result = track_events(sim.events, meta, classic_params(v_min=0.0))
     assert result.tracks.size > 0 and not result.meta.has_colour
     assert np.all(result.tracks["class"] == -1) and not result.tracks["Y"].any()
 

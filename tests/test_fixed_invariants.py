@@ -53,6 +53,8 @@ def fresh():
     MODEL.hist[:] = 0
     MODEL.globals[:] = 0
     MODEL.overflow[:] = 0
+    MODEL.support[:] = 0
+    MODEL.seen[:] = False
     fb = MODEL.table["background"].frac_bits
     MODEL.globals[1:4] = 128 << fb
     return MODEL

@@ -377,7 +377,7 @@ def test_truth_round_trips_through_the_csv(tmp_path):
     rows = static_object(range(2), cx=1.5, cy=2.25, label="green", fully_visible=0) + [gt_row(0, 7, 3, 4, vx=-0.5)]
     write_truth(tmp_path / "gt.csv", rows)
     truth = read_truth(tmp_path / "gt.csv")
-    assert truth.dtype.names == TRUTH_COLUMNS and truth.size == 3
+    assert truth.dtype.names == TRUTH_COLUMNS + ("visible",) and truth.size == 3 and truth["visible"].tolist() == [1.0] * 3
     assert truth["cx"].tolist() == [1.5, 1.5, 3.0] and truth["label"].tolist() == ["green", "green", "red"]
     assert truth["fully_visible"].tolist() == [False, False, True] and truth["vx"][2] == -0.5
     assert np.array_equal(truth, truth_array(rows))

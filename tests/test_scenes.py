@@ -85,7 +85,7 @@ def test_truth_csv_has_the_documented_columns(tmp_path):
     write_truth(path, scene_from_toml(TWO_LEGS).source.truth())
     with open(path) as f:
         reader = csv.DictReader(f)
-        assert tuple(reader.fieldnames) == TRUTH_COLUMNS
+        assert tuple(reader.fieldnames) == TRUTH_COLUMNS + ("visible",)
         # Present from frame 2 to 24; it leaves through the top once cy + 3 <= -0.5, that is
         # 30 - 4·(k - 12) <= -3.5, so frames 2..20 are visible.
         assert [int(r["frame"]) for r in reader] == list(range(2, 21))

@@ -52,6 +52,7 @@ class Harness:
         # A batch's records must fit the capture memory: at most N per filter step.
         self.batch = max(1, min(self.depth, (rec_depth // n_clusters - 1) * filter_every))
         self.ev_mem = [dut.ev_mem[i] for i in range(self.depth)]
+        self.filter_every = filter_every
         self.stats = {"cycles": 0, "filter_cycles": 0, "filter_steps": 0, "events": 0, "wall_s": 0.0}
 
     async def reset(self, cycles: int = 3):
@@ -77,8 +78,10 @@ class Harness:
             dut.start.value = 1
             await RisingEdge(dut.clk)
             dut.start.value = 0
-            # Bound: every event, eviction scan and filter step at its worst, slowed by the gaps and stalls.
-            bound = 1000 + len(batch) * (8 + 2 * n_clusters) * 256 // max(1, 256 - max(gap, stall))
+            # Bound: every event, eviction scan and filter step at its worst (with every slot merging,
+            # each merge a division of up to 128 cycles), slowed by the gaps and stalls.
+            merges = n_clusters * 130 // self.filter_every + 1
+            bound = 1000 + len(batch) * (8 + 2 * n_clusters + merges) * 256 // max(1, 256 - max(gap, stall))
             try:
                 await with_timeout(RisingEdge(dut.done), bound * CLOCK_NS, "ns")
             except SimTimeoutError:

@@ -293,7 +293,9 @@ def _merge(S, H, G, s, j, k, precision):
     py = _q((a_s * S[s, PY] + a_j * S[j, PY]) / (a_s + a_j), Q_CENTRE, precision)
     lo_x, hi_x = min(S[s, PX] - S[s, RX], S[j, PX] - S[j, RX]), max(S[s, PX] + S[s, RX], S[j, PX] + S[j, RX])
     lo_y, hi_y = min(S[s, PY] - S[s, RY], S[j, PY] - S[j, RY]), max(S[s, PY] + S[s, RY], S[j, PY] + S[j, RY])
-    ppx, ppy = S[survivor, PPX] + (px - S[survivor, PX]), S[survivor, PPY] + (py - S[survivor, PY])
+    # (kept inside the sensor: a young cluster's previous centre may not move out of the view)
+    ppx = min(max(S[survivor, PPX] + (px - S[survivor, PX]), 0.0), k[K_WIDTH] - 1.0)
+    ppy = min(max(S[survivor, PPY] + (py - S[survivor, PY]), 0.0), k[K_HEIGHT] - 1.0)
     act = _q(a_s + a_j, Q_ACT, precision)
     count = S[s, EV_COUNT] + S[j, EV_COUNT]
     if survivor == j:

@@ -50,9 +50,9 @@ SIGNALS = (
     C_MAX_ACT, C_MAX_V, C_MIN_V, C_MAX_VI, C_MIN_VI, C_MAX_GAMMA,
     C_MAX_EVCOUNT, C_MAX_SIZE_TARGET, C_V_FULL_BITS, C_MAX_SPEED_SQ,
     C_SEEK_SCALE, C_MERGE, C_MERGE_SCALE, C_MERGE_V_TOL, C_MERGE_V_REL, C_SCALE_F, C_NOISE_GATE, C_NOISE_GATE_F,
-    C_SUPPORT, C_SUPPORT_BITS, C_SUPPORT_WINDOW, C_MAX_CENTRE, C_R_MAX_RAW, C_VI_CAP,
-) = range(85)  # fmt: skip
-N_CONSTANTS = 85
+    C_SUPPORT, C_SUPPORT_BITS, C_SUPPORT_WINDOW, C_R_MAX_RAW, C_VI_CAP,
+) = range(84)  # fmt: skip
+N_CONSTANTS = 84
 
 
 def constant_vector(table, params, has_colour: bool) -> np.ndarray:
@@ -101,7 +101,7 @@ def constant_vector(table, params, has_colour: bool) -> np.ndarray:
     k[C_MERGE_V_TOL], k[C_MERGE_V_REL], k[C_SCALE_F] = raw("merge_v_tol"), raw("merge_v_rel"), SCALE_FRAC_BITS
     k[C_NOISE_GATE], k[C_NOISE_GATE_F] = raw("noise_gate"), NOISE_GATE_FRAC_BITS
     k[C_SUPPORT], k[C_SUPPORT_BITS], k[C_SUPPORT_WINDOW] = params.create_support, params.support_cell_bits, raw("support_window")
-    k[C_MAX_CENTRE], k[C_R_MAX_RAW] = f["centre"].raw_max, raw("r_max")
+    k[C_R_MAX_RAW] = raw("r_max")
     k[C_VI_CAP] = params.interval_warmup()
     return k
 
@@ -394,8 +394,9 @@ def _merge(S, H, G, s, j, k, log, ranges):
     hi_x = max(S[s, PX] + (S[s, RX] << up), S[j, PX] + (S[j, RX] << up))
     lo_y = min(S[s, PY] - (S[s, RY] << up), S[j, PY] - (S[j, RY] << up))
     hi_y = max(S[s, PY] + (S[s, RY] << up), S[j, PY] + (S[j, RY] << up))
-    ppx = _store(S[survivor, PPX] + (px - S[survivor, PX]), 0, k[C_MAX_CENTRE], S_CENTRE, log, ranges)
-    ppy = _store(S[survivor, PPY] + (py - S[survivor, PY]), 0, k[C_MAX_CENTRE], S_CENTRE, log, ranges)
+    # The previous centre moves with the centre, kept inside the sensor (as the float model).
+    ppx = min(max(S[survivor, PPX] + (px - S[survivor, PX]), 0), (k[C_WIDTH] - 1) << k[C_FP])
+    ppy = min(max(S[survivor, PPY] + (py - S[survivor, PY]), 0), (k[C_HEIGHT] - 1) << k[C_FP])
     act = _store(a_s + a_j, 0, k[C_MAX_ACT], S_ACT, log, ranges)
     count = _store(S[s, EV_COUNT] + S[j, EV_COUNT], 0, k[C_MAX_EVCOUNT], S_EVCOUNT, log, ranges)
     if survivor == j:  # its state, with s's decay reference (s is decayed to now)

@@ -344,7 +344,8 @@ def render_table(table: FormatTable) -> str:
     return "\n".join([line(header), line(tuple("-" * w for w in widths)), *map(line, rows)])
 
 
-_ASCII = str.maketrans({"µ": "u", "²": "^2", "₁": "_1", "α": "alpha", "β": "beta", "γ": "gamma", "θ": "theta", "τ": "tau", "Δ": "d", "·": "*"})
+_ASCII = str.maketrans({"µ": "u", "²": "^2", "₁": "_1", "α": "alpha", "β": "beta", "γ": "gamma", "θ": "theta", "τ": "tau", "Δ": "d", "·": "*",
+                        "×": "x", "−": "-", "≥": ">=", "≤": "<="})  # fmt: skip
 
 
 def _packed(name: str, values, width: int) -> str:

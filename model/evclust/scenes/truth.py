@@ -17,7 +17,7 @@ def write_truth(path: str | Path, rows: list[dict]) -> None:
         with open(tmp, "w", newline="") as f:
             writer = csv.DictWriter(f, fieldnames=TRUTH_COLUMNS + tuple(TRUTH_OPTIONAL))
             writer.writeheader()
-            writer.writerows(rows)
+            writer.writerows({**TRUTH_OPTIONAL, **row} for row in rows)  # optional columns at their defaults
 
 
 # ---------------------------------------------------------------------------------------------
