@@ -22,9 +22,9 @@ def pixel_events(events: np.ndarray, x: int, y: int) -> np.ndarray:
 # defaults are tuned for scenes nobody tuned for; these tests check the paper's mechanisms.
 CLASSIC = dict(
     seek_margin=12.0, r_init=10.0, r_min=2.0, r_max=80.0, size_gain=1.5, alpha_pos=0.98, alpha_size=0.99,
-    t_half_us=20000.0, a_min=1.0, a_valid=20.0, gamma_mode="count", alpha_vel_int=0.7, tau_us=100000.0,
-    alpha_lum=0.99, alpha_chro=0.99, p_correction=1.0, v_min=0.3, exit_margin=10.0,
-    seek_scale=0.0, merge=False, noise_gate=0.0,
+    t_half_us=20000.0, a_min=1.0, a_valid=20.0, alpha_vel_mcm=0.9999, gamma_mode="count", alpha_vel_int=0.7,
+    tau_us=100000.0, alpha_lum=0.99, alpha_chro=0.99, p_correction=1.0, v_min=0.3, exit_margin=10.0,
+    seek_scale=0.0, merge=False, noise_gate=0.0, create_support=False,
 )  # fmt: skip
 
 

@@ -29,6 +29,8 @@ def add_parser(sub) -> None:
     p.add_argument("-o", "--output", default="docs/GENERALIZATION.md", metavar="MD", help="page to write (default: docs/GENERALIZATION.md)")
     p.add_argument("--scheduler", metavar="ADDR", help="Dask scheduler address (default: a local cluster)")
     p.add_argument("--workers", type=int, metavar="N", help="local Dask workers (default: one per core)")
+    p.add_argument("--ablation", action="store_true",
+                   help="instead: the defaults with each addition beyond the paper off in turn, and the paper's (float model)")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bars")
     p.set_defaults(run=run)
 
@@ -36,7 +38,7 @@ def add_parser(sub) -> None:
 def run(args) -> int:
     from evclust.clusterer.run import MODELS
     from evclust.suite import dask_client, split_seeds
-    from evclust.suite.report import default_configurations, run_configurations, write_report
+    from evclust.suite.report import ablation_configurations, default_configurations, run_configurations, write_report
 
     seeds = split_seeds(args.split)
     if args.seeds:
@@ -53,8 +55,12 @@ def run(args) -> int:
     command = " ".join(["evclust generalize", f"--split {args.split}", *([f"--seeds {' '.join(map(str, args.seeds))}"] if args.seeds else []),
                         f"--models {','.join(models)}", f"-o {shlex.quote(str(out))}"])  # fmt: skip
     machine = f"{platform.machine()}, {platform.python_implementation()} {platform.python_version()}"
+    configurations = ablation_configurations() if args.ablation else default_configurations(models)
+    if args.ablation:
+        command += " --ablation"
     with dask_client(args.scheduler, args.workers) as client:
-        runs = run_configurations(client, Path(args.suite_dir), seeds, default_configurations(models), progress=not args.quiet)
-    write_report(runs, Path(args.suite_dir), out, args.split, seeds, command, machine, picture)
+        runs = run_configurations(client, Path(args.suite_dir), seeds, configurations, progress=not args.quiet)
+    write_report(runs, Path(args.suite_dir), out, args.split, seeds, command, machine, picture,
+                 categories_of=("default",) if args.ablation else None)  # fmt: skip
     print(f"{out}: {len(seeds)} scenes of the {args.split} split, {len(runs)} configurations")
     return 0

@@ -54,8 +54,9 @@ SMALL = dict(width=64, height=48, t_frame_us=10_000.0)
 # The parameters the directed cases were written with: the defaults of before the
 # one-cluster-per-object additions, which each case switches on itself when it tests one.
 _WRITTEN_WITH = dict(
-    r_min=2.0, size_gain=1.5, alpha_pos=0.98, alpha_size=0.99, a_min=1.0, gamma_mode="count", alpha_vel_int=0.7,
-    alpha_lum=0.99, alpha_chro=0.99, p_correction=1.0, exit_margin=10.0, seek_scale=0.0, merge=False, noise_gate=0.0,
+    r_min=2.0, size_gain=1.5, alpha_pos=0.98, alpha_size=0.99, a_min=1.0, alpha_vel_mcm=0.9999, gamma_mode="count",
+    alpha_vel_int=0.7, alpha_lum=0.99, alpha_chro=0.99, p_correction=1.0, exit_margin=10.0,
+    seek_scale=0.0, merge=False, noise_gate=0.0, create_support=False,
 )  # fmt: skip
 
 
