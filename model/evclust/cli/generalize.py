@@ -61,6 +61,7 @@ def run(args) -> int:
     with dask_client(args.scheduler, args.workers) as client:
         runs = run_configurations(client, Path(args.suite_dir), seeds, configurations, progress=not args.quiet)
     write_report(runs, Path(args.suite_dir), out, args.split, seeds, command, machine, picture,
-                 categories_of=("default",) if args.ablation else None)  # fmt: skip
+                 categories_of=("default",) if args.ablation else None,
+                 title="Ablation: what each addition beyond the paper buys" if args.ablation else "Generalization")  # fmt: skip
     print(f"{out}: {len(seeds)} scenes of the {args.split} split, {len(runs)} configurations")
     return 0

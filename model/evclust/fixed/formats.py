@@ -171,6 +171,7 @@ def build_formats(
     # The centre keeps at least R's fraction bits: the seek shifts R up to P's, never down.
     pos_frac = max(guard("beta_pos"), guard("beta_size"))
     v_full = 2.0 ** _bits_for(max(p.r_max, 64.0))  # px/frame: a speed above this is not an object
+    v_mcm_int = max(12, min(16, MAX_WORD_BITS - 1 - guard("beta_vel_mcm") - beta_bits["beta_vel_mcm"]))
     f = [
         Format("ev_t", False, 32, 0, "input", "event time, µs; wraps by design", overflow="wrap"),
         Format("ev_xy", False, coord, 0, "input", "event coordinates, px"),
@@ -180,14 +181,16 @@ def build_formats(
         Format("activity", False, _bits_for((1 << 16)), 8, "state", "decayed event count A"),
         Format("t_last", False, 32, 0, "state", "time the activity refers to, µs", overflow="wrap"),
         # V_MCM's input γ·(P_new - P) is large per event even when V is small: γ reaches ~10^4.
-        Format("v_mcm", True, 12, guard("beta_vel_mcm"), "state", "MCM velocity accumulator and its input, px/frame", rounding="nearest"),
+        # γ·step reaches γ (up to 2^14 events/frame) times a step of a px or two: as many integer
+        # bits as the α step's product (V times β, < 2^63) leaves, from 12 up to 16.
+        Format("v_mcm", True, v_mcm_int, guard("beta_vel_mcm"), "state", "MCM velocity accumulator and its input, px/frame", rounding="nearest"),
         # w is a divisor: its dead band must be tiny relative to 1, not to a pixel (2^-20).
         Format("mcm_norm", False, 1, guard("beta_vel_mcm") + 14, "state", "1 - α_vm^n: the MCM filter run on 1 (reaches 1.0)", rounding="nearest"),
         Format("v_int", True, _bits_for(v_full), guard("beta_vel_int"), "state", "interval velocity, px/frame"),
         Format("colour", False, 8, guard("beta_chro") if p.alpha_chro >= p.alpha_lum else guard("beta_lum"), "state", "cluster colour Y, Cb, Cr"),
         Format("background", False, 8, guard("beta_bg"), "state", "background colour Y, Cb, Cr"),
         Format("gamma", False, 14, 8, "state", "γ: events per frame (the activity estimate reaches ~8000 early on)"),
-        Format("events_in_interval", False, 16, 0, "state", "events of the cluster since the last τ boundary"),
+        Format("events_in_interval", False, 20, 0, "state", "events of the cluster since the last τ boundary (a dense cluster: 10^5 in a τ)"),
         Format("hist", False, p.hist_bits, 0, "state", "palette histogram counter"),
         Format("id", False, 32, 0, "state", "cluster id", overflow="wrap"),
         Format("offset", True, coord, pos_frac, "intermediate", "e - P, px"),
