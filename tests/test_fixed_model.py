@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 from scipy.optimize import linear_sum_assignment
 
-from evclust.clusterer import ClustererParams, track_events
+from evclust.clusterer import track_events
 from evclust.events import EVENT_DTYPE, EventMeta
 
-from conftest import simulate_toml
+from conftest import classic_params, simulate_toml
 from test_clusterer import square_scene
 
 T_FRAME = 1e4
@@ -31,7 +31,7 @@ def by_step(tracks):
 
 
 def test_fixed_follows_float_on_a_rigid_square(square):
-    params = ClustererParams(**PARAMS)
+    params = classic_params(**PARAMS)
     flt = track_events(square.events, square.meta, params, model="float")
     fix = track_events(square.events, square.meta, params, model="fixed")
     assert fix.stats["saturations"] == {}
@@ -57,7 +57,7 @@ def test_fixed_follows_float_on_a_rigid_square(square):
 
 
 def test_a_stream_across_the_timestamp_wrap_gives_the_same_tracks(square):
-    params = ClustererParams(**PARAMS)
+    params = classic_params(**PARAMS)
     # Shift by a whole number of τ so that τ boundaries fall at the same places, far enough that
     # the 32-bit time wraps in the middle of the stream.
     tau = int(params.tau_us)
@@ -87,7 +87,7 @@ META = EventMeta(width=64, height=48, source="unit", t_frame_us=T_FRAME)
 
 
 def test_a_burst_of_simultaneous_events_on_one_pixel_stays_bounded():
-    params = ClustererParams(v_min=0.0, a_valid=5.0)
+    params = classic_params(v_min=0.0, a_valid=5.0)
     burst = events_at([(1000, 10, 20, 200)] * 100_000)
     run = track_events(burst, META, params, model="fixed")
     assert run.stats["created"] == 1
@@ -103,7 +103,7 @@ def test_a_burst_of_simultaneous_events_on_one_pixel_stays_bounded():
 
 
 def test_a_gap_of_hours_frees_the_old_clusters():
-    params = ClustererParams(v_min=0.0, a_valid=5.0, filter_every=16)
+    params = classic_params(v_min=0.0, a_valid=5.0, filter_every=16)
     before = events_at([(1000 + i, 10, 20, 200) for i in range(64)])
     hours = 2 * 3600 * 10**6  # longer than the 32-bit µs counter: it aliases to 48 min, still ≫ T_half
     after = events_at([(1000 + hours + i, 50, 30, 200) for i in range(64)])
@@ -114,7 +114,7 @@ def test_a_gap_of_hours_frees_the_old_clusters():
 
 
 def test_inputs_at_every_extreme_never_saturate_state():
-    params = ClustererParams(v_min=0.0, a_valid=2.0, filter_every=8)
+    params = classic_params(v_min=0.0, a_valid=2.0, filter_every=8)
     corners = [(0, 0), (63, 0), (0, 47), (63, 47)]
     points = [(1000 * i + j, x, y, lum) for i, ((x, y), lum) in enumerate(zip(corners * 50, [0, 255] * 100)) for j in range(4)]
     run = track_events(events_at(points), META, params, model="fixed")
@@ -126,7 +126,7 @@ def test_full_table_evicts_exactly_as_the_float_model_does():
     from evclust.fixed.model import FixedClusterer
     from evclust.clusterer.layout import ID, PX
 
-    params = ClustererParams(n_clusters=2, a_valid=5.0, a_min=0.0, filter_every=10**6, seek_margin=2.0, t_half_us=1e9, r_init=3.0)
+    params = classic_params(n_clusters=2, a_valid=5.0, a_min=0.0, filter_every=10**6, seek_margin=2.0, t_half_us=1e9, r_init=3.0)
     model = FixedClusterer(params, 100, 100, T_FRAME)
     fp = model.table["centre"].frac_bits
     model.feed(events_at([(i, 10, 10, 100) for i in range(6)] + [(10 + i, 50, 50, 100) for i in range(2)]))
@@ -153,7 +153,7 @@ def test_a_long_soak_keeps_the_state_bounded_without_drift():
     ev["t"], ev["x"], ev["y"], ev["p"] = t, x, y, 1
     ev["Y"], ev["Cb"], ev["Cr"] = rng.integers(0, 256, n), 128, 128
     meta = EventMeta(width=320, height=240, source="soak", t_frame_us=T_FRAME)
-    params = ClustererParams(v_min=0.0, a_valid=5.0, r_max=40.0, seek_margin=12.0, filter_every=1024)
+    params = classic_params(v_min=0.0, a_valid=5.0, r_max=40.0, seek_margin=12.0, filter_every=1024)
     flt = track_events(ev, meta, params, model="float").tracks
     fix = track_events(ev, meta, params, model="fixed")
     assert fix.stats["saturations"] == {}
@@ -175,7 +175,7 @@ def test_size_at_r_max_and_velocities_at_full_scale_never_wrap():
     from evclust.clusterer.layout import RX, RY, VALID, VIX, VIY, VMX, VMY
     from evclust.fixed.model import FixedClusterer
 
-    params = ClustererParams(v_min=0.0, a_valid=2.0, filter_every=4, r_max=20.0, r_init=20.0, r_min=2.0, seek_margin=30.0)
+    params = classic_params(v_min=0.0, a_valid=2.0, filter_every=4, r_max=20.0, r_init=20.0, r_min=2.0, seek_margin=30.0)
     model = FixedClusterer(params, 64, 48, T_FRAME)
     model.feed(events_at([(0, 32, 24, 100)]))  # one cluster
     f = model.table
@@ -199,7 +199,7 @@ def test_size_at_r_max_and_velocities_at_full_scale_never_wrap():
 
 
 def test_shift_only_betas_run_close_to_the_multiplier_model(square):
-    params = ClustererParams(**PARAMS)
+    params = classic_params(**PARAMS)
     exact = track_events(square.events, square.meta, params, model="fixed")
     shifted = track_events(square.events, square.meta, params, model="fixed", beta_shift_only=True)
     assert shifted.stats["saturations"] == {}

@@ -58,8 +58,10 @@ def test_track_prints_the_time_constants_it_chose(tmp_path, capsys):
     capsys.readouterr()
     assert main(["track", str(tmp_path / "e.npz"), "-o", str(tmp_path / "t.csv"), "-q"]) == 0
     line = capsys.readouterr().out
-    # 15 fps: T_half is one frame, 66,667 µs; τ 5.5 frames.
-    assert "parameters from defaults (t_half 66,667 µs (= 1 frames), tau 366,667 µs (= 5.5 frames))" in line
+    # 15 fps: T_half 1.8 frames is 120,000 µs, τ 5.3 frames 353,333 µs.
+    defaults = ClustererParams()
+    assert (defaults.t_half_frames, defaults.tau_frames) == (1.8, 5.3)
+    assert "parameters from defaults (t_half 120,000 µs (= 1.8 frames), tau 353,333 µs (= 5.3 frames))" in line
 
 
 def test_suite_tuning_keeps_its_trials_in_sqlite_and_resumes(tmp_path):
