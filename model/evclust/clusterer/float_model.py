@@ -453,9 +453,10 @@ def run_events(S, H, G, k, palette, background_mask, support, t_us, xs, ys, lums
         else:
             _update(S, H, G, s, t, x, y, lum, cb, cr, k, palette, background_mask, precision)
             updated_reported = S[s, REPORTED] != 0.0
-        support[cy, cx] = t
+        if k[K_SUPPORT] != 0.0:
+            support[cy, cx] = t
         # Step 4: events that do not update a reported cluster track the background colour.
-        if not updated_reported:  # the activity of the events no reported cluster takes
+        if not updated_reported and k[K_NOISE_GATE] > 0.0:  # the activity of the events no reported cluster takes
             G[BG_ACT] = _q(_decayed(G[BG_ACT], t - G[BG_T], k[K_T_HALF], precision), Q_ACT, precision) + 1.0
             G[BG_T] = t
         if k[K_COLOUR] != 0.0 and k[K_BG_FIXED] == 0.0 and not updated_reported:

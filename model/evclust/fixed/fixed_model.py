@@ -582,9 +582,10 @@ def run_events(S, H, G, k, table, gains, palette, inv_ww, background_mask, suppo
             updated_reported = S[s, REPORTED] != 0
         if trace is not None:
             trace[i] = (action << 16) | max(s, 0)
-        support[cy, cx] = t
-        seen[cy, cx] = True
-        if not updated_reported:
+        if k[C_SUPPORT] != 0:
+            support[cy, cx] = t
+            seen[cy, cx] = True
+        if not updated_reported and k[C_NOISE_GATE] != 0:  # the background's activity: read by the noise gate only
             _decay_background(G, t, k, table)
             G[BG_ACT] = _store(G[BG_ACT] + (np.int64(1) << k[C_FA]), 0, k[C_MAX_ACT], S_ACT, log, ranges)
         if k[C_COLOUR] != 0 and k[C_BG_FIXED] == 0 and not updated_reported:
