@@ -53,11 +53,9 @@ def run(args) -> int:
     out = Path(args.output)
     picture = out.parent / "img" / f"{out.stem.lower()}_failures.png"
     command = " ".join(["evclust generalize", f"--split {args.split}", *([f"--seeds {' '.join(map(str, args.seeds))}"] if args.seeds else []),
-                        f"--models {','.join(models)}", f"-o {shlex.quote(str(out))}"])  # fmt: skip
+                        "--ablation" if args.ablation else f"--models {','.join(models)}", f"-o {shlex.quote(str(out))}"])  # fmt: skip
     machine = f"{platform.machine()}, {platform.python_implementation()} {platform.python_version()}"
     configurations = ablation_configurations() if args.ablation else default_configurations(models)
-    if args.ablation:
-        command += " --ablation"
     with dask_client(args.scheduler, args.workers) as client:
         runs = run_configurations(client, Path(args.suite_dir), seeds, configurations, progress=not args.quiet)
     write_report(runs, Path(args.suite_dir), out, args.split, seeds, command, machine, picture,

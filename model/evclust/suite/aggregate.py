@@ -31,50 +31,37 @@ def _object_facts(result) -> dict:
     return {o["id"]: o for o in result.facts["objects"]}
 
 
-def _tracks_per_object(results) -> float | None:
-    counts = []
-    for r in results:
-        m = r.matches
-        for g in np.unique(m["gt_id"]):
-            counts.append(np.unique(m["track_id"][m["gt_id"] == g]).size)
+def _tracks_per_object(matches_per_scene) -> float | None:
+    """Distinct track ids matched to each object (ids are per scene), averaged over the objects."""
+    counts = [np.unique(m["track_id"][m["gt_id"] == g]).size for m in matches_per_scene for g in np.unique(m["gt_id"])]
     return float(np.mean(counts)) if counts else None
 
 
 def figures(results, objects=None, trackeval: bool = True) -> dict:
     """Pooled figures of `results` (SceneResult); with `objects` (a predicate on an object's
     ObjectSummary and its generator facts), over those objects only, without precision."""
-    selected = []
-    n_objects = n_records = 0
+    kept_matches = []
+    n_objects = n_samples = n_records = 0
     for r in results:
         facts = _object_facts(r)
-        if objects is None:
-            keep_ids = set(r.objects)
-            n_records += r.n_records
-        else:
-            keep_ids = {i for i, o in r.objects.items() if objects(o, facts[i])}
-        n_objects += sum(r.objects[i].samples for i in keep_ids)
-        m = r.matches[np.isin(r.matches["gt_id"], list(keep_ids))] if keep_ids else r.matches[:0]
-        selected.append(dataclass_copy(r, m))
-    matches = np.concatenate([r.matches for r in selected]) if selected else np.zeros(0, tracking.MATCH_FIELDS)
-    meta = results[0].meta if results else None
+        keep = {i for i, o in r.objects.items() if objects is None or objects(o, facts[i])}
+        n_objects += len(keep)
+        n_samples += sum(r.objects[i].samples for i in keep)
+        n_records += r.n_records
+        kept_matches.append(r.matches[np.isin(r.matches["gt_id"], sorted(keep))])
+    matches = np.concatenate(kept_matches) if kept_matches else np.zeros(0, tracking.MATCH_FIELDS)
     out = {
         "scenes": len(results),
-        "objects": int(sum(len(r.objects) for r in results) if objects is None else sum(
-            sum(1 for i, o in r.objects.items() if objects(o, _object_facts(r)[i])) for r in results)),
-        "recall": matches.size / n_objects if n_objects else None,
-        "precision": (matches.size / n_records if n_records else None) if objects is None else None,
-        "tracks_per_object": _tracks_per_object(selected),
+        "objects": n_objects,
+        "recall": matches.size / n_samples if n_samples else None,
+        "precision": matches.size / n_records if n_records and objects is None else None,
+        "tracks_per_object": _tracks_per_object(kept_matches),
     }
     if objects is None and results and trackeval:
         out |= tracking.headline(tracking.combine_sequences([r.trackeval for r in results]))
-    out |= tracking.accuracy(matches, meta) if meta is not None else {}
+    if results:
+        out |= tracking.accuracy(matches, results[0].meta)
     return out
-
-
-def dataclass_copy(result, matches):
-    import dataclasses
-
-    return dataclasses.replace(result, matches=matches)
 
 
 def by_category(results) -> dict[str, dict]:
