@@ -10,7 +10,7 @@
 // and no free one scans the N slots for the weakest (N + 1 cycles more). Every FILTER_EVERY
 // events the filter step sweeps the table, one slot per cycle, while the mixing palette's
 // 1/|w|^2 entries are refreshed alongside: max(N, PALETTE_SIZE) cycles plus output stalls,
-// plus MERGE_MOMENT_W + 2 cycles per merge (the weighted centre's iterative division).
+// plus MERGE_MOMENT_W + 3 cycles per merge (the weighted centre's iterative division).
 // After a reset, INIT fills the mixing table and clears the creation-support map.
 //
 // N, every width and every constant come from evclust_params.vh, generated from the model's
