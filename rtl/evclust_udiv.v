@@ -1,6 +1,6 @@
 // Unsigned restoring division, one quotient bit per cycle: floor(numerator / denominator), as
 // the model's `//` on non-negative integers (the merge's activity-weighted centre). Off the
-// per-event path: a merge stalls the filter sweep for NUM_W + 1 cycles.
+// per-event path: done rises NUM_W cycles after start (a merge holds the sweep NUM_W + 3 cycles).
 `default_nettype none
 module evclust_udiv #(
     parameter integer NUM_W = 32,
