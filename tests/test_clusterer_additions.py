@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from evclust.clusterer import ClustererParams, load_params, track_events
+from evclust.clusterer import ClustererParams, load_params
 from evclust.clusterer.layout import ACT, ID, MERGED, PX, PY, UNSUPPORTED, VALID, VI_COUNT, VIX
 from evclust.clusterer.run import FloatClusterer
 from evclust.events import EVENT_DTYPE

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import re
 
-import pytest
 
 from evclust.cli import main
 from evclust.clusterer import ClustererParams
