@@ -293,6 +293,24 @@ def test_two_cycles_per_event_and_one_cycle_per_slot_in_a_sweep(sim):
     assert 2 * stats["events"] <= stats["cycles"] - stats["filter_cycles"] <= 2 * stats["events"] + 8  # + the harness's start
 
 
+@pytest.mark.parametrize("sim", SIMS)
+def test_each_merge_holds_the_sweep_for_the_dividers_steps_plus_three_cycles(sim):
+    # Without gaps or stalls: each filter step's max(N, P) cycles, plus, for each merge, the
+    # detection, the dividers' start, their MERGE_MOMENT_W steps and the write.
+    from evclust.vectors.read import load_case
+
+    case = "merge_edges"
+    result = run(sim, _case_header(case), "replay_vectors", {"cases": [str(VECTORS / case)], "seed": 1, "gap": 0, "stall": 0})
+    stats = result["cases"][case]
+    manifest = json.loads((VECTORS / case / "manifest.json").read_text())
+    moment_bits = load_case(VECTORS / case).table["merge_moment"].word_bits
+    counts = manifest["counts"]
+    assert counts["merged"] > 0 and counts["evicted"] == counts["dropped"] == 0  # no eviction scans
+    sweeps = counts["steps"] * max(manifest["n_clusters"], manifest["palette_size"])
+    merges = stats["cycles"] - 2 * stats["events"] - sweeps
+    assert counts["merged"] * (moment_bits + 3) <= merges <= counts["merged"] * (moment_bits + 3) + 8  # + the harness's start
+
+
 def _tampered_copy(tmp_path, case: str, edit) -> Path:
     """A copy of a case with one file edited and its manifest's sha256 updated to match."""
     import shutil
