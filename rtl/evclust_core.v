@@ -40,7 +40,9 @@ module evclust_core (
                              + 2 * V_MCM_W + 2 * V_INT_W + 3 * COLOUR_W + 8 + 4;
     localparam integer TRACE_W = 11;
     localparam integer SWEEP_LEN = N > P ? N : P;
-    localparam integer SWEEP_W = $clog2(SWEEP_LEN + 1);
+    // The sweep tail: the operand register and the divider's stages (SWEEP_DIV_STEP bits each).
+    localparam integer TAIL = 1 + (V_MCM_W - 1 + SWEEP_DIV_STEP - 1) / SWEEP_DIV_STEP;
+    localparam integer SWEEP_W = $clog2(SWEEP_LEN + TAIL + 1);
     localparam integer EVERY_W = $clog2(FILTER_EVERY + 1);
 
     input  wire               clk;
@@ -84,7 +86,7 @@ module evclust_core (
     localparam signed [63:0] HI_X = (($signed({32'd0, SENSOR_WIDTH[31:0]}) - 64'sd1) <<< FP) - K_EXIT_M;
     localparam signed [63:0] HI_Y = (($signed({32'd0, SENSOR_HEIGHT[31:0]}) - 64'sd1) <<< FP) - K_EXIT_M;
     localparam [63:0] TAU = {32'd0, TAU_US[31:0]};
-    localparam integer LAST_SLOT_I = N - 1, LAST_ENTRY_I = P - 1, LAST_SWEEP_I = SWEEP_LEN - 1;
+    localparam integer LAST_SLOT_I = N - 1, LAST_ENTRY_I = P - 1, LAST_SWEEP_I = SWEEP_LEN + TAIL - 1;
     localparam [SWEEP_W-1:0] LAST_SLOT = LAST_SLOT_I[SWEEP_W-1:0], LAST_ENTRY = LAST_ENTRY_I[SWEEP_W-1:0];
     localparam [SWEEP_W-1:0] LAST_SWEEP = LAST_SWEEP_I[SWEEP_W-1:0];
     localparam [SWEEP_W-1:0] N_SLOTS = N[SWEEP_W-1:0], N_ENTRIES = P[SWEEP_W-1:0];
@@ -181,18 +183,21 @@ module evclust_core (
         end
     endfunction
 
-    // floor(a / b) for b > 0, as Python's // (the model's MCM bias correction), with one
-    // divider sized to V << 20: a negative quotient is -ceil(|a| / b) = -((|a| + b - 1) / b).
-    localparam integer QUOTIENT_W = V_MCM_W + 21;
-    function automatic signed [63:0] floor_div;
-        input signed [63:0] a;
+    // floor(a / b) for b > 0, as Python's // (the model's MCM bias correction), saturated to
+    // V's format: a negative quotient is -ceil(|a| / b) = -((|a| + b - 1) / b). The magnitude's
+    // top part decides saturation (a quotient of 2^Q_W or more), and below it the quotient has
+    // Q_W bits, which the sweep tail's pipelined divider computes from the rest.
+    localparam integer QUOTIENT_W = V_MCM_W + 21;  // |V << 20| + b - 1
+    localparam integer Q_W = V_MCM_W - 1;          // a quotient that does not saturate
+    function automatic [QUOTIENT_W-1:0] floor_magnitude;
+        input [V_MCM_W-1:0] v;  // the dividend is v << 20
         input [W20_W-1:0] b;
-        reg [QUOTIENT_W-1:0] magnitude, divisor, quotient;
+        reg signed [63:0] a;
+        reg [QUOTIENT_W-1:0] magnitude;
         begin
+            a = $signed({{(64 - V_MCM_W){v[V_MCM_W-1]}}, v}) <<< 20;
             magnitude = a < 0 ? ~a[QUOTIENT_W-1:0] + {{(QUOTIENT_W - 1){1'b0}}, 1'b1} : a[QUOTIENT_W-1:0];
-            divisor = {{(QUOTIENT_W - W20_W){1'b0}}, b};
-            quotient = (a < 0 ? magnitude + divisor - {{(QUOTIENT_W - 1){1'b0}}, 1'b1} : magnitude) / divisor;
-            floor_div = a < 0 ? -$signed({{(64 - QUOTIENT_W){1'b0}}, quotient}) : $signed({{(64 - QUOTIENT_W){1'b0}}, quotient});
+            floor_magnitude = a < 0 ? magnitude + {{(QUOTIENT_W - W20_W){1'b0}}, b} - {{(QUOTIENT_W - 1){1'b0}}, 1'b1} : magnitude;
         end
     endfunction
 
@@ -451,20 +456,14 @@ module evclust_core (
     end
 
     // ---------------------------------------------------------------- the filter sweep
-    // One slot per cycle: decay, expiry, gamma, the interval velocity at tau boundaries,
-    // the MCM bias correction (the sweep's divider), exit prediction, the record.
+    // Stage 0, one slot k per cycle: decay, expiry, gamma, the interval velocity at tau
+    // boundaries. The tail, TAIL cycles behind: the MCM bias correction (a pipelined divider),
+    // exit prediction, the report and the record. Nothing the tail reads of slot t changes after
+    // t's stage 0 (later slots' merges touch only later slots), so the tail reads the table.
     wire [SLOT_W-1:0] k = index[SLOT_W-1:0];
-    integer cls;
-    reg signed [63:0] f_gamma, f_mx, f_my, f_vix, f_viy, f_vmx, f_vmy, f_vmx_raw, f_vmy_raw, f_px, f_py;
-    reg signed [63:0] f_speed_sq, f_limit, f_per_frame, f_evc;
-    reg [2*SQ_MAG_W-1:0] f_sq_x, f_sq_y;
-    reg [W20_W-1:0]   f_w20;
+    reg signed [63:0] f_gamma, f_mx, f_my, f_vix, f_viy, f_per_frame, f_evc;
     reg [INTERVAL_UPDATES_W-1:0] f_vi_count;
-    reg               f_expire, f_exit, f_left, f_right, f_top, f_bottom, f_moving_mcm, f_moving_int, f_report;
-    reg signed [63:0] f_box;
-    reg signed [63:0] f_best;
-    reg [7:0]         f_class;
-    reg [3:0]         f_flags;
+    reg               f_expire;
     always @* begin
         f_per_frame = u64({{(63 - FRAME_PER_TAU_W){1'b0}}, per_frame});
         f_expire = a_decayed < K_A_MIN;
@@ -472,13 +471,11 @@ module evclust_core (
         f_gamma = u64({{(63 - GAMMA_W){1'b0}}, gamma[k]});
         if (GAMMA_MODE != 2 || vi_count[k] == VI_NONE)
             f_gamma = saturate(gamma_from_activity(a_decayed), 0, MAX_GAMMA);
-        f_px = u64({{(63 - CENTRE_W){1'b0}}, px[k]});
-        f_py = u64({{(63 - CENTRE_W){1'b0}}, py[k]});
         f_evc = u64({{(63 - EVENTS_IN_INTERVAL_W){1'b0}}, ev_count[k]});
         f_vix = $signed({{(64 - V_INT_W){vix[k][V_INT_W-1]}}, vix[k]});
         f_viy = $signed({{(64 - V_INT_W){viy[k][V_INT_W-1]}}, viy[k]});
-        f_mx = saturate(align((f_px - u64({{(63 - CENTRE_W){1'b0}}, ppx[k]})) * f_per_frame, FP + FPT_F, FI), MIN_VI, MAX_VI);
-        f_my = saturate(align((f_py - u64({{(63 - CENTRE_W){1'b0}}, ppy[k]})) * f_per_frame, FP + FPT_F, FI), MIN_VI, MAX_VI);
+        f_mx = saturate(align((u64({{(63 - CENTRE_W){1'b0}}, px[k]}) - u64({{(63 - CENTRE_W){1'b0}}, ppx[k]})) * f_per_frame, FP + FPT_F, FI), MIN_VI, MAX_VI);
+        f_my = saturate(align((u64({{(63 - CENTRE_W){1'b0}}, py[k]}) - u64({{(63 - CENTRE_W){1'b0}}, ppy[k]})) * f_per_frame, FP + FPT_F, FI), MIN_VI, MAX_VI);
         if (boundaries != 33'd0) begin
             if (GAMMA_MODE == 2 && vi_count[k] != VI_NONE)
                 f_gamma = saturate((f_evc * f_per_frame) >>> (FPT_F - FG), 0, MAX_GAMMA);
@@ -495,16 +492,77 @@ module evclust_core (
             end
             f_vi_count = vi_count[k] >= VI_COUNT_MAX ? VI_COUNT_MAX : vi_count[k] + 1'b1;
         end
-        // The reported MCM velocity: V / w.
-        f_vmx_raw = $signed({{(64 - V_MCM_W){vmx[k][V_MCM_W-1]}}, vmx[k]});
-        f_vmy_raw = $signed({{(64 - V_MCM_W){vmy[k][V_MCM_W-1]}}, vmy[k]});
-        f_w20 = norm[k][MCM_NORM_W-1 -: W20_W];
-        f_vmx = f_vmx_raw;
-        f_vmy = f_vmy_raw;
-        if (MCM_CORRECT != 0 && f_w20 != {W20_W{1'b0}}) begin
-            f_vmx = saturate(floor_div(f_vmx_raw <<< 20, f_w20), MIN_V, MAX_V);  // the record's format
-            f_vmy = saturate(floor_div(f_vmy_raw <<< 20, f_w20), MIN_V, MAX_V);
+    end
+
+    // The tail's first register: the live slot swept and its MCM accumulator and weight.
+    reg               p_live;
+    reg [SLOT_W-1:0]  p_slot;
+    reg [V_MCM_W-1:0] p_vmx, p_vmy;
+    reg [W20_W-1:0]   p_w20;
+    wire [QUOTIENT_W-1:0] p_mag_x = floor_magnitude(p_vmx, p_w20);
+    wire [QUOTIENT_W-1:0] p_mag_y = floor_magnitude(p_vmy, p_w20);
+    wire              p_correct = MCM_CORRECT != 0 && p_w20 != {W20_W{1'b0}};
+    wire              p_sat_x = p_mag_x[QUOTIENT_W-1:Q_W] >= {{(QUOTIENT_W - Q_W - W20_W){1'b0}}, p_w20};
+    wire              p_sat_y = p_mag_y[QUOTIENT_W-1:Q_W] >= {{(QUOTIENT_W - Q_W - W20_W){1'b0}}, p_w20};
+    wire [W20_W-1:0]  p_divisor = p_correct ? p_w20 : {{(W20_W - 1){1'b0}}, 1'b1};  // no division by zero
+    localparam integer TAG_W = 1 + SLOT_W + 5;
+    wire [TAG_W-1:0]  t_tag;
+    wire [Q_W-1:0]    t_qx, t_qy;
+    wire              tail_en;
+    evclust_pipediv #(.Q_W(Q_W), .DEN_W(W20_W), .STEP(SWEEP_DIV_STEP), .TAG_W(TAG_W)) div_vmx (
+        .clk(clk), .rst(rst), .en(tail_en),
+        .remainder_in(p_sat_x || !p_correct ? {W20_W{1'b0}} : p_mag_x[Q_W +: W20_W]), .bits_in(p_mag_x[Q_W-1:0]),
+        .divisor(p_divisor),
+        .tag_in({p_live, p_slot, p_correct, p_vmx[V_MCM_W-1], p_sat_x, p_vmy[V_MCM_W-1], p_sat_y}),
+        .quotient(t_qx), .tag_out(t_tag)
+    );
+    wire [TAG_W-1:0] unused_tag_y;
+    evclust_pipediv #(.Q_W(Q_W), .DEN_W(W20_W), .STEP(SWEEP_DIV_STEP), .TAG_W(TAG_W)) div_vmy (
+        .clk(clk), .rst(rst), .en(tail_en),
+        .remainder_in(p_sat_y || !p_correct ? {W20_W{1'b0}} : p_mag_y[Q_W +: W20_W]), .bits_in(p_mag_y[Q_W-1:0]),
+        .divisor(p_divisor),
+        .tag_in({TAG_W{1'b0}}),
+        .quotient(t_qy), .tag_out(unused_tag_y)
+    );
+    wire             t_live = t_tag[TAG_W-1];
+    wire [SLOT_W-1:0] t = t_tag[TAG_W-2 -: SLOT_W];
+    wire             t_correct = t_tag[4], t_neg_x = t_tag[3], t_sat_x = t_tag[2], t_neg_y = t_tag[1], t_sat_y = t_tag[0];
+
+    // The tail's last stage: the reported MCM velocity V / w, exit, report, class, record.
+    function automatic signed [63:0] corrected_v;
+        input [V_MCM_W-1:0] raw;
+        input correct, negative, saturated;
+        input [Q_W-1:0] quotient;
+        reg signed [63:0] q;
+        begin
+            q = u64({{(63 - Q_W){1'b0}}, quotient});
+            if (!correct)
+                corrected_v = $signed({{(64 - V_MCM_W){raw[V_MCM_W-1]}}, raw});
+            else if (saturated)
+                corrected_v = negative ? MIN_V : MAX_V;
+            else
+                corrected_v = negative ? -q : q;
         end
+    endfunction
+    integer cls;
+    reg signed [63:0] f_vmx, f_vmy, f_vmx_raw, f_vmy_raw, f_px, f_py, f_act, f_vix_t, f_viy_t;
+    reg signed [63:0] f_speed_sq, f_limit;
+    reg [2*SQ_MAG_W-1:0] f_sq_x, f_sq_y;
+    reg               f_exit, f_left, f_right, f_top, f_bottom, f_moving_mcm, f_moving_int, f_report;
+    reg signed [63:0] f_box;
+    reg signed [63:0] f_best;
+    reg [7:0]         f_class;
+    reg [3:0]         f_flags;
+    always @* begin
+        f_act = u64({{(63 - ACTIVITY_W){1'b0}}, act[t]});
+        f_px = u64({{(63 - CENTRE_W){1'b0}}, px[t]});
+        f_py = u64({{(63 - CENTRE_W){1'b0}}, py[t]});
+        f_vix_t = $signed({{(64 - V_INT_W){vix[t][V_INT_W-1]}}, vix[t]});
+        f_viy_t = $signed({{(64 - V_INT_W){viy[t][V_INT_W-1]}}, viy[t]});
+        f_vmx_raw = $signed({{(64 - V_MCM_W){vmx[t][V_MCM_W-1]}}, vmx[t]});
+        f_vmy_raw = $signed({{(64 - V_MCM_W){vmy[t][V_MCM_W-1]}}, vmy[t]});
+        f_vmx = corrected_v(vmx[t], t_correct, t_neg_x, t_sat_x, t_qx);
+        f_vmy = corrected_v(vmy[t], t_correct, t_neg_y, t_sat_y, t_qy);
         // Exit prediction on the squared speed.
         f_sq_x = square(f_vmx, FV);
         f_sq_y = square(f_vmy, FV);
@@ -520,32 +578,32 @@ module evclust_core (
                || (f_top && f_vmy < 0 && speed_sq({1'b0, f_sq_y}, FV) >= f_limit)
                || (f_bottom && f_vmy > 0 && speed_sq({1'b0, f_sq_y}, FV) >= f_limit));
         f_moving_mcm = speed_sq({1'b0, square(f_vmx_raw, FV)} + {1'b0, square(f_vmy_raw, FV)}, FV) >= K_V_MIN_SQ;
-        f_moving_int = speed_sq({1'b0, square(f_vix, FI)} + {1'b0, square(f_viy, FI)}, FI) >= K_V_MIN_SQ;
-        f_report = a_decayed >= K_A_VALID && (f_moving_mcm || f_moving_int);
+        f_moving_int = speed_sq({1'b0, square(f_vix_t, FI)} + {1'b0, square(f_viy_t, FI)}, FI) >= K_V_MIN_SQ;
+        f_report = f_act >= K_A_VALID && (f_moving_mcm || f_moving_int);
         // The noise gate: A * W * H >= gate * A_bg * (pixels of the box), the gate in Q.NOISE_GATE_FRAC.
-        f_box = (2 * u64({{(63 - HALF_SIZE_W){1'b0}}, rx[k] >> FR}) + 1) * (2 * u64({{(63 - HALF_SIZE_W){1'b0}}, ry[k] >> FR}) + 1);
+        f_box = (2 * u64({{(63 - HALF_SIZE_W){1'b0}}, rx[t] >> FR}) + 1) * (2 * u64({{(63 - HALF_SIZE_W){1'b0}}, ry[t] >> FR}) + 1);
         if (K_NOISE_GATE != 0 && f_report)
-            f_report = (a_decayed * SENSOR_PIXELS) <<< NOISE_GATE_FRAC >= K_NOISE_GATE * u64({{(63 - ACTIVITY_W){1'b0}}, bg_act}) * f_box;
+            f_report = (f_act * SENSOR_PIXELS) <<< NOISE_GATE_FRAC >= K_NOISE_GATE * u64({{(63 - ACTIVITY_W){1'b0}}, bg_act}) * f_box;
         // The class: the strongest non-background histogram entry, none while all are zero.
         f_class = 8'hff;
         f_best = 0;
         for (cls = 0; cls < P; cls = cls + 1) begin
-            if (!BACKGROUND_MASK[cls] && u64({{(63 - HIST_W){1'b0}}, hist[k * P + cls]}) > f_best) begin
-                f_best = u64({{(63 - HIST_W){1'b0}}, hist[k * P + cls]});
+            if (!BACKGROUND_MASK[cls] && u64({{(63 - HIST_W){1'b0}}, hist[t * P + cls]}) > f_best) begin
+                f_best = u64({{(63 - HIST_W){1'b0}}, hist[t * P + cls]});
                 f_class = cls[7:0];
             end
         end
-        f_flags = (ever_reported[k] ? 4'd0 : FLAG_NEW) | ((f_left || f_right || f_top || f_bottom) ? FLAG_BORDER : 4'd0)
+        f_flags = (ever_reported[t] ? 4'd0 : FLAG_NEW) | ((f_left || f_right || f_top || f_bottom) ? FLAG_BORDER : 4'd0)
                 | (f_moving_mcm ? FLAG_MOVING_MCM : 4'd0) | (f_moving_int ? FLAG_MOVING_INT : 4'd0);
     end
 
-    // The record of the swept slot, in the layout of expected.hex.
-    wire signed [63:0] r_cy = corrected(u64({{(63 - COLOUR_W){1'b0}}, col_y[k]}), u64({{(63 - BACKGROUND_W){1'b0}}, bg_y}));
-    wire signed [63:0] r_cb = corrected(u64({{(63 - COLOUR_W){1'b0}}, col_cb[k]}), u64({{(63 - BACKGROUND_W){1'b0}}, bg_cb}));
-    wire signed [63:0] r_cr = corrected(u64({{(63 - COLOUR_W){1'b0}}, col_cr[k]}), u64({{(63 - BACKGROUND_W){1'b0}}, bg_cr}));
+    // The record of slot t, in the layout of expected.hex.
+    wire signed [63:0] r_cy = corrected(u64({{(63 - COLOUR_W){1'b0}}, col_y[t]}), u64({{(63 - BACKGROUND_W){1'b0}}, bg_y}));
+    wire signed [63:0] r_cb = corrected(u64({{(63 - COLOUR_W){1'b0}}, col_cb[t]}), u64({{(63 - BACKGROUND_W){1'b0}}, bg_cb}));
+    wire signed [63:0] r_cr = corrected(u64({{(63 - COLOUR_W){1'b0}}, col_cr[t]}), u64({{(63 - BACKGROUND_W){1'b0}}, bg_cr}));
     wire [REC_W-1:0] record = {
-        e_t, step, k, id[k], px[k], py[k], rx[k], ry[k], dec_a,
-        f_vmx[V_MCM_W-1:0], f_vmy[V_MCM_W-1:0], f_vix[V_INT_W-1:0], f_viy[V_INT_W-1:0],
+        e_t, step, t, id[t], px[t], py[t], rx[t], ry[t], act[t],
+        f_vmx[V_MCM_W-1:0], f_vmy[V_MCM_W-1:0], vix[t], viy[t],
         r_cy[COLOUR_W-1:0], r_cb[COLOUR_W-1:0], r_cr[COLOUR_W-1:0], f_class, f_flags
     };
 
@@ -712,6 +770,7 @@ module evclust_core (
     wire sweep_live = sweep_advance && index < N_SLOTS && valid[k];
     wire sweep_merge = sweep_live && !f_expire && merge_found;  // k absorbs merge_j first
     wire sweep_slot = sweep_live && !sweep_merge;
+    assign tail_en = sweep_advance && !sweep_merge;
 
     // The pipeline: stage A takes an event whenever it is empty or hands its event to stage B
     // in the same cycle; B (EXEC) takes it when B is empty (IDLE) or finishes an event that
@@ -751,6 +810,7 @@ module evclust_core (
             started <= 1'b0;
             a_valid <= 1'b0;
             seek_w <= {SLOT_W{1'b0}};
+            p_live <= 1'b0;
             boundaries <= 33'd0;
             per_frame <= {FRAME_PER_TAU_W{1'b0}};
             for (i = 0; i < N; i = i + 1) begin
@@ -960,7 +1020,7 @@ module evclust_core (
                 valid[m_j] <= 1'b0;
             end
 
-            if (sweep_slot) begin
+            if (sweep_slot) begin  // stage 0
                 act[k] <= dec_a;
                 residual[k] <= dec_residual;
                 t_last[k] <= e_t;
@@ -976,15 +1036,24 @@ module evclust_core (
                         ppx[k] <= px[k];
                         ppy[k] <= py[k];
                     end
-                    if (f_exit) begin
-                        valid[k] <= 1'b0;
-                    end else begin
-                        reported[k] <= f_report;
-                        if (f_report) begin
-                            ever_reported[k] <= 1'b1;
-                            rec_valid <= 1'b1;
-                            rec_data <= record;
-                        end
+                end
+            end
+            if (tail_en) begin  // the tail's first register
+                p_live <= sweep_slot && !f_expire;
+                p_slot <= k;
+                p_vmx <= vmx[k];
+                p_vmy <= vmy[k];
+                p_w20 <= norm[k][MCM_NORM_W-1 -: W20_W];
+            end
+            if (tail_en && t_live) begin  // the tail's last stage
+                if (f_exit) begin
+                    valid[t] <= 1'b0;
+                end else begin
+                    reported[t] <= f_report;
+                    if (f_report) begin
+                        ever_reported[t] <= 1'b1;
+                        rec_valid <= 1'b1;
+                        rec_data <= record;
                     end
                 end
             end

@@ -325,4 +325,5 @@ localparam integer BG_INIT_Y = 6321603;
 localparam integer BG_INIT_CB = 8519680;
 localparam integer BG_INIT_CR = 8366981;
 localparam integer BETA_SHIFT_ONLY = 0;
+localparam integer SWEEP_DIV_STEP = 4;  // quotient bits per stage of the sweep's divider
 // verilator lint_on UNUSEDPARAM

@@ -364,6 +364,15 @@ def verilog_header(table: FormatTable) -> str:
 # The RTL's limits beyond the model's: the trace names a slot in 8 bits, and the tau-boundary
 # count is compared with 2^FRAME_PER_TAU_W in a 33-bit word.
 RTL_MAX_CLUSTERS = 256
+# Quotient bits per stage of the sweep's pipelined divider (the MCM bias correction): fewer
+# bits, a shorter path and a longer sweep tail (`sweep_tail_cycles`). The results do not depend on it.
+SWEEP_DIV_STEP = 4
+
+
+def sweep_tail_cycles(table: FormatTable) -> int:
+    """The cycles a filter sweep's tail adds: the operand register and the divider's stages."""
+    quotient_bits = table.formats["v_mcm"].word_bits - 1
+    return 1 + -(-quotient_bits // SWEEP_DIV_STEP)
 
 
 def _verilog_lines(table: FormatTable) -> str:
@@ -407,5 +416,6 @@ def _verilog_lines(table: FormatTable) -> str:
     for name, value in table.options:
         out.append(f"localparam integer {name} = {value};")
     out.append(f"localparam integer BETA_SHIFT_ONLY = {int(table.beta_shift_only)};")
+    out.append(f"localparam integer SWEEP_DIV_STEP = {SWEEP_DIV_STEP};  // quotient bits per stage of the sweep's divider")
     out.append("// verilator lint_on UNUSEDPARAM")
     return "\n".join(out) + "\n"
