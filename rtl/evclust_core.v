@@ -55,7 +55,7 @@ module evclust_core (
     output reg  [REC_W-1:0]   rec_data;
     output reg                trace_valid;
     output reg  [TRACE_W-1:0] trace_data;
-    output wire               filter_active;  // the filter step is sweeping the table
+    output wire               filter_active;  // a filter step: its phase cycle(s) and its sweep
 
     // ---------------------------------------------------------------- formats and constants
     localparam integer FP = CENTRE_FRAC, FR = HALF_SIZE_FRAC, FA = ACTIVITY_FRAC, FV = V_MCM_FRAC;
@@ -255,7 +255,7 @@ module evclust_core (
     reg [CELL_W-1:0]         init_cell;  // INIT: the cell being cleared
 
     // ---------------------------------------------------------------- control
-    localparam [2:0] ST_INIT = 3'd0, ST_IDLE = 3'd1, ST_EXEC = 3'd2, ST_SCAN = 3'd3, ST_EVICT = 3'd4, ST_SWEEP = 3'd5, ST_MERGE = 3'd6;
+    localparam [2:0] ST_INIT = 3'd0, ST_IDLE = 3'd1, ST_EXEC = 3'd2, ST_SCAN = 3'd3, ST_EVICT = 3'd4, ST_SWEEP = 3'd5, ST_MERGE = 3'd6, ST_PHASE = 3'd7;
     reg [2:0]              state;
     reg [SWEEP_W-1:0]      index;        // INIT: palette entry; SCAN: slot; SWEEP: slot and palette entry
     reg [31:0]             e_t;
@@ -266,7 +266,7 @@ module evclust_core (
     reg [32:0]             boundaries;   // tau boundaries since the last filter step
     reg [FRAME_PER_TAU_W-1:0] per_frame; // T_frame / (boundaries * tau)
 
-    assign filter_active = state == ST_SWEEP;
+    assign filter_active = state == ST_SWEEP || state == ST_PHASE;
 
     // ---------------------------------------------------------------- step 1: the seek
     // Stage A holds an accepted event while every slot compares it against its window in
@@ -668,15 +668,16 @@ module evclust_core (
     wire                  div_start = state == ST_MERGE && !m_started;
     wire                  div_x_done, div_y_done;
     wire [MOMENT_W-1:0]   div_x_q, div_y_q;
+    wire [ACTIVITY_W:0]   unused_left_x, unused_left_y;
     evclust_udiv #(.NUM_W(MOMENT_W), .DEN_W(ACTIVITY_W + 1)) div_x (
         .clk(clk), .rst(rst), .start(div_start),
         .numerator(m_moment_x[MOMENT_W-1:0]), .denominator(m_weight[ACTIVITY_W:0]),
-        .done(div_x_done), .quotient(div_x_q)
+        .done(div_x_done), .quotient(div_x_q), .remainder_out(unused_left_x)
     );
     evclust_udiv #(.NUM_W(MOMENT_W), .DEN_W(ACTIVITY_W + 1)) div_y (
         .clk(clk), .rst(rst), .start(div_start),
         .numerator(m_moment_y[MOMENT_W-1:0]), .denominator(m_weight[ACTIVITY_W:0]),
-        .done(div_y_done), .quotient(div_y_q)
+        .done(div_y_done), .quotient(div_y_q), .remainder_out(unused_left_y)
     );
     wire m_write = state == ST_MERGE && m_started && div_x_done && div_y_done;  // the merge's last cycle
 
@@ -703,12 +704,29 @@ module evclust_core (
     // Dividers sized to their operands: a 33-bit phase by the constant tau, T_frame/tau by a
     // count that leaves nothing once it reaches 2^FRAME_PER_TAU_W.
     wire [32:0] phase = {{(33 - TAU_PHASE_W){1'b0}}, tau_phase} + {1'b0, e_t - t_filter};
-    wire [32:0] phase_boundaries = phase / TAU[32:0];
-    wire [32:0] phase_left = phase - phase_boundaries * TAU[32:0];
-    wire        many_boundaries = phase_boundaries >= (33'd1 << FRAME_PER_TAU_W);
-    wire [FRAME_PER_TAU_W-1:0] boundary_count = phase_boundaries == 33'd0 ? {{(FRAME_PER_TAU_W - 1){1'b0}}, 1'b1}
-                                              : phase_boundaries[FRAME_PER_TAU_W-1:0];
-    wire [FRAME_PER_TAU_W-1:0] frame_per_boundary = many_boundaries ? {FRAME_PER_TAU_W{1'b0}} : FRAME_PER_TAU / boundary_count;
+    // The filter step's first cycle (PHASE) settles the usual cases, fewer than two boundaries,
+    // by comparison; more take two iterative divisions (phase / tau, then T_frame / count).
+    reg  [32:0] phase_q;     // the phase at the filter step's event
+    reg  [1:0]  phase_step;  // PHASE: deciding, dividing the phase, dividing the frame period
+    localparam [1:0] PHASE_DECIDE = 2'd0, PHASE_BY_TAU = 2'd1, PHASE_FRAME = 2'd2;
+    wire        phase_start = state == ST_PHASE && phase_step == PHASE_DECIDE && phase_q >= TAU[31:0] * 33'd2;
+    wire        by_tau_done, frame_done;
+    wire [32:0] by_tau_q;
+    wire [TAU_PHASE_W:0] by_tau_left;
+    evclust_udiv #(.NUM_W(33), .DEN_W(TAU_PHASE_W + 1)) div_phase (
+        .clk(clk), .rst(rst), .start(phase_start),
+        .numerator(phase_q), .denominator(TAU[TAU_PHASE_W:0]),
+        .done(by_tau_done), .quotient(by_tau_q), .remainder_out(by_tau_left)
+    );
+    wire        many_boundaries = by_tau_q >= (33'd1 << FRAME_PER_TAU_W);
+    wire        frame_start = state == ST_PHASE && phase_step == PHASE_BY_TAU && by_tau_done && !many_boundaries;
+    wire [FRAME_PER_TAU_W-1:0] frame_q;
+    wire [FRAME_PER_TAU_W-1:0] unused_frame_left;
+    evclust_udiv #(.NUM_W(FRAME_PER_TAU_W), .DEN_W(FRAME_PER_TAU_W)) div_frame (
+        .clk(clk), .rst(rst), .start(frame_start),
+        .numerator(FRAME_PER_TAU), .denominator(by_tau_q[FRAME_PER_TAU_W-1:0]),
+        .done(frame_done), .quotient(frame_q), .remainder_out(unused_frame_left)
+    );
 
     // 1/|palette_j - BG|^2 for the mixing rule (model: refresh_mixing), one entry per cycle.
     wire [CLASS_W-1:0] refresh_j = index[CLASS_W-1:0];
@@ -859,6 +877,35 @@ module evclust_core (
                         state <= ST_IDLE;
                     end
                 end
+                ST_PHASE: case (phase_step)  // tau boundaries since the last step and T_frame / (n tau)
+                    PHASE_DECIDE: if (phase_q < {1'b0, TAU[31:0]}) begin
+                        boundaries <= 33'd0;
+                        tau_phase <= phase_q[TAU_PHASE_W-1:0];
+                        per_frame <= FRAME_PER_TAU;  // T_frame / tau: n counts as 1
+                        state <= ST_SWEEP;
+                    end else if (!phase_start) begin  // one boundary
+                        boundaries <= 33'd1;
+                        tau_phase <= phase_q[TAU_PHASE_W-1:0] - TAU[TAU_PHASE_W-1:0];
+                        per_frame <= FRAME_PER_TAU;
+                        state <= ST_SWEEP;
+                    end else begin
+                        phase_step <= PHASE_BY_TAU;
+                    end
+                    PHASE_BY_TAU: if (by_tau_done) begin
+                        boundaries <= by_tau_q;
+                        tau_phase <= by_tau_left[TAU_PHASE_W-1:0];
+                        if (many_boundaries) begin  // T_frame / (n tau) leaves nothing
+                            per_frame <= {FRAME_PER_TAU_W{1'b0}};
+                            state <= ST_SWEEP;
+                        end else begin
+                            phase_step <= PHASE_FRAME;
+                        end
+                    end
+                    default: if (frame_done) begin
+                        per_frame <= frame_q;
+                        state <= ST_SWEEP;
+                    end
+                endcase
                 ST_MERGE: begin  // the dividers started in the first cycle; the slot written in the last
                     m_started <= 1'b1;
                     if (m_write) begin
@@ -895,11 +942,10 @@ module evclust_core (
                 end
                 if (sweep_due) begin
                     since_filter <= {EVERY_W{1'b0}};
-                    boundaries <= phase_boundaries;
-                    tau_phase <= phase_left[TAU_PHASE_W-1:0];
-                    per_frame <= frame_per_boundary;
+                    phase_q <= phase;
+                    phase_step <= PHASE_DECIDE;
                     index <= {SWEEP_W{1'b0}};
-                    state <= ST_SWEEP;
+                    state <= ST_PHASE;
                 end else begin
                     since_filter <= since_filter + 1'b1;
                     state <= ST_IDLE;

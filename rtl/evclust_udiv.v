@@ -12,7 +12,8 @@ module evclust_udiv #(
     input  wire [NUM_W-1:0] numerator,
     input  wire [DEN_W-1:0] denominator,  // not zero
     output reg              done,         // quotient valid, until the next start
-    output reg  [NUM_W-1:0] quotient
+    output reg  [NUM_W-1:0] quotient,
+    output wire [DEN_W-1:0] remainder_out  // numerator - quotient * denominator, with done
 );
     localparam integer COUNT_W = $clog2(NUM_W + 1);
     localparam [COUNT_W-1:0] LAST = NUM_W[COUNT_W-1:0];
@@ -26,6 +27,7 @@ module evclust_udiv #(
     wire           fits = shifted >= {1'b0, divisor};
     wire [DEN_W:0] reduced = shifted - {1'b0, divisor};
     wire           busy = count != {COUNT_W{1'b0}};
+    assign remainder_out = remainder;
 
     always @(posedge clk) begin
         if (rst) begin

@@ -284,8 +284,8 @@ def test_no_event_is_lost_or_duplicated_under_heavy_back_pressure(sim):
 @pytest.mark.parametrize("sim", SIMS)
 def test_one_cycle_per_event_and_max_n_p_plus_the_tail_per_sweep(sim):
     # Without gaps or stalls: each event takes one cycle (the seek of the next overlaps its
-    # update), each filter step max(N, P) cycles plus the sweep tail's, then one cycle in which
-    # the held event enters the seek again.
+    # update); each filter step its phase cycle (fewer than two tau boundaries here), max(N, P)
+    # cycles and the sweep tail's, then one cycle in which the held event enters the seek again.
     from evclust.fixed.formats import sweep_tail_cycles
     from evclust.vectors.read import load_case
 
@@ -295,14 +295,14 @@ def test_one_cycle_per_event_and_max_n_p_plus_the_tail_per_sweep(sim):
     manifest = json.loads((VECTORS / case / "manifest.json").read_text())
     tail = sweep_tail_cycles(load_case(VECTORS / case).table)
     assert stats["filter_steps"] == manifest["counts"]["steps"]
-    assert stats["filter_cycles"] == stats["filter_steps"] * (max(manifest["n_clusters"], manifest["palette_size"]) + tail)
+    assert stats["filter_cycles"] == stats["filter_steps"] * (1 + max(manifest["n_clusters"], manifest["palette_size"]) + tail)
     outside = stats["cycles"] - stats["filter_cycles"]
     assert stats["events"] + stats["filter_steps"] <= outside <= stats["events"] + stats["filter_steps"] + 8  # + the harness's start
 
 
 @pytest.mark.parametrize("sim", SIMS)
 def test_each_merge_holds_the_sweep_for_the_dividers_steps_plus_three_cycles(sim):
-    # Without gaps or stalls: one cycle per event, each filter step's max(N, P) + tail + 1
+    # Without gaps or stalls: one cycle per event, each filter step's 1 + max(N, P) + tail + 1
     # cycles, plus, for each merge, the detection, the dividers' start, their MERGE_MOMENT_W
     # steps and the write.
     from evclust.fixed.formats import sweep_tail_cycles
@@ -316,7 +316,7 @@ def test_each_merge_holds_the_sweep_for_the_dividers_steps_plus_three_cycles(sim
     moment_bits = table["merge_moment"].word_bits
     counts = manifest["counts"]
     assert counts["merged"] > 0 and counts["evicted"] == counts["dropped"] == 0  # no eviction scans
-    sweeps = counts["steps"] * (max(manifest["n_clusters"], manifest["palette_size"]) + sweep_tail_cycles(table) + 1)
+    sweeps = counts["steps"] * (1 + max(manifest["n_clusters"], manifest["palette_size"]) + sweep_tail_cycles(table) + 1)
     merges = stats["cycles"] - stats["events"] - sweeps
     assert counts["merged"] * (moment_bits + 3) <= merges <= counts["merged"] * (moment_bits + 3) + 8  # + the harness's start
 
