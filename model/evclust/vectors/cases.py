@@ -120,8 +120,11 @@ def gaps() -> Case:
     t = 1000
     for k in range(6):
         rows += [(t + i, 30 + k, 20, 150, 128, 128) for i in range(64)]
-        t += 3_000_000  # three seconds of silence
-    return Case("clusters separated by gaps of three seconds", _events(rows), **SMALL, params=_small_params(), source="directed")
+        # Three seconds of silence (150 tau boundaries), once 45 minutes: more boundaries than
+        # T_frame / (n tau) resolves (2^FRAME_PER_TAU_W), so the frame period per boundary is 0.
+        t += 2_700_000_000 if k == 3 else 3_000_000
+    return Case("clusters separated by gaps of three seconds and one of 45 minutes", _events(rows), **SMALL, params=_small_params(),
+                source="directed")  # fmt: skip
 
 
 def borders() -> Case:
