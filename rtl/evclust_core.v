@@ -41,7 +41,9 @@ module evclust_core (
     localparam integer TRACE_W = 11;
     localparam integer SWEEP_LEN = N > P ? N : P;
     // The sweep tail: the operand register and the divider's stages (SWEEP_DIV_STEP bits each).
-    localparam integer TAIL = 1 + (V_MCM_W - 1 + SWEEP_DIV_STEP - 1) / SWEEP_DIV_STEP;
+    localparam integer INV_STAGES = (33 + SWEEP_DIV_STEP - 1) / SWEEP_DIV_STEP;  // 2^32 / |w|^2
+    localparam integer MCM_TAIL = 1 + (V_MCM_W - 1 + SWEEP_DIV_STEP - 1) / SWEEP_DIV_STEP;
+    localparam integer TAIL = MCM_TAIL > INV_STAGES ? MCM_TAIL : INV_STAGES;
     localparam integer SWEEP_W = $clog2(SWEEP_LEN + TAIL + 1);
     localparam integer EVERY_W = $clog2(FILTER_EVERY + 1);
 
@@ -86,9 +88,11 @@ module evclust_core (
     localparam signed [63:0] HI_X = (($signed({32'd0, SENSOR_WIDTH[31:0]}) - 64'sd1) <<< FP) - K_EXIT_M;
     localparam signed [63:0] HI_Y = (($signed({32'd0, SENSOR_HEIGHT[31:0]}) - 64'sd1) <<< FP) - K_EXIT_M;
     localparam [63:0] TAU = {32'd0, TAU_US[31:0]};
-    localparam integer LAST_SLOT_I = N - 1, LAST_ENTRY_I = P - 1, LAST_SWEEP_I = SWEEP_LEN + TAIL - 1;
-    localparam [SWEEP_W-1:0] LAST_SLOT = LAST_SLOT_I[SWEEP_W-1:0], LAST_ENTRY = LAST_ENTRY_I[SWEEP_W-1:0];
+    localparam integer LAST_SLOT_I = N - 1, LAST_SWEEP_I = SWEEP_LEN + TAIL - 1;
+    localparam [SWEEP_W-1:0] LAST_SLOT = LAST_SLOT_I[SWEEP_W-1:0];
     localparam [SWEEP_W-1:0] LAST_SWEEP = LAST_SWEEP_I[SWEEP_W-1:0];
+    localparam integer LAST_INIT_I = P + INV_STAGES - 1;  // the last mixing entry out of its divider
+    localparam [SWEEP_W-1:0] LAST_INIT = LAST_INIT_I[SWEEP_W-1:0];
     localparam [SWEEP_W-1:0] N_SLOTS = N[SWEEP_W-1:0], N_ENTRIES = P[SWEEP_W-1:0];
     localparam integer COS_SQ_F = 16;
     // One cluster per object (beyond the paper): scaled seek, merging, noise gate, creation support.
@@ -734,8 +738,21 @@ module evclust_core (
     wire signed [63:0] w_cb = u64({55'd0, PALETTE_CB[refresh_j * 8 +: 8]}) - (u64({{(63 - BACKGROUND_W){1'b0}}, bg_cb}) >>> FB);
     wire signed [63:0] w_cr = u64({55'd0, PALETTE_CR[refresh_j * 8 +: 8]}) - (u64({{(63 - BACKGROUND_W){1'b0}}, bg_cr}) >>> FB);
     wire signed [63:0] ww = w_y * w_y + w_cb * w_cb + w_cr * w_cr;  // < 3 * 255^2 < 2^18
-    wire [32:0] inverse = ww == 64'sd0 ? 33'd0 : (33'd1 << 32) / {15'd0, ww[17:0]};
-    wire [INV_WW_W-1:0] refreshed = inverse[INV_WW_W-1:0];
+    // 2^32 / ww in a pipelined divider, INV_STAGES cycles behind the entry fed (INIT and the
+    // sweep feed one entry per cycle; the sweep's tail and INIT wait for it).
+    wire               inv_en = state == ST_INIT || tail_en;
+    wire               inv_live = index < N_ENTRIES && (state == ST_INIT || (MIXING != 0 && BG_FIXED == 0));
+    wire [CLASS_W+1:0] inv_tag;
+    wire [32:0]        inverse;
+    evclust_pipediv #(.Q_W(33), .DEN_W(18), .STEP(SWEEP_DIV_STEP), .TAG_W(CLASS_W + 2)) div_inverse (
+        .clk(clk), .rst(rst), .en(inv_en),
+        .remainder_in(18'd0), .bits_in(33'd1 << 32), .divisor(ww == 64'sd0 ? 18'd1 : ww[17:0]),
+        .tag_in({inv_live, ww == 64'sd0, refresh_j}),
+        .quotient(inverse), .tag_out(inv_tag)
+    );
+    wire               inv_out_live = inv_tag[CLASS_W+1];
+    wire [CLASS_W-1:0] inv_out_j = inv_tag[CLASS_W-1:0];
+    wire [INV_WW_W-1:0] refreshed = inv_tag[CLASS_W] ? {INV_WW_W{1'b0}} : inverse[INV_WW_W-1:0];
 
     // ---------------------------------------------------------------- the event's decision
     // EXEC: update the slot found, or create in a free one; SCAN finds the weakest; EVICT
@@ -838,15 +855,13 @@ module evclust_core (
         end else begin
             case (state)
                 ST_INIT: begin  // the mixing rule's table for the initial background; the support map cleared
-                    if (index <= LAST_ENTRY) begin
-                        inv_ww[refresh_j * INV_WW_W +: INV_WW_W] <= refreshed;
+                    if (index < LAST_INIT)
                         index <= index + 1'b1;
-                    end
                     if (CREATE_SUPPORT != 0) begin
                         support_seen[init_cell] <= 1'b0;
                         init_cell <= init_cell + 1'b1;
                     end
-                    if (index >= LAST_ENTRY && (CREATE_SUPPORT == 0 || init_cell == LAST_CELL)) begin
+                    if (index >= LAST_INIT && (CREATE_SUPPORT == 0 || init_cell == LAST_CELL)) begin
                         index <= {SWEEP_W{1'b0}};
                         state <= ST_IDLE;
                     end
@@ -868,8 +883,6 @@ module evclust_core (
                     m_j <= merge_j;
                     state <= ST_MERGE;
                 end else if (sweep_advance) begin
-                    if (index < N_ENTRIES && MIXING != 0 && BG_FIXED == 0)
-                        inv_ww[refresh_j * INV_WW_W +: INV_WW_W] <= refreshed;
                     index <= index + 1'b1;
                     if (index == LAST_SWEEP) begin
                         step <= step + 32'd1;
@@ -1084,6 +1097,8 @@ module evclust_core (
                     end
                 end
             end
+            if (inv_en && inv_out_live)  // a mixing entry out of its divider
+                inv_ww[inv_out_j * INV_WW_W +: INV_WW_W] <= refreshed;
             if (tail_en) begin  // the tail's first register
                 p_live <= sweep_slot && !f_expire;
                 p_slot <= k;

@@ -286,18 +286,19 @@ def test_one_cycle_per_event_and_max_n_p_plus_the_tail_per_sweep(sim):
     # Without gaps or stalls: each event takes one cycle (the seek of the next overlaps its
     # update); each filter step its phase cycle (fewer than two tau boundaries here), max(N, P)
     # cycles and the sweep tail's, then one cycle in which the held event enters the seek again.
-    from evclust.fixed.formats import sweep_tail_cycles
+    from evclust.fixed.formats import mixing_fill_cycles, sweep_tail_cycles
     from evclust.vectors.read import load_case
 
     case = "bursts"  # no evictions: no scans
     result = run(sim, _case_header(case), "replay_vectors", {"cases": [str(VECTORS / case)], "seed": 1, "gap": 0, "stall": 0})
     stats = result["cases"][case]
     manifest = json.loads((VECTORS / case / "manifest.json").read_text())
-    tail = sweep_tail_cycles(load_case(VECTORS / case).table)
+    table = load_case(VECTORS / case).table
+    tail, start = sweep_tail_cycles(table), mixing_fill_cycles(table) + 8  # the reset's fill, the harness's start
     assert stats["filter_steps"] == manifest["counts"]["steps"]
     assert stats["filter_cycles"] == stats["filter_steps"] * (1 + max(manifest["n_clusters"], manifest["palette_size"]) + tail)
     outside = stats["cycles"] - stats["filter_cycles"]
-    assert stats["events"] + stats["filter_steps"] <= outside <= stats["events"] + stats["filter_steps"] + 8  # + the harness's start
+    assert stats["events"] + stats["filter_steps"] <= outside <= stats["events"] + stats["filter_steps"] + start
 
 
 @pytest.mark.parametrize("sim", SIMS)
@@ -305,7 +306,7 @@ def test_each_merge_holds_the_sweep_for_the_dividers_steps_plus_three_cycles(sim
     # Without gaps or stalls: one cycle per event, each filter step's 1 + max(N, P) + tail + 1
     # cycles, plus, for each merge, the detection, the dividers' start, their MERGE_MOMENT_W
     # steps and the write.
-    from evclust.fixed.formats import sweep_tail_cycles
+    from evclust.fixed.formats import mixing_fill_cycles, sweep_tail_cycles
     from evclust.vectors.read import load_case
 
     case = "merge_edges"
@@ -318,7 +319,8 @@ def test_each_merge_holds_the_sweep_for_the_dividers_steps_plus_three_cycles(sim
     assert counts["merged"] > 0 and counts["evicted"] == counts["dropped"] == 0  # no eviction scans
     sweeps = counts["steps"] * (1 + max(manifest["n_clusters"], manifest["palette_size"]) + sweep_tail_cycles(table) + 1)
     merges = stats["cycles"] - stats["events"] - sweeps
-    assert counts["merged"] * (moment_bits + 3) <= merges <= counts["merged"] * (moment_bits + 3) + 8  # + the harness's start
+    start = mixing_fill_cycles(table) + 8  # the reset's fill, the harness's start
+    assert counts["merged"] * (moment_bits + 3) <= merges <= counts["merged"] * (moment_bits + 3) + start
 
 
 def _tampered_copy(tmp_path, case: str, edit) -> Path:
