@@ -72,7 +72,7 @@ module evclust_core (
     localparam signed [63:0] MAX_SPEED_SQ = (64'sd1 <<< SPEED_SQ_W) - 1;
     localparam signed [63:0] MAX_V = (64'sd1 <<< (V_MCM_W - 1)) - 1, MIN_V = -(64'sd1 <<< (V_MCM_W - 1));
     localparam signed [63:0] MAX_VI = (64'sd1 <<< (V_INT_W - 1)) - 1, MIN_VI = -(64'sd1 <<< (V_INT_W - 1));
-    localparam signed [63:0] MAX_STEP = (64'sd1 <<< (4 + FP)) - 1, MIN_STEP = -(64'sd1 <<< (4 + FP));
+    localparam signed [63:0] MAX_STEP = (64'sd1 <<< (CENTRE_STEP_W - 1)) - 1, MIN_STEP = -(64'sd1 <<< (CENTRE_STEP_W - 1));
     localparam signed [63:0] H_MAX = (64'sd1 <<< HIST_W) - 1;
     localparam signed [63:0] K_B_POS = $signed({{(64 - BETA_POS_W){1'b0}}, BETA_POS}), K_B_SIZE = $signed({{(64 - BETA_SIZE_W){1'b0}}, BETA_SIZE});
     localparam signed [63:0] K_B_VM = $signed({{(64 - BETA_VEL_MCM_W){1'b0}}, BETA_VEL_MCM}), K_B_VI = $signed({{(64 - BETA_VEL_INT_W){1'b0}}, BETA_VEL_INT});
@@ -94,7 +94,7 @@ module evclust_core (
     localparam integer LAST_INIT_I = P + INV_STAGES - 1;  // the last mixing entry out of its divider
     localparam [SWEEP_W-1:0] LAST_INIT = LAST_INIT_I[SWEEP_W-1:0];
     localparam [SWEEP_W-1:0] N_SLOTS = N[SWEEP_W-1:0], N_ENTRIES = P[SWEEP_W-1:0];
-    localparam integer COS_SQ_F = 16;
+    localparam integer COS_SQ_F = COS_SQ_EXIT_FRAC;
     // One cluster per object (beyond the paper): scaled seek, merging, noise gate, creation support.
     localparam signed [63:0] K_SEEK_SCALE = $signed({{(64 - SEEK_SCALE_W){1'b0}}, SEEK_SCALE});
     localparam signed [63:0] K_MERGE_SCALE = $signed({{(64 - MERGE_SCALE_W){1'b0}}, MERGE_SCALE});
@@ -111,7 +111,7 @@ module evclust_core (
     localparam [INTERVAL_UPDATES_W-1:0] VI_COUNT_MAX = VI_COUNT_MAX_I[INTERVAL_UPDATES_W-1:0];
     localparam [INTERVAL_UPDATES_W-1:0] VI_WARM_END = VI_CAP[INTERVAL_UPDATES_W-1:0];
     localparam [INTERVAL_UPDATES_W-1:0] VI_NONE = 0, VI_FIRST = 1, VI_MEASURED = 2;
-    localparam integer W20_W = MCM_NORM_W - (FW - 20);  // w with 20 fraction bits: the divisor
+    localparam integer W20_W = MCM_WEIGHT_W;  // w cut to mcm_weight's fraction bits: the divisor
 
     localparam [2:0] TRACE_UPDATE = 3'd0, TRACE_CREATE = 3'd1, TRACE_EVICT = 3'd2, TRACE_DROP = 3'd3, TRACE_UNSUPPORTED = 3'd4;
     localparam [3:0] FLAG_NEW = 4'd1, FLAG_BORDER = 4'd2, FLAG_MOVING_MCM = 4'd4, FLAG_MOVING_INT = 4'd8;
@@ -183,7 +183,7 @@ module evclust_core (
     function automatic signed [63:0] gamma_from_activity;
         input signed [63:0] a;
         begin
-            gamma_from_activity = GAMMA_MODE == 0 ? K_GAMMA_GLOBAL : (a * K_GPA) >>> (FA + GAMMA_PER_ACTIVITY_FRAC - FG);
+            gamma_from_activity = GAMMA_MODE == GAMMA_MODE_GLOBAL ? K_GAMMA_GLOBAL : (a * K_GPA) >>> (FA + GAMMA_PER_ACTIVITY_FRAC - FG);
         end
     endfunction
 
@@ -191,15 +191,15 @@ module evclust_core (
     // V's format: a negative quotient is -ceil(|a| / b) = -((|a| + b - 1) / b). The magnitude's
     // top part decides saturation (a quotient of 2^Q_W or more), and below it the quotient has
     // Q_W bits, which the sweep tail's pipelined divider computes from the rest.
-    localparam integer QUOTIENT_W = V_MCM_W + 21;  // |V << 20| + b - 1
+    localparam integer QUOTIENT_W = V_MCM_W + MCM_WEIGHT_FRAC + 1;  // |V << F_w| + b - 1
     localparam integer Q_W = V_MCM_W - 1;          // a quotient that does not saturate
     function automatic [QUOTIENT_W-1:0] floor_magnitude;
-        input [V_MCM_W-1:0] v;  // the dividend is v << 20
+        input [V_MCM_W-1:0] v;  // the dividend is v << MCM_WEIGHT_FRAC
         input [W20_W-1:0] b;
         reg signed [63:0] a;
         reg [QUOTIENT_W-1:0] magnitude;
         begin
-            a = $signed({{(64 - V_MCM_W){v[V_MCM_W-1]}}, v}) <<< 20;
+            a = $signed({{(64 - V_MCM_W){v[V_MCM_W-1]}}, v}) <<< MCM_WEIGHT_FRAC;
             magnitude = a < 0 ? ~a[QUOTIENT_W-1:0] + {{(QUOTIENT_W - 1){1'b0}}, 1'b1} : a[QUOTIENT_W-1:0];
             floor_magnitude = a < 0 ? magnitude + {{(QUOTIENT_W - W20_W){1'b0}}, b} - {{(QUOTIENT_W - 1){1'b0}}, 1'b1} : magnitude;
         end
@@ -473,7 +473,7 @@ module evclust_core (
         f_expire = a_decayed < K_A_MIN;
         f_vi_count = vi_count[k];
         f_gamma = u64({{(63 - GAMMA_W){1'b0}}, gamma[k]});
-        if (GAMMA_MODE != 2 || vi_count[k] == VI_NONE)
+        if (GAMMA_MODE != GAMMA_MODE_COUNT || vi_count[k] == VI_NONE)
             f_gamma = saturate(gamma_from_activity(a_decayed), 0, MAX_GAMMA);
         f_evc = u64({{(63 - EVENTS_IN_INTERVAL_W){1'b0}}, ev_count[k]});
         f_vix = $signed({{(64 - V_INT_W){vix[k][V_INT_W-1]}}, vix[k]});
@@ -481,7 +481,7 @@ module evclust_core (
         f_mx = saturate(align((u64({{(63 - CENTRE_W){1'b0}}, px[k]}) - u64({{(63 - CENTRE_W){1'b0}}, ppx[k]})) * f_per_frame, FP + FPT_F, FI), MIN_VI, MAX_VI);
         f_my = saturate(align((u64({{(63 - CENTRE_W){1'b0}}, py[k]}) - u64({{(63 - CENTRE_W){1'b0}}, ppy[k]})) * f_per_frame, FP + FPT_F, FI), MIN_VI, MAX_VI);
         if (boundaries != 33'd0) begin
-            if (GAMMA_MODE == 2 && vi_count[k] != VI_NONE)
+            if (GAMMA_MODE == GAMMA_MODE_COUNT && vi_count[k] != VI_NONE)
                 f_gamma = saturate((f_evc * f_per_frame) >>> (FPT_F - FG), 0, MAX_GAMMA);
             f_evc = 0;
             if (WARM_START == 0 || vi_count[k] >= VI_WARM_END) begin
@@ -1104,7 +1104,7 @@ module evclust_core (
                 p_slot <= k;
                 p_vmx <= vmx[k];
                 p_vmy <= vmy[k];
-                p_w20 <= norm[k][MCM_NORM_W-1 -: W20_W];
+                p_w20 <= norm[k][MCM_NORM_W-1 -: W20_W];  // floor to mcm_weight's fraction bits
             end
             if (tail_en && t_live) begin  // the tail's last stage
                 if (f_exit) begin

@@ -58,9 +58,13 @@ module evclust_palette (
     reg [7:0]         ad_y, ad_cb, ad_cr;
     reg signed [9:0]  w_y, w_cb, w_cr;
     reg signed [19:0] dot;
-    reg [50:0]        q_wide;
-    reg [16:0]        q;
-    reg signed [27:0] r_y, r_cb, r_cr;
+    localparam integer QF = MIXING_Q_FRAC;
+    localparam integer PROD_W = 18 + INV_WW_W;  // u.w (positive, 18 bits) x 2^32 / |w|^2
+    localparam integer RES_W = 10 + QF + 2;     // (u << QF) - q w
+    localparam [MIXING_Q_W-1:0] ONE_Q = 1 << QF;
+    reg [PROD_W-1:0]  q_wide;
+    reg [MIXING_Q_W-1:0] q;
+    reg signed [RES_W-1:0] r_y, r_cb, r_cr;
     reg [CLASS_W-1:0] nearest, mixed;
     reg mixed_found;
 
@@ -92,15 +96,16 @@ module evclust_palette (
             w_cb = t_cb[9:0];
             w_cr = t_cr[9:0];
             dot = u_y10 * w_y + u_cb10 * w_cb + u_cr10 * w_cr;
-            q_wide = {33'd0, dot[17:0]} * {18'd0, inv_ww[j*INV_WW_W +: INV_WW_W]};
-            q = dot <= 20'sd0 ? 17'd0 : (q_wide[50:16] > 35'd65536 ? 17'd65536 : q_wide[32:16]);  // Q0.16, clamped to 1
-            r_y = ($signed({{18{u_y10[9]}}, u_y10}) <<< 16) - $signed({11'd0, q}) * w_y;
-            r_cb = ($signed({{18{u_cb10[9]}}, u_cb10}) <<< 16) - $signed({11'd0, q}) * w_cb;
-            r_cr = ($signed({{18{u_cr10[9]}}, u_cr10}) <<< 16) - $signed({11'd0, q}) * w_cr;
-            t_y = abs64({{36{r_y[27]}}, r_y});
-            t_cb = abs64({{36{r_cb[27]}}, r_cb});
-            t_cr = abs64({{36{r_cr[27]}}, r_cr});
-            d_line = BACKGROUND_MASK[j] ? d_end : (W_Y * t_y + ((t_cb + t_cr) <<< FW)) >>> 16;
+            q_wide = {{(PROD_W - 18){1'b0}}, dot[17:0]} * {{(PROD_W - INV_WW_W){1'b0}}, inv_ww[j*INV_WW_W +: INV_WW_W]};
+            // mixing_q, clamped to 1
+            q = dot <= 20'sd0 ? {MIXING_Q_W{1'b0}} : (q_wide[PROD_W-1:QF] > {{(PROD_W - QF - MIXING_Q_W){1'b0}}, ONE_Q} ? ONE_Q : q_wide[QF +: MIXING_Q_W]);
+            r_y = ($signed({{(RES_W - 10){u_y10[9]}}, u_y10}) <<< QF) - $signed({{(RES_W - MIXING_Q_W){1'b0}}, q}) * w_y;
+            r_cb = ($signed({{(RES_W - 10){u_cb10[9]}}, u_cb10}) <<< QF) - $signed({{(RES_W - MIXING_Q_W){1'b0}}, q}) * w_cb;
+            r_cr = ($signed({{(RES_W - 10){u_cr10[9]}}, u_cr10}) <<< QF) - $signed({{(RES_W - MIXING_Q_W){1'b0}}, q}) * w_cr;
+            t_y = abs64({{(64 - RES_W){r_y[RES_W-1]}}, r_y});
+            t_cb = abs64({{(64 - RES_W){r_cb[RES_W-1]}}, r_cb});
+            t_cr = abs64({{(64 - RES_W){r_cr[RES_W-1]}}, r_cr});
+            d_line = BACKGROUND_MASK[j] ? d_end : (W_Y * t_y + ((t_cb + t_cr) <<< FW)) >>> QF;
             if (d_line <= TOLERANCE && d_end < mixed_d) begin
                 mixed = j[CLASS_W-1:0];
                 mixed_d = d_end;

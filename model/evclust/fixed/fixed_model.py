@@ -19,7 +19,7 @@ from evclust.clusterer.layout import (
     T_LAST, VALID, VI_COUNT, VIX, VIY, VMX, VMY,
 )  # fmt: skip
 from evclust.fixed.arith import FLOOR, NEAREST, alpha_step_nb, decay_apply_nb, decay_nb, decay_steps_nb
-from evclust.fixed.formats import DECAY_FRAC_BITS, DECAY_TABLE_BITS, NOISE_GATE_FRAC_BITS, SCALE_FRAC_BITS
+from evclust.fixed.formats import DECAY_FRAC_BITS, DECAY_TABLE_BITS, GAMMA_MODES, NOISE_GATE_FRAC_BITS, SCALE_FRAC_BITS
 
 TIME_MASK = (1 << 32) - 1
 # Globals beyond the float model's: the τ phase (µs since the last boundary).
@@ -51,8 +51,9 @@ SIGNALS = (
     C_MAX_EVCOUNT, C_MAX_SIZE_TARGET, C_V_FULL_BITS, C_MAX_SPEED_SQ,
     C_SEEK_SCALE, C_MERGE, C_MERGE_SCALE, C_MERGE_V_TOL, C_MERGE_V_REL, C_SCALE_F, C_NOISE_GATE, C_NOISE_GATE_F,
     C_SUPPORT, C_SUPPORT_BITS, C_SUPPORT_WINDOW, C_R_MAX_RAW, C_VI_CAP,
-) = range(84)  # fmt: skip
-N_CONSTANTS = 84
+    C_MIN_STEP, C_MAX_STEP, C_FWD, C_FQ,
+) = range(88)  # fmt: skip
+N_CONSTANTS = 88
 
 
 def constant_vector(table, params, has_colour: bool) -> np.ndarray:
@@ -76,7 +77,7 @@ def constant_vector(table, params, has_colour: bool) -> np.ndarray:
         k[code], k[bits] = c[name].raw, c[name].fmt.frac_bits
     k[C_INV_TH], k[C_INV_TH_F] = raw("inv_t_half"), c["inv_t_half"].fmt.frac_bits
     k[C_A_MIN], k[C_A_VALID], k[C_EVERY] = raw("a_min"), raw("a_valid"), params.filter_every
-    k[C_GAMMA_MODE] = ("global", "activity", "count").index(params.gamma_mode)
+    k[C_GAMMA_MODE] = GAMMA_MODES.index(params.gamma_mode)
     k[C_GAMMA_GLOBAL] = raw("gamma_global")
     k[C_GPA], k[C_GPA_F] = raw("gamma_per_activity"), c["gamma_per_activity"].fmt.frac_bits
     k[C_FPT], k[C_FPT_F] = raw("frame_per_tau"), c["frame_per_tau"].fmt.frac_bits
@@ -86,7 +87,9 @@ def constant_vector(table, params, has_colour: bool) -> np.ndarray:
     k[C_LUMA_W], k[C_LUMA_W_F] = raw("luma_weight"), (c["luma_weight"].fmt.frac_bits if "luma_weight" in c else 0)
     k[C_H_MAX] = (1 << params.hist_bits) - 1
     k[C_V_MIN_SQ], k[C_V_EXIT_SQ], k[C_SQ_F] = raw("v_min_sq"), raw("v_exit_sq"), f["speed_sq"].frac_bits
-    k[C_COS_SQ], k[C_COS_SQ_F] = raw("cos_sq_exit"), 16
+    k[C_COS_SQ], k[C_COS_SQ_F] = raw("cos_sq_exit"), (c["cos_sq_exit"].fmt.frac_bits if "cos_sq_exit" in c else 0)
+    k[C_MIN_STEP], k[C_MAX_STEP] = f["centre_step"].raw_min, f["centre_step"].raw_max
+    k[C_FWD], k[C_FQ] = f["mcm_weight"].frac_bits, f["mixing_q"].frac_bits
     k[C_EXIT_M] = raw("exit_margin")
     k[C_WIDTH], k[C_HEIGHT], k[C_COLOUR] = table.width, table.height, has_colour
     k[C_WARM], k[C_MCM_CORRECT] = params.velocity_warm_start, params.mcm_bias_correction
@@ -215,7 +218,7 @@ def _nearest_palette(ey, ecb, ecr, palette, k):
 def _mixing_palette(ey, ecb, ecr, bg, palette, inv_ww, background_mask, k):
     """The mixing rule (docs/FIXED_POINT.md): q in Q0.16 from a precomputed 1/|w|², then the
     L1 residual against the tolerance; distances in units of 2^-F_w."""
-    fw = k[C_LUMA_W_F]
+    fw, fq = k[C_LUMA_W_F], k[C_FQ]
     tol = k[C_MIX_TOL] << fw
     uy, ucb, ucr = ey - bg[0], ecb - bg[1], ecr - bg[2]
     best, best_d = -1, np.int64(1) << 62
@@ -226,9 +229,9 @@ def _mixing_palette(ey, ecb, ecr, bg, palette, inv_ww, background_mask, k):
         else:
             wy, wcb, wcr = palette[j, 0] - bg[0], palette[j, 1] - bg[1], palette[j, 2] - bg[2]
             dot = uy * wy + ucb * wcb + ucr * wcr
-            q = 0 if dot <= 0 else min((dot * inv_ww[j]) >> 16, np.int64(1) << 16)  # Q0.16
-            ry, rcb, rcr = (uy << 16) - q * wy, (ucb << 16) - q * wcb, (ucr << 16) - q * wcr
-            d_line = (k[C_LUMA_W] * abs(ry) + ((abs(rcb) + abs(rcr)) << fw)) >> 16
+            q = 0 if dot <= 0 else min((dot * inv_ww[j]) >> fq, np.int64(1) << fq)  # mixing_q
+            ry, rcb, rcr = (uy << fq) - q * wy, (ucb << fq) - q * wcb, (ucr << fq) - q * wcr
+            d_line = (k[C_LUMA_W] * abs(ry) + ((abs(rcb) + abs(rcr)) << fw)) >> fq
         if d_line <= tol and d_end < best_d:
             best, best_d = j, d_end
     return best if best >= 0 else _nearest_palette(ey, ecb, ecr, palette, k)
@@ -281,8 +284,8 @@ def _update(S, H, G, s, t, ex, ey, lum, cb, cr, k, table, palette, inv_ww, backg
     S[s, RX] = _seen(min(max(alpha_step_nb(S[s, RX], gx, k[C_B_SIZE], k[C_BB_SIZE], 0, FLOOR), k[C_R_MIN]), k[C_R_MAX]), S_HALF, ranges)
     S[s, RY] = _seen(min(max(alpha_step_nb(S[s, RY], gy, k[C_B_SIZE], k[C_BB_SIZE], 0, FLOOR), k[C_R_MIN]), k[C_R_MAX]), S_HALF, ranges)
     # 3d. MCM: V += β_vm (γ (P_new - P) - V); the same filter on 1 gives the bias-correction weight.
-    step_x = _store(px_new - px, -(np.int64(1) << (4 + fp)), (np.int64(1) << (4 + fp)) - 1, S_STEP, log, ranges)
-    step_y = _store(py_new - py, -(np.int64(1) << (4 + fp)), (np.int64(1) << (4 + fp)) - 1, S_STEP, log, ranges)
+    step_x = _store(px_new - px, k[C_MIN_STEP], k[C_MAX_STEP], S_STEP, log, ranges)
+    step_y = _store(py_new - py, k[C_MIN_STEP], k[C_MAX_STEP], S_STEP, log, ranges)
     ux = _store(_align(S[s, GAMMA] * step_x, k[C_FG] + fp, k[C_FV]), k[C_MIN_V], k[C_MAX_V], S_MCM_IN, log, ranges)
     uy = _store(_align(S[s, GAMMA] * step_y, k[C_FG] + fp, k[C_FV]), k[C_MIN_V], k[C_MAX_V], S_MCM_IN, log, ranges)
     # Rounded to nearest: V's input is at V's own LSB, so a floor would drift one way.
@@ -465,11 +468,11 @@ def _filter_step(S, H, G, t, k, table, gains, palette, inv_ww, background_mask, 
             S[s, PPX], S[s, PPY] = S[s, PX], S[s, PY]
         # The reported MCM velocity: V / w, the sweep's one division.
         vmx, vmy = S[s, VMX], S[s, VMY]
-        w20 = S[s, MCM_NORM] >> (fw - 20)  # w to 20 fraction bits: V·2^20 fits an int64
-        if k[C_MCM_CORRECT] != 0 and w20 > 0:
+        w_cut = S[s, MCM_NORM] >> (fw - k[C_FWD])  # w in mcm_weight's format: V·2^F fits an int64
+        if k[C_MCM_CORRECT] != 0 and w_cut > 0:
             # Saturated: early on (w small) V/w can leave V's format, which the record must hold.
-            vmx = _store((S[s, VMX] << 20) // w20, k[C_MIN_V], k[C_MAX_V], S_VM, log, ranges)
-            vmy = _store((S[s, VMY] << 20) // w20, k[C_MIN_V], k[C_MAX_V], S_VM, log, ranges)
+            vmx = _store((S[s, VMX] << k[C_FWD]) // w_cut, k[C_MIN_V], k[C_MAX_V], S_VM, log, ranges)
+            vmy = _store((S[s, VMY] << k[C_FWD]) // w_cut, k[C_MIN_V], k[C_MAX_V], S_VM, log, ranges)
         # Exit prediction on the squared speed (no square root).
         speed_sq = _store(_speed_sq(vmx, vmy, fv, k), 0, k[C_MAX_SPEED_SQ], S_SPEED, log, ranges)
         left, right, top, bottom = _near(S[s, PX], S[s, PY], k)

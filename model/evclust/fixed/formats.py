@@ -206,6 +206,8 @@ def build_formats(
                "interval measurements so far + 1, up to the warm-up's end (0: born in this interval)"),
         Format("inv_ww", False, 33, 0, "intermediate", "2^32 / |palette_j - BG|², refreshed at filter steps"),
         Format("mixing_q", False, 1, 16, "intermediate", "mixing fraction q, clamped to [0, 1]"),
+        # The MCM correction divides V·2^F by w cut to F fraction bits: V·2^20 fits an int64.
+        Format("mcm_weight", False, 1, 20, "intermediate", "w to 20 fraction bits: the MCM correction's divisor"),
         Format("dt", False, 32, 0, "intermediate", "t - t_last, µs (modulo 2^32)", overflow="wrap"),
         Format("support_time", False, 32, 0, "state", "creation-support map cell: time of its latest event, µs", overflow="wrap"),
         Format("merge_moment", False, _bits_for((1 << 16)) + coord + 1, 8 + pos_frac, "intermediate",
@@ -287,12 +289,17 @@ OPTIONAL_CONSTANTS = (
 )  # fmt: skip
 
 
+# The codes of clusterer.gamma_mode, in the model's constant vector and the RTL's header.
+GAMMA_MODES = ("global", "activity", "count")
+
+
 def _options(p: ClustererParams, background: Format) -> tuple[tuple[str, int], ...]:
     bg = p.background if p.background is not None else (128.0, 128.0, 128.0)
     mask = sum(1 << j for j, m in enumerate(p.background_mask()) if m)
     return (
         ("FILTER_EVERY", p.filter_every), ("TAU_US", int(round(p.tau_us))),
-        ("GAMMA_MODE", ("global", "activity", "count").index(p.gamma_mode)),
+        ("GAMMA_MODE", GAMMA_MODES.index(p.gamma_mode)),
+        *((f"GAMMA_MODE_{mode.upper()}", code) for code, mode in enumerate(GAMMA_MODES)),
         ("WARM_START", int(p.velocity_warm_start)), ("MCM_CORRECT", int(p.mcm_bias_correction)),
         ("VOTE_CONTRAST", int(p.palette_vote == "contrast")), ("MIXING", int(p.palette_assign == "mixing")),
         ("BG_FIXED", int(p.background is not None)), ("BACKGROUND_MASK", mask),
