@@ -35,8 +35,8 @@ module evclust_core (
     localparam integer P = PALETTE_SIZE;
     localparam integer SLOT_W = N > 1 ? $clog2(N) : 1;
     localparam integer CLASS_W = P > 1 ? $clog2(P) : 1;
-    localparam integer EV_W = 32 + 2 * EV_XY_W + 1 + 24;
-    localparam integer REC_W = 32 + 32 + SLOT_W + 32 + 2 * CENTRE_W + 2 * HALF_SIZE_W + ACTIVITY_W
+    localparam integer EV_W = EV_T_W + 2 * EV_XY_W + 1 + 3 * EV_COLOUR_W;
+    localparam integer REC_W = EV_T_W + 32 + SLOT_W + ID_W + 2 * CENTRE_W + 2 * HALF_SIZE_W + ACTIVITY_W
                              + 2 * V_MCM_W + 2 * V_INT_W + 3 * COLOUR_W + 8 + 4;
     localparam integer TRACE_W = 11;
     localparam integer SWEEP_LEN = N > P ? N : P;
@@ -207,7 +207,7 @@ module evclust_core (
 
     // ---------------------------------------------------------------- the cluster table
     reg                            valid         [0:N-1];
-    reg [31:0]                     id            [0:N-1];
+    reg [ID_W-1:0]                 id            [0:N-1];
     reg [CENTRE_W-1:0]             px            [0:N-1];
     reg [CENTRE_W-1:0]             py            [0:N-1];
     reg [CENTRE_W-1:0]             ppx           [0:N-1];
@@ -216,7 +216,7 @@ module evclust_core (
     reg [HALF_SIZE_W-1:0]          ry            [0:N-1];
     reg [ACTIVITY_W-1:0]           act           [0:N-1];
     reg [DECAY_RESIDUAL_W-1:0]     residual      [0:N-1];
-    reg [31:0]                     t_last        [0:N-1];
+    reg [T_LAST_W-1:0]             t_last        [0:N-1];
     reg [GAMMA_W-1:0]              gamma         [0:N-1];
     reg [V_MCM_W-1:0]              vmx           [0:N-1];
     reg [V_MCM_W-1:0]              vmy           [0:N-1];
@@ -235,15 +235,15 @@ module evclust_core (
     // ---------------------------------------------------------------- globals
     reg [BACKGROUND_W-1:0]     bg_y, bg_cb, bg_cr;
     reg [P*INV_WW_W-1:0]       inv_ww;
-    reg [31:0]                 next_id;
+    reg [ID_W-1:0]             next_id;
     reg [31:0]                 step;
-    reg [31:0]                 t_filter;
+    reg [EV_T_W-1:0]           t_filter;
     reg [TAU_PHASE_W-1:0]      tau_phase;
     reg [EVERY_W-1:0]          since_filter;
     reg                        started;
     reg [ACTIVITY_W-1:0]       bg_act;       // the activity of the events no reported cluster takes
     reg [DECAY_RESIDUAL_W-1:0] bg_residual;
-    reg [31:0]                 bg_t;
+    reg [EV_T_W-1:0]           bg_t;
 
     // ---------------------------------------------------------------- the creation-support map
     // One cell per 2^SUPPORT_CELL_BITS px square, a border cell all round (model: layout.support_shape):
@@ -262,9 +262,9 @@ module evclust_core (
     localparam [2:0] ST_INIT = 3'd0, ST_IDLE = 3'd1, ST_EXEC = 3'd2, ST_SCAN = 3'd3, ST_EVICT = 3'd4, ST_SWEEP = 3'd5, ST_MERGE = 3'd6, ST_PHASE = 3'd7;
     reg [2:0]              state;
     reg [SWEEP_W-1:0]      index;        // INIT: palette entry; SCAN: slot; SWEEP: slot and palette entry
-    reg [31:0]             e_t;
+    reg [EV_T_W-1:0]       e_t;
     reg [EV_XY_W-1:0]      e_x, e_y;
-    reg [7:0]              e_lum, e_cb, e_cr;
+    reg [EV_COLOUR_W-1:0]  e_lum, e_cb, e_cr;
     reg [SLOT_W-1:0]       weakest;
     reg [ACTIVITY_W-1:0]   weakest_a;
     reg [32:0]             boundaries;   // tau boundaries since the last filter step
@@ -279,18 +279,19 @@ module evclust_core (
     // smallest of each, registered into stage B with the event. The slot that the event before
     // writes on that same clock edge is tested again in B (`seek_w`), so the search sees the
     // table exactly as the model does.
-    wire [31:0]        in_t = ev_data[EV_W-1 -: 32];
-    wire [EV_XY_W-1:0] in_x = ev_data[EV_W-33 -: EV_XY_W];
-    wire [EV_XY_W-1:0] in_y = ev_data[EV_W-33-EV_XY_W -: EV_XY_W];
-    wire [7:0]         in_lum = ev_data[23:16];
-    wire [7:0]         in_cb = ev_data[15:8];
-    wire [7:0]         in_cr = ev_data[7:0];
-    wire               unused_polarity = ev_data[24];  // the clusterer is blind to polarity
+    wire [EV_T_W-1:0]  in_t = ev_data[EV_W-1 -: EV_T_W];
+    localparam integer CW = EV_COLOUR_W;
+    wire [EV_XY_W-1:0] in_x = ev_data[EV_W-EV_T_W-1 -: EV_XY_W];
+    wire [EV_XY_W-1:0] in_y = ev_data[EV_W-EV_T_W-EV_XY_W-1 -: EV_XY_W];
+    wire [CW-1:0]      in_lum = ev_data[3*CW-1 -: CW];
+    wire [CW-1:0]      in_cb = ev_data[2*CW-1 -: CW];
+    wire [CW-1:0]      in_cr = ev_data[CW-1:0];
+    wire               unused_polarity = ev_data[3*CW];  // the clusterer is blind to polarity
 
     reg                a_valid;
-    reg [31:0]         a_t;
+    reg [EV_T_W-1:0]   a_t;
     reg [EV_XY_W-1:0]  a_x, a_y;
-    reg [7:0]          a_lum, a_cb, a_cr;
+    reg [CW-1:0]       a_lum, a_cb, a_cr;
 
     localparam integer DIST_W = CENTRE_W + 1;  // |dx| + |dy| of two points inside the sensor
     localparam integer SEEK_KEY_W = 1 + DIST_W + SLOT_W;
@@ -445,9 +446,9 @@ module evclust_core (
         u_vmy = alpha_step($signed({{(64 - V_MCM_W){vmy[e_slot][V_MCM_W-1]}}, vmy[e_slot]}), u_uy, K_B_VM, BETA_VEL_MCM_FRAC, 0, 1'b1);
         u_norm = alpha_step(u64({{(63 - MCM_NORM_W){1'b0}}, norm[e_slot]}), 64'sd1, K_B_VM, BETA_VEL_MCM_FRAC, FW, 1'b1);
         // 3e. Colour.
-        u_cy = alpha_step(u64({{(63 - COLOUR_W){1'b0}}, col_y[e_slot]}), u64({55'd0, e_lum}), K_B_LUM, BETA_LUM_FRAC, FC, 1'b0);
-        u_ccb = alpha_step(u64({{(63 - COLOUR_W){1'b0}}, col_cb[e_slot]}), u64({55'd0, e_cb}), K_B_CHRO, BETA_CHRO_FRAC, FC, 1'b0);
-        u_ccr = alpha_step(u64({{(63 - COLOUR_W){1'b0}}, col_cr[e_slot]}), u64({55'd0, e_cr}), K_B_CHRO, BETA_CHRO_FRAC, FC, 1'b0);
+        u_cy = alpha_step(u64({{(63 - COLOUR_W){1'b0}}, col_y[e_slot]}), u64({{(63 - CW){1'b0}}, e_lum}), K_B_LUM, BETA_LUM_FRAC, FC, 1'b0);
+        u_ccb = alpha_step(u64({{(63 - COLOUR_W){1'b0}}, col_cb[e_slot]}), u64({{(63 - CW){1'b0}}, e_cb}), K_B_CHRO, BETA_CHRO_FRAC, FC, 1'b0);
+        u_ccr = alpha_step(u64({{(63 - COLOUR_W){1'b0}}, col_cr[e_slot]}), u64({{(63 - CW){1'b0}}, e_cr}), K_B_CHRO, BETA_CHRO_FRAC, FC, 1'b0);
         // 3f. Palette histogram: a saturating counter; reaching the top halves the row.
         for (c = 0; c < P; c = c + 1)
             u_hist[c] = u64({{(63 - HIST_W){1'b0}}, hist[e_slot * P + c]});
@@ -794,9 +795,9 @@ module evclust_core (
         end
     end
     // The background learns from every event that is not a reported object's.
-    wire signed [63:0] bg_y_next = alpha_step(u64({{(63 - BACKGROUND_W){1'b0}}, bg_y}), u64({55'd0, e_lum}), K_B_BG, BETA_BG_FRAC, FB, 1'b0);
-    wire signed [63:0] bg_cb_next = alpha_step(u64({{(63 - BACKGROUND_W){1'b0}}, bg_cb}), u64({55'd0, e_cb}), K_B_BG, BETA_BG_FRAC, FB, 1'b0);
-    wire signed [63:0] bg_cr_next = alpha_step(u64({{(63 - BACKGROUND_W){1'b0}}, bg_cr}), u64({55'd0, e_cr}), K_B_BG, BETA_BG_FRAC, FB, 1'b0);
+    wire signed [63:0] bg_y_next = alpha_step(u64({{(63 - BACKGROUND_W){1'b0}}, bg_y}), u64({{(63 - CW){1'b0}}, e_lum}), K_B_BG, BETA_BG_FRAC, FB, 1'b0);
+    wire signed [63:0] bg_cb_next = alpha_step(u64({{(63 - BACKGROUND_W){1'b0}}, bg_cb}), u64({{(63 - CW){1'b0}}, e_cb}), K_B_BG, BETA_BG_FRAC, FB, 1'b0);
+    wire signed [63:0] bg_cr_next = alpha_step(u64({{(63 - BACKGROUND_W){1'b0}}, bg_cr}), u64({{(63 - CW){1'b0}}, e_cr}), K_B_BG, BETA_BG_FRAC, FB, 1'b0);
     wire signed [63:0] gamma_new = gamma_from_activity(ONE_A);
     wire sweep_due = {{(32 - EVERY_W){1'b0}}, since_filter} + 32'd1 >= FILTER_EVERY;
     // An update of a reported cluster is the object's colour, not the background's.
@@ -829,7 +830,7 @@ module evclust_core (
             trace_data <= {TRACE_W{1'b0}};
             bg_act <= {ACTIVITY_W{1'b0}};
             bg_residual <= {DECAY_RESIDUAL_W{1'b0}};
-            bg_t <= 32'd0;
+            bg_t <= {EV_T_W{1'b0}};
             init_cell <= {CELL_W{1'b0}};
             m_j <= {SLOT_W{1'b0}};
             m_started <= 1'b0;
@@ -837,9 +838,9 @@ module evclust_core (
             bg_cb <= BG_INIT_CB[BACKGROUND_W-1:0];
             bg_cr <= BG_INIT_CR[BACKGROUND_W-1:0];
             inv_ww <= {(P * INV_WW_W){1'b0}};
-            next_id <= 32'd0;
+            next_id <= {ID_W{1'b0}};
             step <= 32'd0;
-            t_filter <= 32'd0;
+            t_filter <= {EV_T_W{1'b0}};
             tau_phase <= {TAU_PHASE_W{1'b0}};
             since_filter <= {EVERY_W{1'b0}};
             started <= 1'b0;
@@ -1021,7 +1022,7 @@ module evclust_core (
             if (do_create) begin
                 valid[create_slot] <= 1'b1;
                 id[create_slot] <= next_id;
-                next_id <= next_id + 32'd1;
+                next_id <= next_id + 1'b1;
                 px[create_slot] <= {{(CENTRE_W - EV_XY_W - FP){1'b0}}, e_x, {FP{1'b0}}};
                 py[create_slot] <= {{(CENTRE_W - EV_XY_W - FP){1'b0}}, e_y, {FP{1'b0}}};
                 ppx[create_slot] <= {{(CENTRE_W - EV_XY_W - FP){1'b0}}, e_x, {FP{1'b0}}};

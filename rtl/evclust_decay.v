@@ -14,7 +14,7 @@ module evclust_decay (
 `include "evclust_params.vh"
 
     input  wire [ACTIVITY_W-1:0]       activity;
-    input  wire [31:0]                 dt;
+    input  wire [DT_W-1:0]             dt;
     input  wire [DECAY_RESIDUAL_W-1:0] residual;
     input  wire                        use_residual;
     output wire [ACTIVITY_W-1:0]       decayed;
@@ -27,7 +27,7 @@ module evclust_decay (
     localparam [6:0] FRACTION_SHIFT = DECAY_TABLE_FRAC[6:0];
     localparam [63:0] MAX_HALVINGS = {32'd0, MAX_SHIFT[31:0]};
 
-    wire [63:0] steps = {32'd0, dt} * {{(64 - INV_T_HALF_W){1'b0}}, INV_T_HALF}
+    wire [63:0] steps = {{(64 - DT_W){1'b0}}, dt} * {{(64 - INV_T_HALF_W){1'b0}}, INV_T_HALF}
                       + (use_residual ? {{(64 - DECAY_RESIDUAL_W){1'b0}}, residual} : 64'd0);
     wire [63:0] m = steps >> DROP;
     wire [63:0] halvings = m >> DECAY_TABLE_BITS;

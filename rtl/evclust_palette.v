@@ -21,9 +21,9 @@ module evclust_palette (
 
     localparam integer CLASS_W = PALETTE_SIZE > 1 ? $clog2(PALETTE_SIZE) : 1;
 
-    input  wire [7:0]                          lum;
-    input  wire [7:0]                          cb;
-    input  wire [7:0]                          cr;
+    input  wire [EV_COLOUR_W-1:0]              lum;
+    input  wire [EV_COLOUR_W-1:0]              cb;
+    input  wire [EV_COLOUR_W-1:0]              cr;
     input  wire [BACKGROUND_W-1:0]             bg_y;
     input  wire [BACKGROUND_W-1:0]             bg_cb;
     input  wire [BACKGROUND_W-1:0]             bg_cr;
@@ -37,9 +37,9 @@ module evclust_palette (
     localparam signed [63:0] TOLERANCE = $signed({{(64 - MIXING_TOLERANCE_W){1'b0}}, MIXING_TOLERANCE}) <<< FW;
     localparam signed [63:0] FAR = 64'sd1 <<< 62;
 
-    wire signed [63:0] e_y = $signed({56'd0, lum});
-    wire signed [63:0] e_cb = $signed({56'd0, cb});
-    wire signed [63:0] e_cr = $signed({56'd0, cr});
+    wire signed [63:0] e_y = $signed({{(64 - EV_COLOUR_W){1'b0}}, lum});
+    wire signed [63:0] e_cb = $signed({{(64 - EV_COLOUR_W){1'b0}}, cb});
+    wire signed [63:0] e_cr = $signed({{(64 - EV_COLOUR_W){1'b0}}, cr});
     wire signed [63:0] b_y = $signed({{(64 - BACKGROUND_W){1'b0}}, bg_y});
     wire signed [63:0] b_cb = $signed({{(64 - BACKGROUND_W){1'b0}}, bg_cb});
     wire signed [63:0] b_cr = $signed({{(64 - BACKGROUND_W){1'b0}}, bg_cr});

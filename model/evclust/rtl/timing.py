@@ -27,7 +27,7 @@ from pathlib import Path
 
 from evclust.errors import EvclustError
 from evclust.rtl.sources import BUILD, REPO, RTL_SOURCES, require_repository
-from evclust.rtl.synth import last_step, rtl_snapshot
+from evclust.rtl.synth import ABC9_KNOBS, last_step, rtl_snapshot
 
 TOP = "evclust_core"
 PART = {"device": "LFE5U-85F", "nextpnr": ["--85k", "--package", "CABGA381", "--speed", "8"]}
@@ -66,7 +66,8 @@ def tool_identity() -> str:
 
 def yosys_script(src: Path, out: Path) -> str:
     reads = " ".join(str(src / f) for f in RTL_SOURCES)
-    return "\n".join([
+    # ABC9's &mfs and &verify off, as for synth_xilinx (evclust.rtl.synth: &mfs runs for tens of minutes here).
+    return "\n".join(ABC9_KNOBS + [
         f"read_verilog -I{src} {reads}",
         f"synth_ecp5 -top {TOP} -json {out / 'netlist.json'}",
         f"tee -o {out / 'stat.txt'} stat",
