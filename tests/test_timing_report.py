@@ -1,0 +1,65 @@
+"""The ECP5 timing flow's reading of a nextpnr report (evclust.rtl.timing), on a report written
+here in nextpnr's JSON layout with known figures."""
+
+import json
+
+from evclust.rtl.timing import _critical_path, _figures, cache_key
+
+
+def _step(kind, delay, cell, sources=()):
+    return {"type": kind, "delay": delay, "from": {"cell": cell}, "to": {"cell": cell}, "sources": list(sources)}
+
+
+REPORT = {
+    "fmax": {"clk": {"achieved": 87.5, "constraint": 100}},
+    "utilization": {
+        "TRELLIS_COMB": {"used": 1200, "available": 83640},
+        "TRELLIS_FF": {"used": 800, "available": 83640},
+        "MULT18X18D": {"used": 12, "available": 156},
+        "DP16KD": {"used": 0, "available": 208},
+    },
+    "critical_paths": [
+        {"from": "posedge clk", "to": "<async>", "path": [_step("logic", 9.0, "port")]},  # not clk to clk: ignored
+        {"from": "posedge clk", "to": "posedge clk", "path": [
+            _step("clk-to-q", 0.5, "a_ff"),
+            _step("routing", 1.0, "a_ff", ["evclust_core.v:10.1-10.5"]),
+            _step("logic", 0.25, "x_CCU2C_S0$CCU2_COMB0"),
+            _step("routing", 0.0, "x_CCU2C_S0$CCU2_COMB0"),
+            _step("logic", 0.25, "x_CCU2C_S0$CCU2_COMB1"),
+            _step("routing", 2.0, "lut", ["evclust_core.v:20.1-20.9"]),
+            _step("logic", 1.5, "lut"),
+            _step("setup", 0.5, "b_ff"),
+        ]},
+    ],
+}  # fmt: skip
+
+
+def test_the_clk_to_clk_path_is_counted_in_cells_carry_cells_and_nanoseconds():
+    path = _critical_path(REPORT)
+    assert path["from"] == "a_ff" and path["to"] == "b_ff"
+    assert path["cells"] == 3 and path["carry_cells"] == 2  # two carry halves and one LUT
+    assert path["logic_ns"] == 0.5 + 0.25 + 0.25 + 1.5 + 0.5
+    assert path["routing_ns"] == 3.0
+    assert path["sources"] == ["evclust_core.v:10.1-10.5", "evclust_core.v:20.1-20.9"]
+
+
+def test_figures_give_fmax_resources_and_fit(tmp_path):
+    (tmp_path / "report.json").write_text(json.dumps(REPORT))
+    figures = _figures(tmp_path)
+    assert figures["fmax_mhz"] == 87.5
+    assert figures["resources"]["lut4"] == 1200 and figures["resources"]["mult18"] == 12
+    assert figures["available"]["mult18"] == 156 and figures["fits"]
+    over = json.loads(json.dumps(REPORT))
+    over["utilization"]["MULT18X18D"]["used"] = 157
+    (tmp_path / "report.json").write_text(json.dumps(over))
+    assert not _figures(tmp_path)["fits"]
+
+
+def test_the_cache_key_follows_the_header_the_sources_and_routing():
+    sources = {"evclust_core.v": "module evclust_core; endmodule\n"}
+    key = cache_key("localparam integer N_CLUSTERS = 16;\n", sources, True, "tools 1")
+    assert key == cache_key("localparam integer N_CLUSTERS = 16;\n", dict(sources), True, "tools 1")
+    assert key != cache_key("localparam integer N_CLUSTERS = 4;\n", sources, True, "tools 1")
+    assert key != cache_key("localparam integer N_CLUSTERS = 16;\n", {"evclust_core.v": "module evclust_core; wire w; endmodule\n"}, True, "tools 1")
+    assert key != cache_key("localparam integer N_CLUSTERS = 16;\n", sources, False, "tools 1")
+    assert key != cache_key("localparam integer N_CLUSTERS = 16;\n", sources, True, "tools 2")
