@@ -293,7 +293,7 @@ module evclust_core (
     reg [EV_XY_W-1:0]  a_x, a_y;
     reg [CW-1:0]       a_lum, a_cb, a_cr;
 
-    localparam integer DIST_W = CENTRE_W + 1;  // |dx| + |dy| of two points inside the sensor
+    localparam integer DIST_W = SEEK_DISTANCE_W;  // |dx| + |dy| of two points inside the sensor
     localparam integer SEEK_KEY_W = 1 + DIST_W + SLOT_W;
     localparam integer FREE_KEY_W = 1 + SLOT_W;
 
@@ -429,10 +429,10 @@ module evclust_core (
         u_px_new = alpha_step(u_px, ex, K_B_POS, BETA_POS_FRAC, FP, 1'b0);
         u_py_new = alpha_step(u_py, ey, K_B_POS, BETA_POS_FRAC, FP, 1'b0);
         // 3c. Size.
-        u_ox = abs64((ex <<< FP) - u_px);  // |e - P| < 2^CENTRE_W
+        u_ox = abs64((ex <<< FP) - u_px);  // |e - P|: the offset format's magnitude
         u_oy = abs64((ey <<< FP) - u_py);
-        u_gx = saturate((u64({{(63 - CENTRE_W){1'b0}}, u_ox[CENTRE_W-1:0]}) * K_GAIN) >>> (SIZE_GAIN_FRAC + FP - FR), 0, MAX_SIZE_TARGET);
-        u_gy = saturate((u64({{(63 - CENTRE_W){1'b0}}, u_oy[CENTRE_W-1:0]}) * K_GAIN) >>> (SIZE_GAIN_FRAC + FP - FR), 0, MAX_SIZE_TARGET);
+        u_gx = saturate((u64({{(64 - OFFSET_W){1'b0}}, u_ox[OFFSET_W-2:0]}) * K_GAIN) >>> (SIZE_GAIN_FRAC + FP - FR), 0, MAX_SIZE_TARGET);
+        u_gy = saturate((u64({{(64 - OFFSET_W){1'b0}}, u_oy[OFFSET_W-2:0]}) * K_GAIN) >>> (SIZE_GAIN_FRAC + FP - FR), 0, MAX_SIZE_TARGET);
         u_rx = saturate(alpha_step(u64({{(63 - HALF_SIZE_W){1'b0}}, rx[e_slot]}), u_gx, K_B_SIZE, BETA_SIZE_FRAC, 0, 1'b0), K_R_MIN, K_R_MAX);
         u_ry = saturate(alpha_step(u64({{(63 - HALF_SIZE_W){1'b0}}, ry[e_slot]}), u_gy, K_B_SIZE, BETA_SIZE_FRAC, 0, 1'b0), K_R_MIN, K_R_MAX);
         // 3d. MCM velocity and its bias-correction weight.
@@ -554,7 +554,7 @@ module evclust_core (
     reg signed [63:0] f_speed_sq, f_limit;
     reg [2*SQ_MAG_W-1:0] f_sq_x, f_sq_y;
     reg               f_exit, f_left, f_right, f_top, f_bottom, f_moving_mcm, f_moving_int, f_report;
-    reg signed [63:0] f_box;
+    reg signed [63:0] f_box, f_noise_signal, f_noise_floor;
     reg signed [63:0] f_best;
     reg [7:0]         f_class;
     reg [3:0]         f_flags;
@@ -587,8 +587,10 @@ module evclust_core (
         f_report = f_act >= K_A_VALID && (f_moving_mcm || f_moving_int);
         // The noise gate: A * W * H >= gate * A_bg * (pixels of the box), the gate in Q.NOISE_GATE_FRAC.
         f_box = (2 * u64({{(63 - HALF_SIZE_W){1'b0}}, rx[t] >> FR}) + 1) * (2 * u64({{(63 - HALF_SIZE_W){1'b0}}, ry[t] >> FR}) + 1);
+        f_noise_signal = (f_act * SENSOR_PIXELS) <<< NOISE_GATE_FRAC;  // both sides fit noise_count
+        f_noise_floor = K_NOISE_GATE * u64({{(63 - ACTIVITY_W){1'b0}}, bg_act}) * f_box;
         if (K_NOISE_GATE != 0 && f_report)
-            f_report = (f_act * SENSOR_PIXELS) <<< NOISE_GATE_FRAC >= K_NOISE_GATE * u64({{(63 - ACTIVITY_W){1'b0}}, bg_act}) * f_box;
+            f_report = f_noise_signal[NOISE_COUNT_W-1:0] >= f_noise_floor[NOISE_COUNT_W-1:0];
         // The class: the strongest non-background histogram entry, none while all are zero.
         f_class = 8'hff;
         f_best = 0;

@@ -154,7 +154,8 @@ def build_formats(
         raise EvclustError(f"dead_band_bits = {dead_band_bits}: expected 0..16 guard bits beyond 1/β")
     p = params.resolved(t_frame_us)
     coord = _bits_for(max(width, height) - 1)
-    seek_int = _bits_for(p.r_max + p.seek_margin + max(width, height))
+    # The L1 distance of two points of the sensor needs one bit more than a coordinate.
+    seek_int = max(coord + 1, _bits_for(p.r_max + p.seek_margin + max(width, height)))
     betas = {
         "beta_pos": 1 - p.alpha_pos, "beta_size": 1 - p.alpha_size, "beta_vel_mcm": 1 - p.alpha_vel_mcm,
         "beta_vel_int": 1 - p.alpha_vel_int, "beta_lum": 1 - p.alpha_lum, "beta_chro": 1 - p.alpha_chro,
@@ -198,7 +199,6 @@ def build_formats(
         Format("centre_step", True, 4, pos_frac, "intermediate", "P_new - P, px"),
         Format("size_target", False, coord + _bits_for(p.size_gain), guard("beta_size"), "intermediate", "g_R·|e - P|, px, before R's clamp"),
         Format("speed_sq", False, 2 * _bits_for(v_full) + 1, 16, "intermediate", "|V|², (px/frame)²"),
-        Format("colour_distance", False, 11 + _bits_for(p.luma_weight), 6, "intermediate", "palette L1 distance (w_Y·|ΔY| in 2^-6)"),
         Format("vote", False, 10, 0, "intermediate", "palette vote: 1, or |e - BG|₁ rounded"),
         Format("decay_residual", False, 0, 0, "state", "Δt/T_half below one decay-table step (fraction bits set below)"),
         Format("tau_phase", False, _bits_for(p.tau_us), 0, "state", "µs since the last τ boundary"),
