@@ -7,7 +7,7 @@ import math
 import pytest
 
 from evclust.clusterer import load_params, track_events
-from evclust.fixed.formats import build_formats
+from evclust.fixed.formats import build_formats, sweep_tail_cycles
 from evclust.report.budget import OUTPUTS, SOURCES, budget, emulate, noise_sum_ratio, record_errors
 from evclust.report.report import NOISE_SUM_TOLERANCE_DB, write_report
 from evclust.scenes import load_scene
@@ -73,13 +73,14 @@ def test_the_quick_report_writes_its_markdown_and_figures(tmp_path):
     for figure in ("budget_traffic.png", "budget_pedestrian.png", "error_vs_bits_traffic.png", "ranges_traffic.png", "runtime_traffic.png"):
         assert (tmp_path / "img" / figure).stat().st_size > 5000
         assert f"img/{figure}" in text
-    # The RTL ran under both simulators, and its cycles per event follow the sweep law: two cycles
-    # an event plus max(N, P) per filter step every filter_every events (more only while a full
-    # table scans for a victim, and for the harness's start).
+    # The RTL ran under both simulators, and its cycles per event follow the schedule: one cycle
+    # an event plus, every filter_every events, a filter step of 1 + max(N, P) + the sweep tail
+    # + 1 cycles (more only while a full table scans for a victim, and for the harness's start).
     for sim in ("verilator", "icarus"):
         assert f"| traffic | RTL, {sim} (stream) |" in text
     cycles = {row.split(" | ")[0].lstrip("| "): float(row.split(" | ")[2]) for row in text.splitlines() if row.startswith("| N=")}
     params, _ = load_params("traffic")
     for label, n in (("N=4", 4), ("N=8", 8), ("N=16 (default)", 16)):
-        law = 2 + max(n, len(params.palette)) / params.filter_every
+        tail = sweep_tail_cycles(build_formats(params.model_copy(update={"n_clusters": n}), 480, 270, params.t_frame_us or 50000.0))
+        law = 1 + (2 + max(n, len(params.palette)) + tail) / params.filter_every
         assert law <= cycles[label] < law + 0.05, label
