@@ -5,13 +5,16 @@
 // (valid/ready, the word of expected.hex) and a trace of each event's action (a monitor port
 // without back-pressure, the word of trace.hex). Reset is synchronous and active high.
 //
-// Schedule: an event is accepted in IDLE together with the parallel nearest-cluster search
-// over all N slots, and applied in EXEC: 2 cycles per event. An event that finds no slot
-// and no free one scans the N slots for the weakest (N + 1 cycles more). Every FILTER_EVERY
-// events the filter step sweeps the table, one slot per cycle, while the mixing palette's
-// 1/|w|^2 entries are refreshed alongside: max(N, PALETTE_SIZE) cycles plus output stalls,
-// plus MERGE_MOMENT_W + 3 cycles per merge (the weighted centre's iterative division).
-// After a reset, INIT fills the mixing table and clears the creation-support map.
+// Schedule: one event per clock in steady state. Stage A holds an accepted event while all N
+// slots are searched in parallel; stage B (EXEC) applies it, while stage A searches for the
+// next (docs/RTL.md: the one-event-per-clock pipeline). An event that finds no slot and no
+// free one scans the N slots for the weakest (N + 1 cycles more). Every FILTER_EVERY events the
+// filter step counts the tau boundaries (PHASE: 1 cycle, or two iterative divisions when two or
+// more passed), sweeps the table one slot per cycle while the mixing palette's 1/|w|^2 entries
+// are refreshed alongside, and drains the sweep's tail (exit, report and record TAIL cycles
+// behind the slot): 1 + max(N, PALETTE_SIZE) + TAIL cycles plus output stalls, plus
+// MERGE_MOMENT_W + 3 cycles per merge (the weighted centre's iterative division). After a
+// reset, INIT fills the mixing table and clears the creation-support map.
 //
 // N, every width and every constant come from evclust_params.vh, generated from the model's
 // formats table (`evclust formats --verilog`).
@@ -504,6 +507,7 @@ module evclust_core (
     reg [SLOT_W-1:0]  p_slot;
     reg [V_MCM_W-1:0] p_vmx, p_vmy;
     reg [W20_W-1:0]   p_w20;
+    wire [MCM_NORM_W-1:0] norm_cut = norm[k] >> (FW - MCM_WEIGHT_FRAC);  // w floored to mcm_weight's format
     wire [QUOTIENT_W-1:0] p_mag_x = floor_magnitude(p_vmx, p_w20);
     wire [QUOTIENT_W-1:0] p_mag_y = floor_magnitude(p_vmy, p_w20);
     wire              p_correct = MCM_CORRECT != 0 && p_w20 != {W20_W{1'b0}};
@@ -862,7 +866,8 @@ module evclust_core (
                         index <= index + 1'b1;
                     if (CREATE_SUPPORT != 0) begin
                         support_seen[init_cell] <= 1'b0;
-                        init_cell <= init_cell + 1'b1;
+                        if (init_cell != LAST_CELL)  // a small map waits here for the mixing table
+                            init_cell <= init_cell + 1'b1;
                     end
                     if (index >= LAST_INIT && (CREATE_SUPPORT == 0 || init_cell == LAST_CELL)) begin
                         index <= {SWEEP_W{1'b0}};
@@ -1107,7 +1112,7 @@ module evclust_core (
                 p_slot <= k;
                 p_vmx <= vmx[k];
                 p_vmy <= vmy[k];
-                p_w20 <= norm[k][MCM_NORM_W-1 -: W20_W];  // floor to mcm_weight's fraction bits
+                p_w20 <= norm_cut[W20_W-1:0];
             end
             if (tail_en && t_live) begin  // the tail's last stage
                 if (f_exit) begin

@@ -156,6 +156,9 @@ def build_formats(
     coord = _bits_for(max(width, height) - 1)
     # The L1 distance of two points of the sensor needs one bit more than a coordinate.
     seek_int = max(coord + 1, _bits_for(p.r_max + p.seek_margin + max(width, height)))
+    activity_bits = _bits_for(1 << 16) + 8
+    noise_int = max(activity_bits + _bits_for(width * height) + NOISE_GATE_FRAC_BITS,
+                    _bits_for(p.noise_gate) + NOISE_GATE_FRAC_BITS + activity_bits + 2 * _bits_for(2 * int(p.r_max) + 1)) - 8
     betas = {
         "beta_pos": 1 - p.alpha_pos, "beta_size": 1 - p.alpha_size, "beta_vel_mcm": 1 - p.alpha_vel_mcm,
         "beta_vel_int": 1 - p.alpha_vel_int, "beta_lum": 1 - p.alpha_lum, "beta_chro": 1 - p.alpha_chro,
@@ -212,7 +215,8 @@ def build_formats(
         Format("support_time", False, 32, 0, "state", "creation-support map cell: time of its latest event, µs", overflow="wrap"),
         Format("merge_moment", False, _bits_for((1 << 16)) + coord + 1, 8 + pos_frac, "intermediate",
                "A_s·P_s + A_j·P_j of a merge (activity × centre)"),
-        Format("noise_count", False, 2 * (_bits_for(1 << 16) + 8) + 2, 8, "intermediate", "A·W·H against γ_n·A_bg·box (activity × px²)"),
+        # A·W·H << 4 against gate·A_bg·(2⌊R⌋ + 1)², the raw words with the activity's 8 fraction bits.
+        Format("noise_count", False, noise_int, 8, "intermediate", "A·W·H against γ_n·A_bg·box (activity × px²)"),
     ]
     formats = {fmt.name: fmt for fmt in f}
     # |V|^2 squares a full-scale velocity in the speed's fraction bits: it must fit an int64.
