@@ -33,8 +33,9 @@ def table(rows) -> str:
     for r in rows:
         res, avail, cp = r["resources"], r["available"], r["critical_path"]
         pct = lambda k: f"{res[k]:,} ({100 * res[k] / avail[k]:.0f} %)" if avail[k] else f"{res[k]:,}"  # noqa: E731
+        fmax = f"{r['fmax_mhz']:.1f}" if r["fmax_mhz"] is not None else "does not fit"
         lines.append(
-            f"| {r['n_clusters']} | {r['fmax_mhz']:.1f} | {'yes' if r['routed'] else 'placement estimate'} | {pct('lut4')} | {pct('ff')} "
+            f"| {r['n_clusters']} | {fmax} | {'yes' if r['routed'] else 'placement estimate'} | {pct('lut4')} | {pct('ff')} "
             f"| {pct('mult18')} | {pct('bram')} | {res['carry']:,} | {'yes' if r['fits'] else '**no**'} "
             f"| {cp.get('cells', '?')} ({cp.get('carry_cells', '?')}), {cp.get('logic_ns', 0):.1f} + {cp.get('routing_ns', 0):.1f} "
             f"| {(r['synth_s'] + r['pnr_s']) / 60:.0f} min |")  # fmt: skip
@@ -60,6 +61,9 @@ def section(rows) -> str:
     ]
     for r in rows:
         cp = r["critical_path"]
+        if not cp:
+            lines.append(f"- N = {r['n_clusters']}: not placed: the design needs more cells than the part has.")
+            continue
         lines.append(f"- N = {r['n_clusters']}: `{cp.get('from')}` to `{cp.get('to')}`; through {', '.join(cp.get('sources', [])[:6])}.")
     return "\n".join(lines + [END, ""])
 
@@ -79,7 +83,8 @@ def main():
             beat = lambda step, s, detail, n=n: print(f"  N={n}: {step} {s:5.0f} s {detail}", file=sys.stderr)  # noqa: E731
             figures = place_and_route(params_header(n), f"traffic-n{n}", not args.no_route, beat, snapshot)
             rows.append(figures | {"n_clusters": n})
-            print(f"timing: N={n}: {figures['fmax_mhz']:.1f} MHz{' (cached)' if figures['cached'] else ''}", file=sys.stderr)
+            fmax = f"{figures['fmax_mhz']:.1f} MHz" if figures["fmax_mhz"] is not None else "does not fit the part"
+            print(f"timing: N={n}: {fmax}{' (cached)' if figures['cached'] else ''}", file=sys.stderr)
     except EvclustError as e:
         sys.exit(f"timing: {e}")
     args.json.parent.mkdir(parents=True, exist_ok=True)

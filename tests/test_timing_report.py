@@ -63,3 +63,20 @@ def test_the_cache_key_follows_the_header_the_sources_and_routing():
     assert key != cache_key("localparam integer N_CLUSTERS = 16;\n", {"evclust_core.v": "module evclust_core; wire w; endmodule\n"}, True, "tools 1")
     assert key != cache_key("localparam integer N_CLUSTERS = 16;\n", sources, False, "tools 1")
     assert key != cache_key("localparam integer N_CLUSTERS = 16;\n", sources, True, "tools 2")
+
+
+def test_a_design_too_large_for_the_part_is_a_result_with_its_utilisation(tmp_path):
+    from evclust.rtl.timing import _unplaced
+
+    (tmp_path / "nextpnr.log").write_text(
+        "Info: Device utilisation:\n"
+        "Info: \t          MULT18X18D:     144/    156    92%\n"
+        "Info: \t          TRELLIS_FF:   17129/  83640    20%\n"
+        "Info: \t        TRELLIS_COMB:   94699/  83640   113%\n"
+        "ERROR: Unable to find legal placement for all cells, design is probably at utilisation limit.\n")  # fmt: skip
+    figures = _unplaced(tmp_path)
+    assert figures["fmax_mhz"] is None and not figures["fits"]
+    assert figures["resources"]["lut4"] == 94699 and figures["available"]["lut4"] == 83640
+    assert figures["resources"]["mult18"] == 144 and figures["resources"]["ff"] == 17129
+    (tmp_path / "nextpnr.log").write_text("ERROR: something else\n")
+    assert _unplaced(tmp_path) is None  # any other failure stays an error

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import re
 import shutil
 import subprocess
 import sys
@@ -122,6 +123,21 @@ def _figures(out: Path) -> dict:
     }
 
 
+def _unplaced(out: Path) -> dict | None:
+    """Figures of a design too large for the part: nextpnr's utilisation lines and no Fmax."""
+    log = (out / "nextpnr.log").read_text(errors="replace") if (out / "nextpnr.log").exists() else ""
+    if "Unable to place" not in log and "Unable to find legal placement" not in log:
+        return None
+    used = {m[1]: (int(m[2]), int(m[3])) for m in re.finditer(r"^Info:\s+(\w+):\s+(\d+)/\s*(\d+)", log, re.M)}
+    return {
+        "fmax_mhz": None,
+        "critical_path": {},
+        "resources": {name: used.get(cell, (0, 0))[0] for cell, name in RESOURCES.items()},
+        "available": {name: used.get(cell, (0, 0))[1] for cell, name in RESOURCES.items()},
+        "fits": False,
+    }
+
+
 def _run(cmd: list[str], cwd: Path, log: Path, what: str, heartbeat) -> float:
     start = time.monotonic()
     with open(cwd / f"{what}.stderr", "w") as err:
@@ -163,8 +179,15 @@ def place_and_route(header: str, label: str, route: bool = True, heartbeat=None,
     (out / "synth.ys").write_text(yosys_script(src, out))
     launcher = [sys.executable, "-c", LAUNCHER]
     synth_s = _run(launcher + ["yosys", "-q", "-l", str(out / "yosys.log"), str(out / "synth.ys")], out, out / "yosys.log", "yosys", heartbeat)
-    pnr_s = _run(launcher + ["nextpnr"] + nextpnr_args(out, route), out, out / "nextpnr.log", "nextpnr", heartbeat)
-    figures = _figures(out) | {
+    try:
+        pnr_s = _run(launcher + ["nextpnr"] + nextpnr_args(out, route), out, out / "nextpnr.log", "nextpnr", heartbeat)
+        measured = _figures(out)
+    except EvclustError:
+        measured = _unplaced(out)  # too large for the part: a result, not an error
+        if measured is None:
+            raise
+        pnr_s = 0.0
+    figures = measured | {
         "label": label, "rtl": rtl, "tools": identity, "device": PART["device"], "speed": 8,
         "routed": route, "synth_s": round(synth_s), "pnr_s": round(pnr_s),
     }  # fmt: skip
