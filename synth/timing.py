@@ -27,7 +27,7 @@ START, END = "<!-- bench:timing:start -->", "<!-- bench:timing:end -->"
 
 
 def table(rows) -> str:
-    head = ("| N | Fmax (MHz) | routed | LUT4 | FF | MULT18X18D | DP16KD | carry (CCU2C) | fits | critical path: cells "
+    head = ("| N | Fmax (MHz) | routed | logic cells (TRELLIS_COMB) | FF | MULT18X18D | DP16KD | carry (CCU2C) | fits | critical path: cells "
             "(carry), logic + routing ns | synth + P&R time |")  # fmt: skip
     lines = [head, "|" + "---|" * (head.count("|") - 1)]
     for r in rows:
@@ -36,7 +36,7 @@ def table(rows) -> str:
         fmax = f"{r['fmax_mhz']:.1f}" if r["fmax_mhz"] is not None else "does not fit"
         lines.append(
             f"| {r['n_clusters']} | {fmax} | {'yes' if r['routed'] else 'placement estimate'} | {pct('lut4')} | {pct('ff')} "
-            f"| {pct('mult18')} | {pct('bram')} | {res['carry']:,} | {'yes' if r['fits'] else '**no**'} "
+            f"| {pct('mult18')} | {pct('bram')} | {r['carry_cells']:,} | {'yes' if r['fits'] else '**no**'} "
             f"| {cp.get('cells', '?')} ({cp.get('carry_cells', '?')}), {cp.get('logic_ns', 0):.1f} + {cp.get('routing_ns', 0):.1f} "
             f"| {(r['synth_s'] + r['pnr_s']) / 60:.0f} min |")  # fmt: skip
     return "\n".join(lines)

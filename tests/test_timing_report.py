@@ -49,6 +49,9 @@ def test_figures_give_fmax_resources_and_fit(tmp_path):
     assert figures["fmax_mhz"] == 87.5
     assert figures["resources"]["lut4"] == 1200 and figures["resources"]["mult18"] == 12
     assert figures["available"]["mult18"] == 156 and figures["fits"]
+    assert figures["carry_cells"] == 0  # no Yosys statistics here
+    (tmp_path / "stat.txt").write_text("   Number of cells:  2000\n     15982   CCU2C\n     61846   LUT4\n")
+    assert _figures(tmp_path)["carry_cells"] == 15982
     over = json.loads(json.dumps(REPORT))
     over["utilization"]["MULT18X18D"]["used"] = 157
     (tmp_path / "report.json").write_text(json.dumps(over))

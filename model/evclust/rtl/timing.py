@@ -54,8 +54,14 @@ sys.exit(run(sys.argv[2:]))
 """
 
 # The part's resources as nextpnr names them, with the names the report uses.
-RESOURCES = {"TRELLIS_COMB": "lut4", "TRELLIS_FF": "ff", "MULT18X18D": "mult18", "DP16KD": "bram",
-             "TRELLIS_RAMW": "lutram_w", "CCU2C": "carry"}  # fmt: skip
+RESOURCES = {"TRELLIS_COMB": "lut4", "TRELLIS_FF": "ff", "MULT18X18D": "mult18", "DP16KD": "bram", "TRELLIS_RAMW": "lutram_w"}
+
+
+def _carry_cells(out: Path) -> int:
+    """CCU2C cells (2 carry bits each) in Yosys's statistics: nextpnr counts them as logic cells."""
+    stat = (out / "stat.txt").read_text() if (out / "stat.txt").exists() else ""
+    found = re.findall(r"^\s*(\d+)\s+CCU2C\s*$", stat, re.M)
+    return int(found[-1]) if found else 0
 
 
 def tool_identity() -> str:
@@ -120,6 +126,7 @@ def _figures(out: Path) -> dict:
         "resources": {name: used.get(cell, {}).get("used", 0) for cell, name in RESOURCES.items()},
         "available": {name: used.get(cell, {}).get("available", 0) for cell, name in RESOURCES.items()},
         "fits": all(u["used"] <= u["available"] for u in used.values()),
+        "carry_cells": _carry_cells(out),
     }
 
 
@@ -135,6 +142,7 @@ def _unplaced(out: Path) -> dict | None:
         "resources": {name: used.get(cell, (0, 0))[0] for cell, name in RESOURCES.items()},
         "available": {name: used.get(cell, (0, 0))[1] for cell, name in RESOURCES.items()},
         "fits": False,
+        "carry_cells": _carry_cells(out),
     }
 
 
