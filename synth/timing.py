@@ -64,7 +64,9 @@ def section(rows) -> str:
         if not cp:
             lines.append(f"- N = {r['n_clusters']}: not placed: the design needs more cells than the part has.")
             continue
-        lines.append(f"- N = {r['n_clusters']}: `{cp.get('from')}` to `{cp.get('to')}`; through {', '.join(cp.get('sources', [])[:6])}.")
+        where = list(dict.fromkeys(src.split(":")[0] + ":" + src.split(":")[1].split(".")[0] for src in cp.get("sources", []) if ":" in src))
+        shown = ", ".join(where[:8]) + (f", ... ({len(where) - 10} more), " + ", ".join(where[-2:]) if len(where) > 10 else ", ".join([""] + where[8:]))
+        lines.append(f"- N = {r['n_clusters']}: `{cp.get('from')}` to `{cp.get('to')}`, through the lines {shown}.")
     return "\n".join(lines + [END, ""])
 
 

@@ -112,7 +112,7 @@ def _critical_path(report: dict) -> dict:
         "carry_cells": sum(1 for c in cells if "CCU2" in c),
         "logic_ns": round(sum(s["delay"] for s in logic), 2),
         "routing_ns": round(sum(s["delay"] for s in steps if s["type"] == "routing"), 2),
-        "sources": sorted({src for s in steps for src in s.get("sources", [])})[:12],
+        "sources": list(dict.fromkeys(src for s in steps for src in s.get("sources", []))),  # in path order
     }
 
 
