@@ -100,8 +100,8 @@ def section(rows) -> str:
         f"mid-size Artix-7 offers, N = 16): **{'PASS' if 'XC7A75T' in fits else 'FAIL'}**.",
         "- Logic depth is Yosys `ltp` on the flattened, mapped netlist with registers (FD*, LUTRAM, SRL, DSPs with a "
         "packed register) left out, so a path runs register to register. It counts cells, not nanoseconds: a CARRY4 "
-        "carries 4 bits. The longest path is the MCM bias correction's 56/21-bit divider (`floor_div`) in the filter "
-        "sweep; the four dividers hold about 60 % of the CARRY4s and, by an estimate from synthesising each alone, about half the LUTs (docs/RTL.md: pipelining them).",
+        "carries 4 bits. Since issue 12 no divider is combinational (the sweep's are pipelined, the filter step's "
+        "iterate); Fmax from a real place and route is in the ECP5 section below.",
         "- INV cells are counted apart from the LUTs (Vivado absorbs most into LUTs); the LUTRAM holds the table "
         "fields that only one slot reads at a time.",
         END,
