@@ -34,10 +34,11 @@ def table(rows) -> str:
         res, avail, cp = r["resources"], r["available"], r["critical_path"]
         pct = lambda k: f"{res[k]:,} ({100 * res[k] / avail[k]:.0f} %)" if avail[k] else f"{res[k]:,}"  # noqa: E731
         fmax = f"{r['fmax_mhz']:.1f}" if r["fmax_mhz"] is not None else "does not fit"
+        path = f"{cp['cells']} ({cp['carry_cells']}), {cp['logic_ns']:.1f} + {cp['routing_ns']:.1f}" if cp else "none"
         lines.append(
-            f"| {r['n_clusters']} | {fmax} | {'yes' if r['routed'] else 'placement estimate'} | {pct('lut4')} | {pct('ff')} "
+            f"| {r['n_clusters']} | {fmax} | {('yes' if r['routed'] else 'placement estimate') if cp else 'not placed'} | {pct('lut4')} | {pct('ff')} "
             f"| {pct('mult18')} | {pct('bram')} | {r['carry_cells']:,} | {'yes' if r['fits'] else '**no**'} "
-            f"| {cp.get('cells', '?')} ({cp.get('carry_cells', '?')}), {cp.get('logic_ns', 0):.1f} + {cp.get('routing_ns', 0):.1f} "
+            f"| {path} "
             f"| {(r['synth_s'] + r['pnr_s']) / 60:.0f} min |")  # fmt: skip
     return "\n".join(lines)
 
@@ -64,8 +65,10 @@ def section(rows) -> str:
         if not cp:
             lines.append(f"- N = {r['n_clusters']}: not placed: the design needs more cells than the part has.")
             continue
-        where = list(dict.fromkeys(src.split(":")[0] + ":" + src.split(":")[1].split(".")[0] for src in cp.get("sources", []) if ":" in src))
-        shown = ", ".join(where[:8]) + (f", ... ({len(where) - 10} more), " + ", ".join(where[-2:]) if len(where) > 10 else ", ".join([""] + where[8:]))
+        # The project's own lines (not Yosys's techmap files), file name and line, in path order.
+        where = list(dict.fromkeys(Path(src.split(":")[0]).name + ":" + src.split(":")[1].split(".")[0]
+                                   for src in cp.get("sources", []) if ":" in src and Path(src.split(":")[0]).name.startswith("evclust_")))
+        shown = ", ".join(where)
         lines.append(f"- N = {r['n_clusters']}: `{cp.get('from')}` to `{cp.get('to')}`, through the lines {shown}.")
     return "\n".join(lines + [END, ""])
 
