@@ -77,7 +77,9 @@ def main() -> int:
         f"run {datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC, on the machine above.",
         "",
         "Cycles, counted by the harness (tb/evclust_core/evclust_tb.v) while every vector case replays "
-        "with no input gap and no output stall. `filter` cycles are those with `filter_active` high.",
+        "with no input gap and no output stall. `filter` cycles are those with `filter_active` high (a step's phase, "
+        "sweep, merges and tail). Cycles count from the end of the reset, so they include the reset's fill: one cycle "
+        "per creation-support map cell where the map is on (creation_support, suite_clip).",
         "",
         "| case | N | events | cycles | cycles/event | cycles/event outside sweeps | sweeps | cycles/sweep | evictions + drops |",
         "|---|---:|---:|---:|---:|---:|---:|---:|---:|",

@@ -60,7 +60,7 @@ module evclust_core (
     output reg  [REC_W-1:0]   rec_data;
     output reg                trace_valid;
     output reg  [TRACE_W-1:0] trace_data;
-    output wire               filter_active;  // a filter step: its phase cycle(s) and its sweep
+    output wire               filter_active;  // a filter step: its phase cycle(s), sweep, merges and tail
 
     // ---------------------------------------------------------------- formats and constants
     localparam integer FP = CENTRE_FRAC, FR = HALF_SIZE_FRAC, FA = ACTIVITY_FRAC, FV = V_MCM_FRAC;
@@ -273,7 +273,7 @@ module evclust_core (
     reg [32:0]             boundaries;   // tau boundaries since the last filter step
     reg [FRAME_PER_TAU_W-1:0] per_frame; // T_frame / (boundaries * tau)
 
-    assign filter_active = state == ST_SWEEP || state == ST_PHASE;
+    assign filter_active = state == ST_PHASE || state == ST_SWEEP || state == ST_MERGE;
 
     // ---------------------------------------------------------------- step 1: the seek
     // Stage A holds an accepted event while every slot compares it against its window in
