@@ -44,7 +44,7 @@ module evclust_core (
     localparam integer TRACE_W = 11;
     localparam integer SWEEP_LEN = N > P ? N : P;
     // The sweep tail: the operand register and the divider's stages (SWEEP_DIV_STEP bits each).
-    localparam integer INV_STAGES = (33 + SWEEP_DIV_STEP - 1) / SWEEP_DIV_STEP;  // 2^32 / |w|^2
+    localparam integer INV_STAGES = (INV_WW_W + SWEEP_DIV_STEP - 1) / SWEEP_DIV_STEP;  // 2^32 / |w|^2
     localparam integer MCM_TAIL = 1 + (V_MCM_W - 1 + SWEEP_DIV_STEP - 1) / SWEEP_DIV_STEP;
     localparam integer TAIL = MCM_TAIL > INV_STAGES ? MCM_TAIL : INV_STAGES;
     localparam integer SWEEP_W = $clog2(SWEEP_LEN + TAIL + 1);
@@ -711,9 +711,8 @@ module evclust_core (
     wire signed [63:0]    m_evc = saturate(u64({{(63 - EVENTS_IN_INTERVAL_W){1'b0}}, ev_count[k]})
                                            + u64({{(63 - EVENTS_IN_INTERVAL_W){1'b0}}, ev_count[m_j]}), 0, MAX_EVCOUNT);
 
-    // tau boundaries since the last filter step, from the phase counter; T_frame/(n tau).
-    // Dividers sized to their operands: a 33-bit phase by the constant tau, T_frame/tau by a
-    // count that leaves nothing once it reaches 2^FRAME_PER_TAU_W.
+    // tau boundaries since the last filter step, from the phase counter (33 bits: a 32-bit time
+    // difference plus the phase); T_frame/(n tau), nothing once n reaches 2^FRAME_PER_TAU_W.
     wire [32:0] phase = {{(33 - TAU_PHASE_W){1'b0}}, tau_phase} + {1'b0, e_t - t_filter};
     // The filter step's first cycle (PHASE) settles the usual cases, fewer than two boundaries,
     // by comparison; more take two iterative divisions (phase / tau, then T_frame / count).
@@ -750,16 +749,16 @@ module evclust_core (
     wire               inv_en = state == ST_INIT || tail_en;
     wire               inv_live = index < N_ENTRIES && (state == ST_INIT || (MIXING != 0 && BG_FIXED == 0));
     wire [CLASS_W+1:0] inv_tag;
-    wire [32:0]        inverse;
-    evclust_pipediv #(.Q_W(33), .DEN_W(18), .STEP(SWEEP_DIV_STEP), .TAG_W(CLASS_W + 2)) div_inverse (
+    wire [INV_WW_W-1:0] inverse;
+    evclust_pipediv #(.Q_W(INV_WW_W), .DEN_W(18), .STEP(SWEEP_DIV_STEP), .TAG_W(CLASS_W + 2)) div_inverse (
         .clk(clk), .rst(rst), .en(inv_en),
-        .remainder_in(18'd0), .bits_in(33'd1 << 32), .divisor(ww == 64'sd0 ? 18'd1 : ww[17:0]),
+        .remainder_in(18'd0), .bits_in({1'b1, {(INV_WW_W - 1){1'b0}}}), .divisor(ww == 64'sd0 ? 18'd1 : ww[17:0]),
         .tag_in({inv_live, ww == 64'sd0, refresh_j}),
         .quotient(inverse), .tag_out(inv_tag)
     );
     wire               inv_out_live = inv_tag[CLASS_W+1];
     wire [CLASS_W-1:0] inv_out_j = inv_tag[CLASS_W-1:0];
-    wire [INV_WW_W-1:0] refreshed = inv_tag[CLASS_W] ? {INV_WW_W{1'b0}} : inverse[INV_WW_W-1:0];
+    wire [INV_WW_W-1:0] refreshed = inv_tag[CLASS_W] ? {INV_WW_W{1'b0}} : inverse;
 
     // ---------------------------------------------------------------- the event's decision
     // EXEC: update the slot found, or create in a free one; SCAN finds the weakest; EVICT

@@ -382,15 +382,15 @@ SWEEP_DIV_STEP = 4
 
 def sweep_tail_cycles(table: FormatTable) -> int:
     """The cycles a filter sweep's tail adds: the longer of the MCM correction's (its operand
-    register and its divider's stages) and the mixing table's (2^32 / |w|^2, 33 quotient bits)."""
+    register and its divider's stages) and the mixing table's (2^32 / |w|^2, inv_ww's bits)."""
     quotient_bits = table.formats["v_mcm"].word_bits - 1
-    return max(1 + -(-quotient_bits // SWEEP_DIV_STEP), -(-33 // SWEEP_DIV_STEP))
+    return max(1 + -(-quotient_bits // SWEEP_DIV_STEP), -(-table.formats["inv_ww"].word_bits // SWEEP_DIV_STEP))
 
 
 def mixing_fill_cycles(table: FormatTable) -> int:
     """The cycles after a reset in which the RTL fills its mixing table (one entry fed per cycle
-    into the 33-bit divider); clearing the creation-support map may take longer."""
-    return table.palette_size + -(-33 // SWEEP_DIV_STEP)
+    into inv_ww's divider); clearing the creation-support map may take longer."""
+    return table.palette_size + -(-table.formats["inv_ww"].word_bits // SWEEP_DIV_STEP)
 
 
 def _verilog_lines(table: FormatTable) -> str:
