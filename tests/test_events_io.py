@@ -76,7 +76,10 @@ def test_faulty_streams_are_refused_naming_file_record_and_fault(tmp_path, event
     if suffix == ".npz":
         np.savez(path, events=events, meta=np.array(META.to_json()))
     else:
-        write_events(path, events, META)
+        with h5py.File(path, "w") as f:
+            for name in EVENT_DTYPE.names:
+                f.create_dataset(f"events/{name}", data=events[name])
+            f.attrs["width"], f.attrs["height"] = META.width, META.height
     with pytest.raises(EvclustError) as err:
         read_events(path)
     assert str(err.value).startswith(str(path)) and fault in str(err.value) and "\n" not in str(err.value)

@@ -1,7 +1,8 @@
-"""Events: one structured dtype everywhere, files in .npz and HDF5, validated on read."""
+"""Events: one structured dtype everywhere; files in .npz, HDF5, AEDAT4 and EVT2/3, read and
+written in chunks, validated on read."""
 
 from evclust.events.format import EVENT_DTYPE, COLOUR_FIELDS, EventMeta, concat_events, empty_events, sort_events
-from evclust.events.io import read_events, write_events
+from evclust.events.io import CHUNK, SUFFIXES, EventReader, event_writer, read_events, write_events
 from evclust.events.validate import validate_events
 
 __all__ = [
@@ -11,6 +12,10 @@ __all__ = [
     "concat_events",
     "empty_events",
     "sort_events",
+    "CHUNK",
+    "SUFFIXES",
+    "EventReader",
+    "event_writer",
     "read_events",
     "write_events",
     "validate_events",

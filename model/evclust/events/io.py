@@ -1,69 +1,131 @@
-"""Event files: `.npz` (native) and HDF5 (`events/{t,x,y,p,Y,Cb,Cr}` plus attributes).
+"""Event files, read and written in chunks so a stream larger than memory passes through.
 
-Writers are atomic: a failed write leaves no file. Readers validate and fail with one line.
+Formats, by suffix:
+- `.npz`: native, the whole stream in one array (written at once: keep it for small streams);
+- `.h5`, `.hdf5`: `events/{t,x,y,p[,Y,Cb,Cr]}` datasets plus the metadata as attributes;
+- `.aedat4` (iniVation DV) and `.raw` (Prophesee EVT3, or EVT2): DVS events only, via faery
+  (evclust.events.camera).
+
+Readers validate every chunk and the seams between chunks, and fail with one line. Writers are
+atomic: a failed write leaves no file.
 """
 
 from __future__ import annotations
 
+import contextlib
 import json
 import zipfile
 from pathlib import Path
+from typing import Iterator
 
 import numpy as np
 
 from evclust.errors import EvclustError, atomic_output
-from evclust.events.format import COLOUR_FIELDS, DVS_FIELDS, EVENT_DTYPE, EventMeta
+from evclust.events import camera
+from evclust.events.format import COLOUR_FIELDS, DVS_FIELDS, EVENT_DTYPE, EventMeta, concat_events, sort_events
 from evclust.events.validate import validate_events
 
 HDF5_SUFFIXES = (".h5", ".hdf5")
 NPZ_SUFFIXES = (".npz",)
+SUFFIXES = NPZ_SUFFIXES + HDF5_SUFFIXES + camera.AEDAT_SUFFIXES + camera.EVT_SUFFIXES
+CHUNK = 1 << 20  # events per chunk: about 15 MB of records
 
 
 def _kind(path: Path) -> str:
     suffix = path.suffix.lower()
-    if suffix in NPZ_SUFFIXES:
-        return "npz"
-    if suffix in HDF5_SUFFIXES:
-        return "hdf5"
-    raise EvclustError(f"{path}: unknown event file type '{suffix}' (use .npz, .h5 or .hdf5)")
+    for kind, suffixes in (
+        ("npz", NPZ_SUFFIXES),
+        ("hdf5", HDF5_SUFFIXES),
+        ("aedat", camera.AEDAT_SUFFIXES),
+        ("evt", camera.EVT_SUFFIXES),
+    ):
+        if suffix in suffixes:
+            return kind
+    raise EvclustError(f"{path}: unknown event file type '{suffix}' (use {', '.join(SUFFIXES)})")
 
 
-def write_events(path: str | Path, ev: np.ndarray, meta: EventMeta) -> None:
-    path = Path(path)
-    kind = _kind(path)
-    if ev.dtype != EVENT_DTYPE:
-        raise EvclustError(f"{path}: records of dtype {ev.dtype} are not events ({EVENT_DTYPE})")
-    with atomic_output(path) as tmp:
-        if kind == "npz":
-            with open(tmp, "wb") as f:
-                np.savez(f, events=ev, meta=np.array(meta.to_json()))
+# ------------------------------------------------------------------------------------------------
+# Reading
+
+
+class EventReader:
+    """An event file opened for reading: its metadata now, its records chunk by chunk.
+
+    `count` is the number of events when the file says so without decoding it (else None).
+    """
+
+    def __init__(self, path: str | Path):
+        self.path = path = Path(path)
+        self.kind = _kind(path)
+        if not path.is_file():
+            raise EvclustError(f"{path}: no such event file")
+        self._columns = None
+        if self.kind == "npz":
+            self._columns, meta_dict = _read_npz(path)
+            self.count = len(self._columns.get("t", ()))
+        elif self.kind == "hdf5":
+            meta_dict, self.count = _hdf5_header(path)
+        elif self.kind == "aedat":
+            meta_dict, self.count = camera.aedat_header(path)
         else:
-            import h5py
+            meta_dict, self.count = camera.evt_header(path)
+        for key in ("width", "height"):
+            if key not in meta_dict:
+                raise EvclustError(f"{path}: metadata has no sensor {key}")
+        self.meta = EventMeta.from_dict(meta_dict)
 
-            with h5py.File(tmp, "w") as f:
-                group = f.create_group("events")
-                fields = DVS_FIELDS + (COLOUR_FIELDS if meta.has_colour else ())
-                for name in fields:
-                    group.create_dataset(name, data=ev[name], compression="gzip", shuffle=True)
-                for key, value in json.loads(meta.to_json()).items():
-                    if value is not None:
-                        f.attrs[key] = value
+    def chunks(self, size: int = CHUNK) -> Iterator[np.ndarray]:
+        """Validated EVENT_DTYPE chunks of about `size` events, in stream order."""
+        name = str(self.path)
+        if self.kind == "npz":
+            ev, has_colour = _assemble(self.path, self._columns)
+            self._set_colour(has_colour)
+            pieces = (ev[lo : lo + size] for lo in range(0, ev.size, size))
+        elif self.kind == "hdf5":
+            pieces = self._hdf5_chunks(size)
+        else:
+            packets = camera.aedat_packets(self.path) if self.kind == "aedat" else camera.evt_packets(self.path)
+            pieces = _order_ties(_regroup((camera.from_faery(p) for p in packets), size))
+        offset, last = 0, None
+        for piece in pieces:
+            validate_events(piece, self.meta, name, offset=offset, previous=last)
+            offset += piece.size
+            last = piece[-1] if piece.size else last
+            yield piece
+
+    def read(self) -> np.ndarray:
+        return concat_events(self.chunks())
+
+    def _set_colour(self, has_colour: bool) -> None:
+        if self.meta.has_colour != has_colour:
+            self.meta = EventMeta.from_dict({**json.loads(self.meta.to_json()), "has_colour": has_colour})
+
+    def _hdf5_chunks(self, size: int) -> Iterator[np.ndarray]:
+        import h5py
+
+        try:
+            with h5py.File(self.path, "r") as f:
+                group = f["events"]
+                datasets = {name: group[name] for name in group.keys()}
+                _check_fields(self.path, datasets.keys())
+                for name, data in datasets.items():
+                    if data.ndim != 1 or data.shape[0] != self.count:
+                        raise EvclustError(f"{self.path}: field {name} has {data.shape} values, expected ({self.count},)")
+                self._set_colour(COLOUR_FIELDS[0] in datasets)
+                for lo in range(0, self.count, size):
+                    ev, _ = _assemble(self.path, {n: d[lo : lo + size] for n, d in datasets.items()})
+                    yield ev
+        except EvclustError:
+            raise
+        except OSError as exc:
+            raise EvclustError(f"{self.path}: not a readable HDF5 file ({exc})") from None
 
 
 def read_events(path: str | Path) -> tuple[np.ndarray, EventMeta]:
     """Return (events, meta). DVS-only files get zero colour fields and `meta.has_colour=False`."""
-    path = Path(path)
-    kind = _kind(path)
-    if not path.is_file():
-        raise EvclustError(f"{path}: no such event file")
-    columns, meta_dict = _read_npz(path) if kind == "npz" else _read_hdf5(path)
-    for key in ("width", "height"):
-        if key not in meta_dict:
-            raise EvclustError(f"{path}: metadata has no sensor {key}")
-    ev, has_colour = _assemble(path, columns)
-    meta = EventMeta.from_dict({**meta_dict, "has_colour": has_colour})
-    validate_events(ev, meta, str(path))
-    return ev, meta
+    reader = EventReader(path)
+    events = reader.read()
+    return events, reader.meta
 
 
 def _read_npz(path: Path) -> tuple[dict[str, np.ndarray], dict]:
@@ -79,36 +141,46 @@ def _read_npz(path: Path) -> tuple[dict[str, np.ndarray], dict]:
         raise EvclustError(f"{path}: not a readable event file ({exc.__class__.__name__}: {exc})") from None
     if events.dtype.names is None:
         raise EvclustError(f"{path}: 'events' is not a structured array with fields {', '.join(EVENT_DTYPE.names)}")
-    return {name: events[name] for name in events.dtype.names}, meta
+    columns = {name: events[name] for name in events.dtype.names}
+    _check_fields(path, columns)
+    meta["has_colour"] = COLOUR_FIELDS[0] in columns
+    return columns, meta
 
 
-def _read_hdf5(path: Path) -> tuple[dict[str, np.ndarray], dict]:
+def _hdf5_header(path: Path) -> tuple[dict, int]:
     import h5py
 
     try:
         with h5py.File(path, "r") as f:
-            if "events" not in f:
+            if "events" not in f or not isinstance(f["events"], h5py.Group):
                 raise EvclustError(f"{path}: no 'events' group")
             group = f["events"]
-            columns = {name: group[name][()] for name in group.keys()}
+            _check_fields(path, group.keys())
+            count = group["t"].shape[0] if group["t"].ndim == 1 else -1
             meta = {k: (v.item() if hasattr(v, "item") else v) for k, v in f.attrs.items()}
+            meta["has_colour"] = COLOUR_FIELDS[0] in group
     except EvclustError:
         raise
     except OSError as exc:
         raise EvclustError(f"{path}: not a readable HDF5 file ({exc})") from None
-    return columns, meta
+    return meta, count
+
+
+def _check_fields(path: Path, names) -> None:
+    names = set(names)
+    unknown = sorted(names - set(EVENT_DTYPE.names))
+    if unknown:
+        raise EvclustError(f"{path}: unknown event field(s) {', '.join(unknown)}")
+    missing = [name for name in DVS_FIELDS if name not in names]
+    if missing:
+        raise EvclustError(f"{path}: missing event field(s) {', '.join(missing)}")
+    colour_present = [name for name in COLOUR_FIELDS if name in names]
+    if colour_present and len(colour_present) != len(COLOUR_FIELDS):
+        raise EvclustError(f"{path}: colour fields must be all of Y, Cb, Cr or none (found {', '.join(colour_present)})")
 
 
 def _assemble(path: Path, columns: dict[str, np.ndarray]) -> tuple[np.ndarray, bool]:
-    unknown = sorted(set(columns) - set(EVENT_DTYPE.names))
-    if unknown:
-        raise EvclustError(f"{path}: unknown event field(s) {', '.join(unknown)}")
-    missing = [name for name in DVS_FIELDS if name not in columns]
-    if missing:
-        raise EvclustError(f"{path}: missing event field(s) {', '.join(missing)}")
-    colour_present = [name for name in COLOUR_FIELDS if name in columns]
-    if colour_present and len(colour_present) != len(COLOUR_FIELDS):
-        raise EvclustError(f"{path}: colour fields must be all of Y, Cb, Cr or none (found {', '.join(colour_present)})")
+    _check_fields(path, columns)
     n = len(columns["t"])
     ev = np.zeros(n, dtype=EVENT_DTYPE)
     for name, column in columns.items():
@@ -122,4 +194,143 @@ def _assemble(path: Path, columns: dict[str, np.ndarray]) -> tuple[np.ndarray, b
             i = int(np.flatnonzero((column < info.min) | (column > info.max))[0])
             raise EvclustError(f"{path}: record {i}: {name}={int(column[i])} does not fit {EVENT_DTYPE[name]}")
         ev[name] = column
-    return ev, bool(colour_present)
+    return ev, COLOUR_FIELDS[0] in columns
+
+
+def _regroup(packets: Iterator[np.ndarray], size: int) -> Iterator[np.ndarray]:
+    """Cut a camera decoder's packets (of any size) into chunks of about `size` events. A chunk
+    ends between two timestamps, never inside a run of equal ones, so ties can be ordered per
+    chunk."""
+    held: list[np.ndarray] = []
+    held_n = 0
+    for packet in packets:
+        held.append(packet)
+        held_n += packet.size
+        if held_n < size:
+            continue
+        chunk = concat_events(held)
+        t = chunk["t"]
+        start = 0
+        while chunk.size - start >= size:
+            run = t[start + size - 1]
+            cut = int(np.searchsorted(t, run, side="left"))
+            if cut <= start:  # one timestamp fills the chunk: take its whole run
+                cut = int(np.searchsorted(t, run, side="right"))
+            if cut >= chunk.size:  # the run may go on in the next packet
+                break
+            yield chunk[start:cut]
+            start = cut
+        held, held_n = [chunk[start:]], chunk.size - start
+    if held_n:
+        yield concat_events(held)
+
+
+def _order_ties(chunks: Iterator[np.ndarray]) -> Iterator[np.ndarray]:
+    """Cameras emit the events of one timestamp in readout order; the stream contract (SPEC §2)
+    orders them by y then x. Only chunks that need it are sorted, and only when time is monotonic
+    (a chunk going back in time is left as it is, for the validator to name)."""
+    for ev in chunks:
+        t = ev["t"]
+        if ev.size > 1 and not (t[1:] < t[:-1]).any():
+            key = ev["y"].astype(np.int64) * 65536 + ev["x"]
+            if ((t[1:] == t[:-1]) & (key[1:] < key[:-1])).any():
+                ev = sort_events(ev)
+        yield ev
+
+
+# ------------------------------------------------------------------------------------------------
+# Writing
+
+
+class _NpzWriter:
+    """npz holds one array: chunks are gathered and written at close."""
+
+    def __init__(self, tmp: Path, meta: EventMeta):
+        self.tmp, self.meta, self.chunks = tmp, meta, []
+
+    def write(self, ev: np.ndarray) -> None:
+        self.chunks.append(ev)
+
+    def close(self, failed: bool = False) -> None:
+        if failed:
+            return
+        with open(self.tmp, "wb") as f:
+            np.savez(f, events=concat_events(self.chunks), meta=np.array(self.meta.to_json()))
+
+
+class _Hdf5Writer:
+    def __init__(self, tmp: Path, meta: EventMeta):
+        import h5py
+
+        self.file = h5py.File(tmp, "w")
+        group = self.file.create_group("events")
+        fields = DVS_FIELDS + (COLOUR_FIELDS if meta.has_colour else ())
+        self.datasets = {
+            name: group.create_dataset(
+                name, shape=(0,), maxshape=(None,), dtype=EVENT_DTYPE[name], chunks=(1 << 16,), compression="gzip",
+                compression_opts=1, shuffle=True,
+            )  # fmt: skip
+            for name in fields
+        }
+        for key, value in json.loads(meta.to_json()).items():
+            if value is not None:
+                self.file.attrs[key] = value
+
+    def write(self, ev: np.ndarray) -> None:
+        for name, data in self.datasets.items():
+            n = data.shape[0]
+            data.resize((n + ev.size,))
+            data[n:] = ev[name]
+
+    def close(self, failed: bool = False) -> None:
+        self.file.close()
+
+
+@contextlib.contextmanager
+def event_writer(path: str | Path, meta: EventMeta, evt_version: str = "evt3"):
+    """Yield a writer with `.write(chunk)`; the file appears only if the block succeeds.
+
+    Camera formats drop the colour fields (DVS events only); `evt_version` picks EVT3 or EVT2
+    for `.raw`.
+    """
+    path = Path(path)
+    kind = _kind(path)
+    with atomic_output(path) as tmp:
+        if kind == "npz":
+            writer = _NpzWriter(tmp, meta)
+        elif kind == "hdf5":
+            writer = _Hdf5Writer(tmp, meta)
+        elif kind == "aedat":
+            writer = camera.AedatWriter(tmp, meta)
+        else:
+            writer = camera.EvtWriter(tmp, meta, evt_version)
+        checked = _CheckedWriter(writer, path, meta)
+        try:
+            yield checked
+        except BaseException:
+            writer.close(failed=True)
+            raise
+        writer.close()
+
+
+class _CheckedWriter:
+    """Refuses records that are not events, and streams out of order, before they reach a file."""
+
+    def __init__(self, writer, path: Path, meta: EventMeta):
+        self.writer, self.path, self.meta = writer, path, meta
+        self.count, self.last = 0, None
+
+    def write(self, ev: np.ndarray) -> None:
+        if ev.dtype != EVENT_DTYPE:
+            raise EvclustError(f"{self.path}: records of dtype {ev.dtype} are not events ({EVENT_DTYPE})")
+        validate_events(ev, self.meta, str(self.path), offset=self.count, previous=self.last)
+        if ev.size:
+            self.writer.write(ev)
+            self.count += ev.size
+            self.last = ev[-1]
+
+
+def write_events(path: str | Path, ev: np.ndarray, meta: EventMeta, evt_version: str = "evt3") -> None:
+    with event_writer(path, meta, evt_version) as writer:
+        for lo in range(0, max(ev.size, 1), CHUNK):
+            writer.write(ev[lo : lo + CHUNK])

@@ -1,0 +1,188 @@
+"""Event-camera files through faery: AEDAT4 (iniVation DV) and EVT2/EVT3 `.raw` (Prophesee).
+
+These formats carry DVS events only (t, x, y, polarity). Reading gives events with zero colour
+fields and `has_colour=False`; writing drops the colour fields. AEDAT4 files written here keep
+evclust's metadata (source, frame period) in the stream's info node, where DV keeps `sizeX`.
+Why faery and not dv-processing, aedat or evlib: docs/DESIGN.md, "Event-camera files".
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Iterator
+
+import numpy as np
+
+from evclust.errors import EvclustError
+from evclust.events.format import EVENT_DTYPE, EventMeta
+
+AEDAT_SUFFIXES = (".aedat4",)
+EVT_SUFFIXES = (".raw",)
+EVT_VERSIONS = ("evt2", "evt3")
+META_ATTRIBUTE = "evclustMeta"  # AEDAT4 info-node attribute holding EventMeta as JSON
+
+
+def faery_dtype() -> np.dtype:
+    import faery
+
+    return faery.EVENTS_DTYPE
+
+
+def from_faery(packet: np.ndarray) -> np.ndarray:
+    """faery's (t u64, x u16, y u16, on bool) records -> EVENT_DTYPE with p = ±1, no colour."""
+    ev = np.zeros(packet.size, EVENT_DTYPE)
+    ev["t"] = packet["t"]
+    ev["x"] = packet["x"]
+    ev["y"] = packet["y"]
+    ev["p"] = np.where(packet["on"], 1, -1)
+    return ev
+
+
+def to_faery(ev: np.ndarray) -> np.ndarray:
+    packet = np.empty(ev.size, faery_dtype())
+    packet["t"] = ev["t"]
+    packet["x"] = ev["x"]
+    packet["y"] = ev["y"]
+    packet["on"] = ev["p"] > 0
+    return packet
+
+
+def _faery_error(path: Path, exc: Exception) -> EvclustError:
+    return EvclustError(f"{path}: not a readable event-camera file ({str(exc).splitlines()[0] if str(exc) else exc.__class__.__name__})")
+
+
+# ------------------------------------------------------------------------------------------------
+# AEDAT4
+
+
+def _aedat_description(meta: EventMeta, compression: str):
+    from faery import aedat
+
+    attr, node = aedat.DescriptionAttribute, aedat.DescriptionNode
+    info = {
+        "sizeX": attr("int", meta.width),
+        "sizeY": attr("int", meta.height),
+        "source": attr("string", "evclust"),
+        META_ATTRIBUTE: attr("string", meta.to_json()),
+    }
+    stream = {
+        "compression": attr("string", compression.upper()),
+        "originalOutputName": attr("string", "events"),
+        "typeIdentifier": attr("string", "EVTS"),
+    }
+    root = "/mainloop/Recorder/outInfo/"
+    return [node("outInfo", root, {}, [node("0", root + "0/", stream, [node("info", root + "0/info/", info, [])])])]
+
+
+def _aedat_event_track(path: Path, decoder) -> tuple[int, tuple[int, int], dict]:
+    """The first event track's id and size, and the evclust metadata if the file carries it."""
+    tracks = [t for t in decoder.tracks() if t.data_type == "events"]
+    if not tracks:
+        raise EvclustError(f"{path}: the AEDAT4 file has no event stream")
+    track = tracks[0]
+    extra: dict = {}
+    stack = list(decoder.description())
+    while stack:
+        node = stack.pop()
+        stack.extend(node.nodes)
+        if META_ATTRIBUTE in node.attributes:
+            try:
+                extra = json.loads(node.attributes[META_ATTRIBUTE].value)
+            except (json.JSONDecodeError, TypeError):
+                raise EvclustError(f"{path}: unreadable {META_ATTRIBUTE} attribute") from None
+    return track.id, tuple(track.dimensions), extra if isinstance(extra, dict) else {}
+
+
+def aedat_header(path: Path) -> tuple[dict, int | None]:
+    """(metadata dict, event count from the file's data table, or None if it has none)."""
+    from faery import aedat
+
+    try:
+        with aedat.Decoder(path) as decoder:
+            track_id, (width, height), extra = _aedat_event_track(path, decoder)
+            try:
+                definitions = decoder.file_data_definitions()
+            except Exception:  # a file cut short has no data table: count unknown
+                definitions = None
+    except EvclustError:
+        raise
+    except Exception as exc:  # faery raises plain exceptions for malformed files
+        raise _faery_error(path, exc) from None
+    count = sum(d.elements_count for d in definitions if d.track_id == track_id) if definitions else None
+    meta = {**extra, "width": width, "height": height, "source": extra.get("source") or path.stem, "has_colour": False}
+    return meta, count
+
+
+def aedat_packets(path: Path) -> Iterator[np.ndarray]:
+    from faery import aedat
+
+    try:
+        with aedat.Decoder(path) as decoder:
+            track_id, _, _ = _aedat_event_track(path, decoder)
+            for track, packet in decoder:
+                if track.id == track_id and len(packet):
+                    yield packet
+    except EvclustError:
+        raise
+    except Exception as exc:
+        raise _faery_error(path, exc) from None
+
+
+class AedatWriter:
+    def __init__(self, tmp: Path, meta: EventMeta, compression: str = "lz4"):
+        from faery import aedat
+
+        self._encoder = aedat.Encoder(tmp, _aedat_description(meta, compression), (compression, 1)).__enter__()
+
+    def write(self, ev: np.ndarray) -> None:
+        if ev.size:
+            self._encoder.write(0, to_faery(ev))
+
+    def close(self, failed: bool = False) -> None:
+        self._encoder.__exit__(None, None, None)
+
+
+# ------------------------------------------------------------------------------------------------
+# EVT2 / EVT3 (.raw)
+
+
+def evt_header(path: Path) -> tuple[dict, None]:
+    from faery import evt
+
+    try:
+        with evt.Decoder(path, None, None) as decoder:
+            width, height = decoder.dimensions
+    except Exception as exc:
+        raise _faery_error(path, exc) from None
+    return {"width": width, "height": height, "source": path.stem, "has_colour": False}, None
+
+
+def evt_packets(path: Path) -> Iterator[np.ndarray]:
+    from faery import evt
+
+    try:
+        with evt.Decoder(path, None, None) as decoder:
+            for packet in decoder:
+                events = packet.get("events")
+                if events is not None and len(events):
+                    yield events
+    except Exception as exc:
+        raise _faery_error(path, exc) from None
+
+
+class EvtWriter:
+    def __init__(self, tmp: Path, meta: EventMeta, version: str = "evt3"):
+        from faery import evt
+
+        if version not in EVT_VERSIONS:
+            raise EvclustError(f"EVT version '{version}' is not one of {', '.join(EVT_VERSIONS)}")
+        # zero_t0=False: timestamps are stored as they are, so a round trip is exact.
+        self._encoder = evt.Encoder(tmp, version, False, (meta.width, meta.height), True).__enter__()
+
+    def write(self, ev: np.ndarray) -> None:
+        if ev.size:
+            self._encoder.write({"events": to_faery(ev)})
+
+    def close(self, failed: bool = False) -> None:
+        self._encoder.__exit__(None, None, None)
