@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import h5py
 import numpy as np
 import pytest
 
 from evclust.cli import main
-from evclust.events import read_events
+from evclust.events import read_events, write_events
 from evclust.tracks import read_tracks
 
 from test_cli import assert_one_line_error, run_cli
@@ -83,3 +85,72 @@ def test_tune_refuses_bad_options(tmp_path, capsys, args, fragment):
     code, _, err = run_cli(capsys, "tune", "crossing", "-o", str(tmp_path / "x.toml"), "-q", *args)
     assert_one_line_error(code, err, fragment)
     assert not (tmp_path / "x.toml").exists()
+
+
+@pytest.mark.parametrize("fmt", ["aedat4", "raw"])
+def test_camera_recordings_track_with_colour_off_as_the_same_dvs_stream_in_hdf5(crossing_events, capsys, fmt):
+    events, meta = read_events(crossing_events / "e.npz")
+    dvs_h5 = crossing_events / "dvs_ref.h5"
+    if not dvs_h5.exists():
+        write_events(dvs_h5, _without_colour(events), dataclasses.replace(meta, has_colour=False))
+    recording = crossing_events / f"e.{fmt}"
+    assert main(["simulate", "crossing", "-o", str(recording), "-q"]) == 0
+    frame = str(meta.t_frame_us)
+    out, ref = crossing_events / f"{fmt}.parquet", crossing_events / "dvs_ref.parquet"
+    code, stdout, err = run_cli(capsys, "track", str(recording), "-o", str(out), "--frame-us", frame, "-q")
+    assert code == 0, err
+    assert main(["track", str(dvs_h5), "-o", str(ref), "--frame-us", frame, "-q"]) == 0
+    got, got_meta = read_tracks(out)
+    want, _ = read_tracks(ref)
+    assert not got_meta.has_colour and got.size > 0 and np.array_equal(got, want)
+    assert np.all(got["class"] == -1) and not got["Y"].any()
+
+
+def test_a_recording_without_frame_period_asks_for_one(crossing_events, capsys):
+    recording = crossing_events / "noframe.raw"
+    assert main(["simulate", "crossing", "-o", str(recording), "-q"]) == 0
+    out = crossing_events / "never.parquet"
+    code, _, err = run_cli(capsys, "track", str(recording), "-o", str(out), "-q")
+    assert_one_line_error(code, err, "no frame period", "--frame-us")
+    assert not out.exists()
+
+
+def test_parquet_and_csv_track_files_hold_the_same_records(crossing_events, capsys):
+    csv_out, pq_out = crossing_events / "same.csv", crossing_events / "same.parquet"
+    for out in (csv_out, pq_out):
+        assert main(["track", str(crossing_events / "e.npz"), "-o", str(out), "-q"]) == 0
+    from_csv, csv_meta = read_tracks(csv_out)
+    from_pq, pq_meta = read_tracks(pq_out)
+    assert csv_meta == pq_meta and from_csv.size == from_pq.size > 0
+    for name in from_pq.dtype.names:  # the CSV keeps 6 significant digits; Parquet every bit
+        np.testing.assert_allclose(from_csv[name], from_pq[name], rtol=1e-5, atol=1e-9, err_msg=name)
+    code, stdout, err = run_cli(capsys, "score", str(pq_out), "--truth", str(crossing_events / "gt.csv"))
+    assert code == 0, err
+
+
+def test_streamed_tracking_does_not_depend_on_the_chunking(crossing_events):
+    from evclust.clusterer import ClustererParams, track_events
+    from evclust.clusterer.run import track_stream
+    from evclust.events import EventReader
+
+    reader = EventReader(crossing_events / "e.npz")
+    whole = track_events(reader.read(), reader.meta, ClustererParams())
+    pieces = []
+    streamed = track_stream(reader.chunks(size=777), reader.meta, ClustererParams(), sink=pieces.append)
+    assert streamed.tracks is None and whole.tracks.size > 0
+    assert np.array_equal(np.concatenate(pieces), whole.tracks) and streamed.stats == whole.stats
+
+
+@pytest.mark.parametrize("name, fragment", [("t.json", "unknown track file type '.json'"), ("t.parquet", "")])
+def test_track_files_refuse_garbage_and_unknown_types(tmp_path, capsys, name, fragment):
+    path = tmp_path / name
+    path.write_bytes(b"PAR1 not really")
+    code, _, err = run_cli(capsys, "score", str(path), "--truth", str(path))
+    assert_one_line_error(code, err, name, fragment or "not a readable Parquet file")
+
+
+def _without_colour(events):
+    dvs = events.copy()
+    for name in ("Y", "Cb", "Cr"):
+        dvs[name] = 0
+    return dvs

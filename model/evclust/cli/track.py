@@ -1,12 +1,10 @@
-"""evclust track EVENTS -o tracks.csv [--params P.toml] [--model float]"""
+"""evclust track EVENTS -o tracks.csv|tracks.parquet [--params P.toml] [--model float]"""
 
 from __future__ import annotations
 
-from evclust.clusterer import load_params, preset_names, track_events
-from evclust.errors import EvclustError
-from evclust.clusterer.run import MODELS
-from evclust.events import read_events
-from evclust.tracks import write_tracks
+from evclust.cli.common import preset_list
+
+MODEL_NAMES = ("fixed", "float")
 
 
 def add_parser(sub) -> None:
@@ -15,17 +13,19 @@ def add_parser(sub) -> None:
         help="cluster an event file into tracks (position, size, velocity, colour)",
         description=(
             "Run the event-by-event clusterer over an event file and write one track record per reported "
-            "cluster per filter step (SPEC §4). Parameters come from --params (a TOML file with a [clusterer] "
+            "cluster per filter step (SPEC §4). The stream is read and the records written chunk by chunk, so "
+            "files larger than memory pass through. Parameters come from --params (a TOML file with a [clusterer] "
             "table, or a preset name), else from the preset of the events' source scene, else the defaults, which "
             "hold across the generalization suite: their time constants are in frames of the event file's frame "
             "period (printed with the summary). "
-            "DVS-only event files run with colour off."
+            "DVS-only event files (AEDAT4, EVT, or HDF5 without colour) run with colour off."
         ),
     )
-    p.add_argument("events", metavar="EVENTS", help="event file (.npz, .h5)")
-    p.add_argument("-o", "--output", required=True, metavar="TRACKS", help="track file to write (.csv)")
-    p.add_argument("--params", metavar="P", help=f"parameter file (.toml) or preset ({', '.join(preset_names())})")
-    p.add_argument("--model", default="float", choices=sorted(MODELS), help="clusterer model (default: float)")
+    p.add_argument("events", metavar="EVENTS", help="event file (.npz, .h5, .aedat4 or .raw EVT2/EVT3)")
+    p.add_argument("-o", "--output", required=True, metavar="TRACKS", help="track file to write (.csv, or .parquet: smaller and faster)")
+    p.add_argument("--params", metavar="P", help=f"parameter file (.toml) or preset ({preset_list()})")
+    p.add_argument("--model", default="float", choices=MODEL_NAMES, help="clusterer model (default: float)")
+    p.add_argument("--frame-us", type=float, metavar="US", help="frame period in µs, the unit of the velocities (default: the event file's; camera recordings have none)")
     p.add_argument("--ranges", action="store_true", help="fixed model: print each signal's range seen and its saturation count")
     p.add_argument("--beta-shift", action="store_true", help="fixed model: round every β to a power of two (shift-only filters)")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
@@ -33,19 +33,40 @@ def add_parser(sub) -> None:
 
 
 def run(args) -> int:
-    events, meta = read_events(args.events)
-    params, origin = load_params(args.params, meta.source)
+    import dataclasses
+
+    from evclust.clusterer import load_params
+    from evclust.clusterer.run import prepare_run, track_stream
+    from evclust.errors import EvclustError
+    from evclust.events import EventReader
+    from evclust.tracks import track_writer
+
+    if args.frame_us is not None and not args.frame_us > 0:
+        raise EvclustError(f"--frame-us {args.frame_us}: the frame period must be positive")
     if (args.ranges or args.beta_shift) and args.model != "fixed":
         raise EvclustError("--ranges and --beta-shift are options of the fixed model: add --model fixed")
+    reader = EventReader(args.events)
+    meta = reader.meta
+    if args.frame_us is not None:
+        meta = dataclasses.replace(meta, t_frame_us=args.frame_us)
+    params, origin = load_params(args.params, meta.source)
     options = {"ranges": args.ranges, "beta_shift_only": args.beta_shift} if args.model == "fixed" else {}
-    result = track_events(events, meta, params, model=args.model, progress=not args.quiet, **options)
-    write_tracks(args.output, result.tracks, result.meta)
-    times = params.times(result.meta.t_frame_us)
+    # The metadata is known before the first event: the file is opened once and filled as we go.
+    _, out_meta = prepare_run(meta, params, args.model)
+    with track_writer(args.output, out_meta) as writer:
+        result = track_stream(
+            reader.chunks(), meta, params, model=args.model, progress=not args.quiet, total=reader.count, sink=writer.write, **options
+        )  # fmt: skip
+    times = params.times(out_meta.t_frame_us)
     print(f"{args.events}: parameters from {origin} ({times}); {result.summary()}")
     if args.ranges:
-        table = result.clusterer.table
-        print(f"{'signal':<20} {'format':<9} {'range of the format':<24} {'seen':<26} saturations")
-        for name, lo, hi, sat in result.clusterer.range_report():
-            fmt = table[{"centre_step": "centre_step", "mcm_step": "v_mcm"}.get(name, name)]
-            print(f"{name:<20} {fmt.q:<9} {f'{fmt.min:g}..{fmt.max:g}':<24} {f'{lo:.6g}..{hi:.6g}':<26} {sat}")
+        print_ranges(result.clusterer)
     return 0
+
+
+def print_ranges(clusterer) -> None:
+    table = clusterer.table
+    print(f"{'signal':<20} {'format':<9} {'range of the format':<24} {'seen':<26} saturations")
+    for name, lo, hi, sat in clusterer.range_report():
+        fmt = table[{"centre_step": "centre_step", "mcm_step": "v_mcm"}.get(name, name)]
+        print(f"{name:<20} {fmt.q:<9} {f'{fmt.min:g}..{fmt.max:g}':<24} {f'{lo:.6g}..{hi:.6g}':<26} {sat}")

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import time
+from typing import Callable, Iterable
 
 import numpy as np
 from tqdm import tqdm
@@ -20,7 +21,7 @@ CHUNK = 1 << 18  # events per compiled call: the progress bar's granularity
 
 @dataclasses.dataclass
 class TrackRun:
-    tracks: np.ndarray
+    tracks: np.ndarray | None  # None when the records went to a sink as they came
     meta: TrackMeta
     stats: dict
     wall_s: float
@@ -30,7 +31,7 @@ class TrackRun:
         s = self.stats
         rate = s["events"] / self.wall_s if self.wall_s > 0 else float("inf")
         return (
-            f"{s['events']} events, {s['steps']} filter steps, {len(self.tracks)} track records, "
+            f"{s['events']} events, {s['steps']} filter steps, {s['records']} track records, "
             f"{s['created']} clusters created ({s['evicted']} by eviction), {s['dropped']} events dropped, "
             f"wall time {self.wall_s:.2f} s, {rate / 1e6:.2f} Mevents/s"
         )
@@ -88,28 +89,9 @@ def records_to_tracks(rows: np.ndarray) -> np.ndarray:
     return tracks
 
 
-def track_events(
-    events: np.ndarray, meta: EventMeta, params: ClustererParams, model: str = "float", progress: bool = False, **options
-) -> TrackRun:
-    """Run a clusterer model over a whole stream; `options` go to the model (fixed: ranges=True)."""
-    if model not in MODELS:
-        raise EvclustError(f"unknown model '{model}' (available: {', '.join(MODELS)})")
-    t_frame_us = params.t_frame_us or meta.t_frame_us
-    if not t_frame_us:
-        raise EvclustError(f"{meta.source or 'events'}: no frame period: set clusterer.t_frame_us (velocities are in px/frame)")
-    params = params.resolved(float(t_frame_us))
-    has_colour = bool(meta.has_colour)
-    clusterer = MODELS[model](params, meta.width, meta.height, float(t_frame_us), has_colour, **options)
-    start = time.perf_counter()
-    pieces = []
-    with tqdm(total=events.size, unit="ev", unit_scale=True, disable=None if progress else True, desc=f"track ({model})") as bar:
-        for lo in range(0, events.size, CHUNK):
-            chunk = events[lo : lo + CHUNK]
-            pieces.append(clusterer.feed(chunk))
-            bar.update(chunk.size)
-    wall = time.perf_counter() - start
-    rows = np.concatenate(pieces) if pieces else np.zeros((0, RECORD_COLUMNS))
-    track_meta = TrackMeta(
+def track_meta(params: ClustererParams, meta: EventMeta, model: str, t_frame_us: float) -> TrackMeta:
+    """What a track file says about the run that wrote it."""
+    return TrackMeta(
         width=meta.width,
         height=meta.height,
         t_frame_us=float(t_frame_us),
@@ -122,6 +104,59 @@ def track_events(
         seek_margin=params.seek_margin,
         seek_scale=params.seek_scale,
         exit_margin=params.exit_margin,
-        has_colour=has_colour,
+        has_colour=bool(meta.has_colour),
     )
-    return TrackRun(records_to_tracks(rows), track_meta, clusterer.stats(), wall, clusterer)
+
+
+def prepare_run(meta: EventMeta, params: ClustererParams, model: str) -> tuple[ClustererParams, TrackMeta]:
+    """Check the model and the frame period; resolve the parameters; the track file's metadata."""
+    if model not in MODELS:
+        raise EvclustError(f"unknown model '{model}' (available: {', '.join(MODELS)})")
+    t_frame_us = params.t_frame_us or meta.t_frame_us
+    if not t_frame_us:
+        raise EvclustError(
+            f"{meta.source or 'events'}: no frame period (velocities are in px/frame): "
+            "give --frame-us or set clusterer.t_frame_us"
+        )
+    params = params.resolved(float(t_frame_us))
+    return params, track_meta(params, meta, model, float(t_frame_us))
+
+
+def track_stream(
+    chunks: Iterable[np.ndarray],
+    meta: EventMeta,
+    params: ClustererParams,
+    model: str = "float",
+    progress: bool = False,
+    total: int | None = None,
+    sink: Callable[[np.ndarray], None] | None = None,
+    **options,
+) -> TrackRun:
+    """Run a clusterer model over a stream given in chunks; `options` go to the model (fixed:
+    ranges=True). With a `sink`, each chunk's track records go to it as they come and the run
+    keeps none (`TrackRun.tracks` is None), so memory does not grow with the stream."""
+    params, out_meta = prepare_run(meta, params, model)
+    clusterer = MODELS[model](params, meta.width, meta.height, out_meta.t_frame_us, out_meta.has_colour, **options)
+    start = time.perf_counter()
+    kept, n_records = [], 0
+    with tqdm(total=total, unit="ev", unit_scale=True, disable=None if progress else True, desc=f"track ({model})") as bar:
+        for chunk in chunks:
+            for lo in range(0, chunk.size, CHUNK):
+                piece = chunk[lo : lo + CHUNK]
+                tracks = records_to_tracks(clusterer.feed(piece))
+                n_records += tracks.size
+                if sink is None:
+                    kept.append(tracks)
+                elif tracks.size:
+                    sink(tracks)
+                bar.update(piece.size)
+    wall = time.perf_counter() - start
+    tracks = None if sink is not None else (np.concatenate(kept) if kept else np.zeros(0, TRACK_DTYPE))
+    return TrackRun(tracks, out_meta, {**clusterer.stats(), "records": n_records}, wall, clusterer)
+
+
+def track_events(
+    events: np.ndarray, meta: EventMeta, params: ClustererParams, model: str = "float", progress: bool = False, **options
+) -> TrackRun:
+    """Run a clusterer model over a whole stream in memory; `options` go to the model."""
+    return track_stream([events], meta, params, model, progress, total=events.size, **options)

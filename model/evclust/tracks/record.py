@@ -1,7 +1,8 @@
-"""Track record dtype, its metadata, and the CSV file."""
+"""Track record dtype, its metadata, and track files: CSV here, Parquet in `columnar`."""
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import dataclasses
 import enum
@@ -38,6 +39,7 @@ TRACK_DTYPE = np.dtype(
 TRACK_FIELDS = TRACK_DTYPE.names
 _INTEGER_FIELDS = {"t_us", "step", "slot", "id", "class", "flags"}
 MAGIC = "# evclust-tracks "
+TRACK_SUFFIXES = (".csv", ".parquet")
 
 
 class TrackFlags(enum.IntFlag):
@@ -84,23 +86,78 @@ def _format(value, integer: bool) -> str:
     return str(int(value)) if integer else f"{float(value):.6g}"
 
 
-def write_tracks(path: str | Path, tracks: np.ndarray, meta: TrackMeta) -> None:
-    tracks = np.asarray(tracks)
-    if tracks.dtype != TRACK_DTYPE:
-        raise EvclustError(f"{path}: records of dtype {tracks.dtype} are not tracks")
+class CsvTrackWriter:
+    """Track records as CSV, appended chunk by chunk."""
+
+    def __init__(self, tmp: Path, meta: TrackMeta):
+        self.file = open(tmp, "w", newline="")
+        self.file.write(MAGIC + meta.to_json() + "\n")
+        self.file.write(",".join(TRACK_FIELDS) + "\n")
+        self.integer = [name in _INTEGER_FIELDS for name in TRACK_FIELDS]
+
+    def write(self, tracks: np.ndarray) -> None:
+        columns = [tracks[name].tolist() for name in TRACK_FIELDS]
+        self.file.writelines(",".join(_format(v, i) for v, i in zip(row, self.integer)) + "\n" for row in zip(*columns))
+
+    def close(self) -> None:
+        self.file.close()
+
+
+def _writer_class(path: Path):
+    suffix = path.suffix.lower()
+    if suffix == ".csv":
+        return CsvTrackWriter
+    if suffix == ".parquet":
+        from evclust.tracks.columnar import ParquetTrackWriter
+
+        return ParquetTrackWriter
+    raise EvclustError(f"{path}: unknown track file type '{suffix}' (use {', '.join(TRACK_SUFFIXES)})")
+
+
+@contextlib.contextmanager
+def track_writer(path: str | Path, meta: TrackMeta):
+    """Yield a writer with `.write(tracks)`; the file appears only if the block succeeds."""
+    path = Path(path)
+    cls = _writer_class(path)
     with atomic_output(path) as tmp:
-        with open(tmp, "w", newline="") as f:
-            f.write(MAGIC + meta.to_json() + "\n")
-            f.write(",".join(TRACK_FIELDS) + "\n")
-            integer = [name in _INTEGER_FIELDS for name in TRACK_FIELDS]
-            columns = [tracks[name].tolist() for name in TRACK_FIELDS]
-            f.writelines(",".join(_format(v, i) for v, i in zip(row, integer)) + "\n" for row in zip(*columns))
+        writer = cls(tmp, meta)
+        try:
+            yield _CheckedTrackWriter(writer, path)
+        finally:
+            writer.close()
+
+
+class _CheckedTrackWriter:
+    def __init__(self, writer, path: Path):
+        self.writer, self.path, self.count = writer, path, 0
+
+    def write(self, tracks: np.ndarray) -> None:
+        tracks = np.asarray(tracks)
+        if tracks.dtype != TRACK_DTYPE:
+            raise EvclustError(f"{self.path}: records of dtype {tracks.dtype} are not tracks")
+        if tracks.size:
+            self.writer.write(tracks)
+            self.count += tracks.size
+
+
+def write_tracks(path: str | Path, tracks: np.ndarray, meta: TrackMeta) -> None:
+    with track_writer(path, meta) as writer:
+        writer.write(tracks)
 
 
 def read_tracks(path: str | Path) -> tuple[np.ndarray, TrackMeta]:
+    """Read a track file (.csv or .parquet): (TRACK_DTYPE records, TrackMeta)."""
     path = Path(path)
     if not path.is_file():
         raise EvclustError(f"{path}: no such track file")
+    if _writer_class(path) is not CsvTrackWriter:
+        from evclust.tracks.columnar import read_parquet_tracks
+
+        return read_parquet_tracks(path)
+    return _read_csv_tracks(path)
+
+
+def _read_csv_tracks(path: Path) -> tuple[np.ndarray, TrackMeta]:
     try:
         text = path.read_text()
     except UnicodeDecodeError as exc:

@@ -1,0 +1,75 @@
+"""Track records as Parquet (pyarrow): one column per field in its own type, written in row groups.
+
+Columnar and compressed, a track file stays several times smaller than the CSV and reads back in
+a fraction of the time; the metadata is the same JSON as the CSV's first line, kept in the
+schema's key-value metadata under `evclust-tracks`.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from evclust.errors import EvclustError
+from evclust.tracks.record import TRACK_DTYPE, TRACK_FIELDS, TrackMeta
+
+META_KEY = b"evclust-tracks"
+
+
+def _schema(meta: TrackMeta):
+    import pyarrow as pa
+
+    fields = [pa.field(name, pa.from_numpy_dtype(TRACK_DTYPE[name])) for name in TRACK_FIELDS]
+    return pa.schema(fields, metadata={META_KEY: meta.to_json().encode()})
+
+
+class ParquetTrackWriter:
+    def __init__(self, tmp: Path, meta: TrackMeta):
+        import pyarrow.parquet as pq
+
+        self.schema = _schema(meta)
+        self.file = pq.ParquetWriter(tmp, self.schema, compression="zstd")
+
+    def write(self, tracks: np.ndarray) -> None:
+        import pyarrow as pa
+
+        columns = [pa.array(np.ascontiguousarray(tracks[name])) for name in TRACK_FIELDS]
+        self.file.write_table(pa.Table.from_arrays(columns, schema=self.schema))
+
+    def close(self) -> None:
+        self.file.close()
+
+
+def read_parquet_tracks(path: Path) -> tuple[np.ndarray, TrackMeta]:
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    try:
+        table = pq.read_table(path)
+    except (pa.ArrowException, OSError) as exc:
+        raise EvclustError(f"{path}: not a readable Parquet file ({str(exc).splitlines()[0]})") from None
+    raw = (table.schema.metadata or {}).get(META_KEY)
+    if raw is None:
+        raise EvclustError(f"{path}: not an evclust track file (no '{META_KEY.decode()}' metadata)")
+    try:
+        meta = TrackMeta.from_dict(json.loads(raw))
+    except (ValueError, TypeError) as exc:
+        raise EvclustError(f"{path}: unreadable metadata ({exc})") from None
+    missing = [name for name in TRACK_FIELDS if name not in table.column_names]
+    if missing:
+        raise EvclustError(f"{path}: missing column(s) {', '.join(missing)}")
+    tracks = np.zeros(table.num_rows, TRACK_DTYPE)
+    for name in TRACK_FIELDS:
+        column = table.column(name)
+        if column.null_count:
+            raise EvclustError(f"{path}: column {name} has {column.null_count} missing value(s)")
+        values = column.to_numpy()
+        if values.dtype != TRACK_DTYPE[name]:
+            raise EvclustError(f"{path}: column {name} has type {values.dtype}, expected {TRACK_DTYPE[name]}")
+        if values.dtype.kind == "f" and not np.isfinite(values).all():
+            i = int(np.flatnonzero(~np.isfinite(values))[0])
+            raise EvclustError(f"{path}: row {i}: {name} is {values[i]}")
+        tracks[name] = values
+    return tracks, meta
