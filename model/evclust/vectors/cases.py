@@ -233,6 +233,34 @@ def suite_clip() -> Case:
                 sim.meta.t_frame_us, ClustererParams(), f"evclust scenes --generate {seed}", seed)  # fmt: skip
 
 
+def file_case(path: str | Path, max_events: int, params: ClustererParams, t_frame_us: float | None = None) -> Case:
+    """The first `max_events` events of any event file, as a case a team replays against the RTL."""
+    from evclust.errors import EvclustError
+    from evclust.events import EventReader, concat_events
+
+    reader = EventReader(path)
+    meta = reader.meta
+    if not meta.has_colour:
+        raise EvclustError(
+            f"{path}: DVS-only events (no colour): the RTL is built with the colour datapath, so its vectors need "
+            "colour events; track the file with the float or fixed model instead"
+        )
+    t_frame_us = t_frame_us or params.t_frame_us or meta.t_frame_us
+    if not t_frame_us:
+        raise EvclustError(f"{path}: no frame period (velocities are in px/frame): give --frame-us")
+    pieces, n = [], 0
+    for chunk in reader.chunks():
+        pieces.append(chunk[: max_events - n])
+        n += pieces[-1].size
+        if n >= max_events:
+            break
+    events = concat_events(pieces)
+    if events.size == 0:
+        raise EvclustError(f"{path}: no events")
+    return Case(f"the first {events.size} events of {Path(path).name}", events, meta.width, meta.height,
+                float(t_frame_us), params, str(path))  # fmt: skip
+
+
 CASES = {
     "traffic_clip": traffic_clip,
     "pedestrian_clip": pedestrian_clip,

@@ -12,7 +12,7 @@ import numpy as np
 from evclust import __version__
 from evclust.clusterer.run import records_to_tracks
 from evclust.fixed.model import FixedClusterer
-from evclust.vectors.cases import CASES
+from evclust.vectors.cases import CASES, Case
 from evclust.vectors.pack import TRACE_FIELDS, event_fields, event_words, hex_lines, pack, record_fields, record_words
 
 FILES = ("events.hex", "expected.hex", "trace.hex")
@@ -36,8 +36,9 @@ def model_words(model: FixedClusterer, events: np.ndarray) -> tuple[list[int], l
     return event_words(events, model.table), record_words(tracks, model.table), words
 
 
-def write_case(name: str, folder: Path) -> dict:
-    case = CASES[name]()
+def write_case(name: str, folder: Path, case: Case | None = None) -> dict:
+    """Write one case: a built-in one by name, or `case` (e.g. from an event file) under `name`."""
+    case = case or CASES[name]()
     model = FixedClusterer(case.params, case.width, case.height, case.t_frame_us)
     event_list, record_list, trace_list = model_words(model, case.events)
     table = model.table
