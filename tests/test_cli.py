@@ -181,3 +181,18 @@ def test_a_video_with_a_truth_csv_beside_it_passes_the_truth_through(tmp_path, c
     events, _ = read_events(tmp_path / "e.npz")
     # A full-frame step from grey 40 to 200: ln(201/41) = 1.59 crosses θ = 0.2 seven times per pixel.
     assert events.size == 7 * 24 * 32 and np.all(events["p"] == 1)
+
+
+def test_help_loads_no_heavy_library():
+    """`evclust --help` builds every verb's parser; none may import numpy, numba, OpenCV, matplotlib,
+    pydantic or the models (the start-up time is in docs/BENCHMARKS.md)."""
+    import subprocess
+    import sys
+
+    code = (
+        "import sys; from evclust.cli import build_parser; build_parser().format_help(); "
+        "heavy = ('numpy', 'numba', 'cv2', 'matplotlib', 'pydantic', 'scipy', 'faery', 'h5py', 'pyarrow'); "
+        "print(sorted({m.split('.')[0] for m in sys.modules} & set(heavy)))"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.strip() == "[]"

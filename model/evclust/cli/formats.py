@@ -2,9 +2,7 @@
 
 from __future__ import annotations
 
-from evclust.clusterer import load_params
 from evclust.errors import EvclustError, atomic_output
-from evclust.fixed import build_formats, render_table, verilog_header
 
 REFERENCE = ("traffic", 480, 270, 50000.0)  # the parameter set the committed RTL header is made from
 
@@ -29,6 +27,9 @@ def add_parser(sub) -> None:
 
 
 def reference_table():
+    from evclust.clusterer import load_params
+    from evclust.fixed import build_formats
+
     params, _ = load_params(REFERENCE[0])
     return build_formats(params, REFERENCE[1], REFERENCE[2], params.t_frame_us or REFERENCE[3])
 
@@ -36,6 +37,9 @@ def reference_table():
 def run(args) -> int:
     if args.width <= 0 or args.height <= 0:
         raise EvclustError(f"sensor {args.width}x{args.height}: width and height must be positive")
+    from evclust.clusterer import load_params
+    from evclust.fixed import build_formats, render_table, verilog_header
+
     params, origin = load_params(args.params or REFERENCE[0])
     t_frame = args.t_frame_us or params.t_frame_us or REFERENCE[3]
     table = build_formats(params, args.width, args.height, t_frame)

@@ -3,13 +3,10 @@
 from __future__ import annotations
 
 from evclust.errors import EvclustError
-from evclust.render.plots import AXES, KINDS, check_plot_path, plot_colour, plot_scatter, plot_velocity
-from evclust.tracks import read_tracks
+from evclust.choices import DEFAULT_GATE_PX, PLOT_AXES, PLOT_KINDS
 
 
 def add_parser(sub) -> None:
-    from evclust.metrics.match import DEFAULT_GATE_PX
-
     p = sub.add_parser(
         "plot",
         help="plot one tracked object against its ground truth",
@@ -23,19 +20,21 @@ def add_parser(sub) -> None:
     p.add_argument("tracks", metavar="TRACKS", help="track file (tracks.csv from 'evclust track')")
     p.add_argument("--truth", required=True, metavar="GT.csv", help="ground truth ('evclust simulate --truth')")
     p.add_argument("-o", "--output", required=True, metavar="PLOT", help="image to write (.png, .svg, .pdf)")
-    p.add_argument("--kind", choices=KINDS, default="velocity", help="what to plot (default: velocity)")
+    p.add_argument("--kind", choices=PLOT_KINDS, default="velocity", help="what to plot (default: velocity)")
     p.add_argument("--events", metavar="EVENTS", help="the event file the tracks came from (needed by --kind scatter)")
     p.add_argument("--gt-id", type=int, metavar="N", help="ground-truth object to plot (default: the one with the most matches)")
     p.add_argument("--gate", type=float, default=DEFAULT_GATE_PX, metavar="PX",
                    help=f"largest centre distance of a match, px (default: {DEFAULT_GATE_PX:g})")
-    p.add_argument("--x", dest="axis", choices=AXES, default="index",
+    p.add_argument("--x", dest="axis", choices=PLOT_AXES, default="index",
                    help="x axis: evaluation index, as the paper, or time (default: index)")
     p.set_defaults(run=run)
 
 
 def run(args) -> int:
     from evclust.metrics.match import match
+    from evclust.render.plots import check_plot_path, plot_colour, plot_scatter, plot_velocity
     from evclust.scenes.truth import read_truth
+    from evclust.tracks import read_tracks
 
     out = check_plot_path(args.output)
     if args.kind == "scatter" and not args.events:

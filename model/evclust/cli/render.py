@@ -5,9 +5,6 @@ from __future__ import annotations
 from pathlib import Path
 
 from evclust.errors import EvclustError
-from evclust.events import read_events
-from evclust.render.tracks import PNG_SUFFIXES, VIDEO_SUFFIXES, render_png, render_video
-from evclust.tracks import read_tracks
 
 
 def add_parser(sub) -> None:
@@ -22,7 +19,7 @@ def add_parser(sub) -> None:
             "(default: the end of the busiest window)."
         ),
     )
-    p.add_argument("events", metavar="EVENTS", help="event file (.npz, .h5)")
+    p.add_argument("events", metavar="EVENTS", help="event file (.npz, .h5, .aedat4, .raw)")
     p.add_argument("tracks", metavar="TRACKS", help="track file (tracks.csv from 'evclust track')")
     p.add_argument("-o", "--output", required=True, metavar="OUT", help="video (.mp4) or picture (.png) to write")
     p.add_argument("--t0", type=float, metavar="US", help="time of the first video frame in µs (default: the first frame with events)")
@@ -36,6 +33,10 @@ def add_parser(sub) -> None:
 
 
 def run(args) -> int:
+    from evclust.events import read_events
+    from evclust.render.tracks import PNG_SUFFIXES, VIDEO_SUFFIXES, render_png, render_video
+    from evclust.tracks import read_tracks
+
     out = Path(args.output)
     suffix = out.suffix.lower()
     if suffix not in VIDEO_SUFFIXES + PNG_SUFFIXES:

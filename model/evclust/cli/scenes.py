@@ -5,10 +5,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from evclust.choices import SPLITS
 from evclust.errors import EvclustError
-from evclust.scenes import builtin_scenes, load_scene
-from evclust.scenes.generate import SPLITS, generate_scene, write_scene
-from evclust.simulator import EFFECTS
 
 
 def add_parser(sub) -> None:
@@ -37,6 +35,8 @@ def run(args) -> int:
         return _list()
     if not args.output:
         raise EvclustError("--generate and --split need -o DIR, the folder to write the scenes into")
+    from evclust.scenes.generate import generate_scene, write_scene
+
     for seed in seeds:
         scene = generate_scene(seed)
         path = write_scene(scene, Path(args.output))
@@ -45,6 +45,9 @@ def run(args) -> int:
 
 
 def _list() -> int:
+    from evclust.scenes import builtin_scenes, load_scene
+    from evclust.simulator import EFFECTS
+
     print("built-in scenes:")
     for name in builtin_scenes():
         spec = load_scene(name).spec

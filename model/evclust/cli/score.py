@@ -6,10 +6,8 @@ import argparse
 import json
 import math
 
+from evclust.choices import DEFAULT_GATE_PX
 from evclust.errors import atomic_output
-from evclust.metrics import DEFAULT_GATE_PX, format_tables, score
-from evclust.scenes.truth import read_truth
-from evclust.tracks import read_tracks
 
 
 def _gate(text: str) -> float:
@@ -39,7 +37,7 @@ def add_parser(sub) -> None:
             "Exit status: 0 on success, 2 on bad input (one line on stderr naming the file and the fault)."
         ),
     )
-    p.add_argument("tracks", metavar="TRACKS", help="track file written by 'evclust track' (tracks.csv)")
+    p.add_argument("tracks", metavar="TRACKS", help="track file written by 'evclust track' (.csv or .parquet)")
     p.add_argument("--truth", required=True, metavar="GT.csv", help="ground-truth CSV written by 'evclust simulate --truth'")
     p.add_argument("--json", metavar="OUT.json", help="also write every figure (and the inputs and options) to this JSON file")
     p.add_argument(
@@ -58,6 +56,10 @@ def add_parser(sub) -> None:
 
 
 def run(args) -> int:
+    from evclust.metrics import format_tables, score
+    from evclust.scenes.truth import read_truth
+    from evclust.tracks import read_tracks
+
     tracks, meta = read_tracks(args.tracks)
     truth = read_truth(args.truth)
     scores = score(tracks, meta, truth, gate_px=args.gate, fully_visible_only=args.fully_visible)

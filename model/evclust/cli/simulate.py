@@ -6,9 +6,6 @@ import shutil
 import sys
 
 from evclust.errors import EvclustError, atomic_output
-from evclust.events import write_events
-from evclust.scenes import load_scene, write_truth
-from evclust.simulator import simulate_scene
 
 
 def add_parser(sub) -> None:
@@ -36,6 +33,10 @@ def run(args) -> int:
         raise EvclustError(f"--frames {args.frames}: at least 2 frames are needed to see a change")
     if args.fps is not None and args.fps <= 0:
         raise EvclustError(f"--fps {args.fps}: the frame rate must be positive")
+    from evclust.events import write_events
+    from evclust.scenes import load_scene, write_truth
+    from evclust.simulator import simulate_scene
+
     scene = load_scene(args.scene, fps=args.fps, max_frames=args.frames)
     if args.truth and not scene.has_truth:
         raise EvclustError(f"{args.scene}: no ground truth for this scene (a video needs a CSV of the same name beside it)")

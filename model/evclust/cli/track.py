@@ -2,9 +2,8 @@
 
 from __future__ import annotations
 
+from evclust.choices import TRACK_MODELS
 from evclust.cli.common import preset_list
-
-MODEL_NAMES = ("fixed", "float")
 
 
 def add_parser(sub) -> None:
@@ -24,7 +23,7 @@ def add_parser(sub) -> None:
     p.add_argument("events", metavar="EVENTS", help="event file (.npz, .h5, .aedat4 or .raw EVT2/EVT3)")
     p.add_argument("-o", "--output", required=True, metavar="TRACKS", help="track file to write (.csv, or .parquet: smaller and faster)")
     p.add_argument("--params", metavar="P", help=f"parameter file (.toml) or preset ({preset_list()})")
-    p.add_argument("--model", default="float", choices=MODEL_NAMES, help="clusterer model (default: float)")
+    p.add_argument("--model", default="float", choices=TRACK_MODELS, help="clusterer model (default: float)")
     p.add_argument("--frame-us", type=float, metavar="US", help="frame period in µs, the unit of the velocities (default: the event file's; camera recordings have none)")
     p.add_argument("--ranges", action="store_true", help="fixed model: print each signal's range seen and its saturation count")
     p.add_argument("--beta-shift", action="store_true", help="fixed model: round every β to a power of two (shift-only filters)")

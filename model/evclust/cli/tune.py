@@ -2,12 +2,7 @@
 
 from __future__ import annotations
 
-from evclust.clusterer import load_params
 from evclust.errors import EvclustError, atomic_output
-from evclust.scenes.truth import truth_array
-from evclust.scenes import load_scene
-from evclust.simulator import simulate_scene
-from evclust.tune import params_to_toml, segment, tune
 
 
 def add_parser(sub) -> None:
@@ -49,6 +44,12 @@ def run(args) -> int:
         raise EvclustError("give a SCENE to tune on, or --suite SPLIT")
     if not 0.0 < args.segment <= 1.0:
         raise EvclustError(f"--segment {args.segment}: must be in (0, 1]")
+    from evclust.clusterer import load_params
+    from evclust.scenes import load_scene
+    from evclust.scenes.truth import truth_array
+    from evclust.simulator import simulate_scene
+    from evclust.tune import params_to_toml, segment, tune
+
     scene = load_scene(args.scene)
     if not scene.has_truth or scene.truth_path is not None:
         raise EvclustError(f"{args.scene}: tuning needs a synthetic scene, whose ground truth is exact")
@@ -70,7 +71,9 @@ def run(args) -> int:
 def _run_suite(args) -> int:
     from pathlib import Path
 
+    from evclust.clusterer import load_params
     from evclust.suite import dask_client, prepare_split, split_seeds
+    from evclust.tune import params_to_toml
     from evclust.tune.suite import tune_suite
 
     seeds = split_seeds(args.suite)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from evclust.choices import SIMULATORS
 from evclust.cli.common import preset_list
 
 DEFAULT_MAX_EVENTS = 20_000  # about a minute under Icarus; raise it for a longer replay
@@ -28,7 +29,7 @@ def add_parser(sub) -> None:
     own.add_argument("--max-events", type=int, default=DEFAULT_MAX_EVENTS, metavar="N", help=f"events to take from the start (default: {DEFAULT_MAX_EVENTS})")
     own.add_argument("--params", metavar="P", help=f"parameter file (.toml) or preset ({preset_list()}); default as for 'evclust track'")
     own.add_argument("--frame-us", type=float, metavar="US", help="frame period in µs (default: the event file's)")
-    own.add_argument("--replay", choices=("icarus", "verilator"), help="then replay the case through the RTL under this simulator (a repository checkout)")
+    own.add_argument("--replay", choices=SIMULATORS, help="then replay the case through the RTL under this simulator (a repository checkout)")
     p.set_defaults(run=run)
 
 

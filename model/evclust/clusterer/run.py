@@ -12,6 +12,7 @@ from tqdm import tqdm
 from evclust.clusterer import float_model
 from evclust.clusterer.layout import BG_CB, BG_CR, BG_Y, GLOBAL_COLUMNS, RECORD_COLUMNS, SLOT_COLUMNS, run_stats, support_shape
 from evclust.clusterer.params import ClustererParams
+from evclust.choices import TRACK_MODELS
 from evclust.errors import EvclustError
 from evclust.events import EventMeta
 from evclust.tracks import TRACK_DTYPE, TrackMeta
@@ -78,7 +79,7 @@ def _fixed_clusterer(*args, **kwargs):
     return FixedClusterer(*args, **kwargs)
 
 
-MODELS = {"float": FloatClusterer, "fixed": _fixed_clusterer}
+MODELS = dict(zip(TRACK_MODELS, (FloatClusterer, _fixed_clusterer)))  # names: evclust.choices, for the CLI
 
 
 def records_to_tracks(rows: np.ndarray) -> np.ndarray:

@@ -19,11 +19,11 @@ import math
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
+from evclust.choices import DEFAULT_GATE_PX
 from evclust.errors import EvclustError
 from evclust.scenes.truth import LABEL_CHARS, truth_array
 from evclust.tracks import TRACK_FIELDS, TrackMeta
 
-DEFAULT_GATE_PX = 30.0
 
 MATCH_DTYPE = np.dtype(
     [

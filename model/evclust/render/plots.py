@@ -21,14 +21,14 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from evclust.choices import PLOT_AXES, PLOT_KINDS  # noqa: E402
 from evclust.colour import ycbcr_to_rgb  # noqa: E402
 from evclust.errors import EvclustError, atomic_output  # noqa: E402
 from evclust.events.format import EventMeta  # noqa: E402
 from evclust.tracks.record import TrackMeta  # noqa: E402
 
 PLOT_SUFFIXES = (".png", ".svg", ".pdf")
-KINDS = ("velocity", "colour", "scatter")
-AXES = ("index", "time")
+KINDS, AXES = PLOT_KINDS, PLOT_AXES
 GT_COLOUR = "tab:blue"
 MCM_COLOUR = "tab:green"
 INT_COLOUR = "#e6b800"  # yellow, dark enough to read on white

@@ -13,12 +13,12 @@ import shutil
 import sysconfig
 from pathlib import Path
 
+from evclust.choices import SIMULATORS
 from evclust.errors import EvclustError
 from evclust.rtl.sources import BUILD, RTL_DIR, RTL_INCLUDES, RTL_SOURCES, TB_DIR, require_repository
 
 SOURCES = (*(RTL_DIR / name for name in RTL_SOURCES), TB_DIR / "evclust_tb.v")
 INCLUDES = tuple(RTL_DIR / name for name in RTL_INCLUDES)
-SIMULATORS = ("icarus", "verilator")
 TOPLEVEL = "evclust_tb"
 
 

@@ -22,6 +22,7 @@ import cv2
 import numpy as np
 import tomli_w
 
+from evclust.choices import SPLITS
 from evclust.clusterer.params import DEFAULT_PALETTE
 from evclust.colour import rgb_to_ycbcr
 from evclust.errors import EvclustError, atomic_output
@@ -30,7 +31,6 @@ from evclust.scenes.synthetic import SyntheticSource
 from evclust.scenes.truth import write_truth
 
 # The fixed split. Disjoint seed ranges: a seed's scene never depends on the split it is in.
-SPLITS = {"tuning": tuple(range(0, 32)), "test": tuple(range(1000, 1032))}
 
 SENSOR_SIZES = ((160, 120), (240, 180), (320, 240), (346, 260), (480, 270), (640, 360), (640, 480), (960, 540), (1280, 720))
 FRAME_RATES = (10, 15, 20, 25, 30, 50, 60)
