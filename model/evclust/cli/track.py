@@ -25,6 +25,7 @@ def add_parser(sub) -> None:
     p.add_argument("--params", metavar="P", help=f"parameter file (.toml) or preset ({preset_list()})")
     p.add_argument("--model", default="float", choices=TRACK_MODELS, help="clusterer model (default: float)")
     p.add_argument("--frame-us", type=float, metavar="US", help="frame period in µs, the unit of the velocities (default: the event file's; camera recordings have none)")
+    p.add_argument("--per-frame", action="store_true", help="write one record per cluster per frame (its last) instead of one per filter step: far smaller outputs for videos")
     p.add_argument("--ranges", action="store_true", help="fixed model: print each signal's range seen and its saturation count")
     p.add_argument("--beta-shift", action="store_true", help="fixed model: round every β to a power of two (shift-only filters)")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
@@ -39,6 +40,7 @@ def run(args) -> int:
     from evclust.errors import EvclustError
     from evclust.events import EventReader
     from evclust.tracks import track_writer
+    from evclust.tracks.thin import PerFrame
 
     if args.frame_us is not None and not args.frame_us > 0:
         raise EvclustError(f"--frame-us {args.frame_us}: the frame period must be positive")
@@ -52,12 +54,18 @@ def run(args) -> int:
     options = {"ranges": args.ranges, "beta_shift_only": args.beta_shift} if args.model == "fixed" else {}
     # The metadata is known before the first event: the file is opened once and filled as we go.
     _, out_meta = prepare_run(meta, params, args.model)
+    out_meta = dataclasses.replace(out_meta, per_frame=args.per_frame)
     with track_writer(args.output, out_meta) as writer:
+        thinner = PerFrame(writer.write, out_meta.t_frame_us) if args.per_frame else None
         result = track_stream(
-            reader.chunks(), meta, params, model=args.model, progress=not args.quiet, total=reader.count, sink=writer.write, **options
+            reader.chunks(), meta, params, model=args.model, progress=not args.quiet, total=reader.count,
+            sink=thinner.write if thinner else writer.write, **options,
         )  # fmt: skip
+        if thinner:
+            thinner.close()
     times = params.times(out_meta.t_frame_us)
-    print(f"{args.events}: parameters from {origin} ({times}); {result.summary()}")
+    written = f"; {writer.count} written, one per cluster per frame" if args.per_frame else ""
+    print(f"{args.events}: parameters from {origin} ({times}); {result.summary()}{written}")
     if args.ranges:
         print_ranges(result.clusterer)
     return 0

@@ -2,7 +2,8 @@
 
 Columnar and compressed, a track file stays several times smaller than the CSV and reads back in
 a fraction of the time; the metadata is the same JSON as the CSV's first line, kept in the
-schema's key-value metadata under `evclust-tracks`.
+schema's key-value metadata under `evclust-tracks`. Real-valued fields are stored as float32:
+7 significant digits, more than the CSV's 6, at half the size; they read back as float64.
 """
 
 from __future__ import annotations
@@ -18,10 +19,14 @@ from evclust.tracks.record import TRACK_DTYPE, TRACK_FIELDS, TrackMeta
 META_KEY = b"evclust-tracks"
 
 
+def _stored(dtype: np.dtype) -> np.dtype:
+    return np.dtype(np.float32) if dtype.kind == "f" else dtype
+
+
 def _schema(meta: TrackMeta):
     import pyarrow as pa
 
-    fields = [pa.field(name, pa.from_numpy_dtype(TRACK_DTYPE[name])) for name in TRACK_FIELDS]
+    fields = [pa.field(name, pa.from_numpy_dtype(_stored(TRACK_DTYPE[name]))) for name in TRACK_FIELDS]
     return pa.schema(fields, metadata={META_KEY: meta.to_json().encode()})
 
 
@@ -30,12 +35,15 @@ class ParquetTrackWriter:
         import pyarrow.parquet as pq
 
         self.schema = _schema(meta)
-        self.file = pq.ParquetWriter(tmp, self.schema, compression="zstd")
+        # Floats split by byte before zstd: their exponents and high bytes then compress well.
+        floats = [name for name in TRACK_FIELDS if TRACK_DTYPE[name].kind == "f"]
+        self.file = pq.ParquetWriter(tmp, self.schema, compression="zstd", use_dictionary=False,
+                                     column_encoding={name: "BYTE_STREAM_SPLIT" for name in floats})  # fmt: skip
 
     def write(self, tracks: np.ndarray) -> None:
         import pyarrow as pa
 
-        columns = [pa.array(np.ascontiguousarray(tracks[name])) for name in TRACK_FIELDS]
+        columns = [pa.array(tracks[name].astype(_stored(TRACK_DTYPE[name]))) for name in TRACK_FIELDS]
         self.file.write_table(pa.Table.from_arrays(columns, schema=self.schema))
 
     def close(self) -> None:
@@ -66,8 +74,8 @@ def read_parquet_tracks(path: Path) -> tuple[np.ndarray, TrackMeta]:
         if column.null_count:
             raise EvclustError(f"{path}: column {name} has {column.null_count} missing value(s)")
         values = column.to_numpy()
-        if values.dtype != TRACK_DTYPE[name]:
-            raise EvclustError(f"{path}: column {name} has type {values.dtype}, expected {TRACK_DTYPE[name]}")
+        if values.dtype != _stored(TRACK_DTYPE[name]):
+            raise EvclustError(f"{path}: column {name} has type {values.dtype}, expected {_stored(TRACK_DTYPE[name])}")
         if values.dtype.kind == "f" and not np.isfinite(values).all():
             i = int(np.flatnonzero(~np.isfinite(values))[0])
             raise EvclustError(f"{path}: row {i}: {name} is {values[i]}")

@@ -66,6 +66,7 @@ class TrackMeta:
     seek_scale: float = 0.0  # ... plus seek_scale·max(rx, ry) (beyond the paper)
     exit_margin: float = 0.0  # M: the border band where exit prediction acts, px
     has_colour: bool = True
+    per_frame: bool = False  # thinned to one record per cluster per frame (evclust.tracks.thin)
 
     def to_json(self) -> str:
         return json.dumps(dataclasses.asdict(self), sort_keys=True)
