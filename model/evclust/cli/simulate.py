@@ -33,17 +33,21 @@ def run(args) -> int:
         raise EvclustError(f"--frames {args.frames}: at least 2 frames are needed to see a change")
     if args.fps is not None and args.fps <= 0:
         raise EvclustError(f"--fps {args.fps}: the frame rate must be positive")
-    from evclust.events import write_events
+    from evclust.events import event_writer
     from evclust.scenes import load_scene, write_truth
-    from evclust.simulator import simulate_scene
+    from evclust.simulator import Simulation, stream_scene
 
     scene = load_scene(args.scene, fps=args.fps, max_frames=args.frames)
     if args.truth and not scene.has_truth:
         raise EvclustError(f"{args.scene}: no ground truth for this scene (a video needs a CSV of the same name beside it)")
-    result = simulate_scene(scene, seed=args.seed, progress=not args.quiet)
-    if result.frames < 2:
-        raise EvclustError(f"{args.scene}: only {result.frames} frame(s) could be read; at least 2 are needed")
-    write_events(args.output, result.events, result.meta)
+    stream = stream_scene(scene, seed=args.seed, progress=not args.quiet)
+    # Written as made, so memory does not grow with the video; a failure leaves no file.
+    with event_writer(args.output, stream.meta) as writer:
+        for chunk in stream:
+            writer.write(chunk)
+        result = Simulation(None, stream.meta, stream.samples, stream.sample_period_us, stream.wall_s, count=writer.count)
+        if result.frames < 2:
+            raise EvclustError(f"{args.scene}: only {result.frames} frame(s) could be read; at least 2 are needed")
     if args.truth:
         if scene.truth_path is not None:
             with atomic_output(args.truth) as tmp:

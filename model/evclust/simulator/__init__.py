@@ -5,9 +5,9 @@ from __future__ import annotations
 from evclust.errors import EvclustError
 from evclust.scenes import Scene
 from evclust.simulator.effects import EFFECTS, SensorGeometry, build_effects
-from evclust.simulator.pipeline import Simulation, Simulator
+from evclust.simulator.pipeline import Simulation, SimulationStream, Simulator
 
-__all__ = ["EFFECTS", "Simulation", "Simulator", "SensorGeometry", "build_effects", "make_simulator", "simulate_scene"]
+__all__ = ["EFFECTS", "Simulation", "SimulationStream", "Simulator", "stream_scene", "SensorGeometry", "build_effects", "make_simulator", "simulate_scene"]
 
 
 def make_simulator(scene: Scene, seed: int | None = None) -> Simulator:
@@ -25,3 +25,10 @@ def simulate_scene(scene: Scene, seed: int | None = None, progress: bool = False
     simulator = make_simulator(scene, seed)
     src = scene.source
     return simulator.run(src.frames(), source=src.source, total=src.n_samples, progress=progress, frame_period_us=src.t_frame_us)
+
+
+def stream_scene(scene: Scene, seed: int | None = None, progress: bool = False) -> SimulationStream:
+    """The events of `scene` interval by interval, for streams larger than memory."""
+    simulator = make_simulator(scene, seed)
+    src = scene.source
+    return simulator.stream(src.frames(), source=src.source, total=src.n_samples, progress=progress, frame_period_us=src.t_frame_us)

@@ -18,11 +18,16 @@ from evclust.simulator.kernel import EventBuffer, detect_interval
 
 @dataclasses.dataclass
 class Simulation:
-    events: np.ndarray
+    events: np.ndarray | None  # None when the events went to a file as they were made
     meta: EventMeta
     samples: int  # views the sensor saw: frames, or frames and the sub-steps between them
     sample_period_us: float
     wall_s: float
+    count: int | None = None  # the number of events, when `events` is None
+
+    @property
+    def n_events(self) -> int:
+        return len(self.events) if self.events is not None else int(self.count or 0)
 
     @property
     def scene_s(self) -> float:
@@ -36,7 +41,7 @@ class Simulation:
         return int(round(self.scene_s * 1e6 / (self.meta.t_frame_us or self.sample_period_us))) + 1
 
     def summary(self) -> str:
-        n = len(self.events)
+        n = self.n_events
         rate = n / self.scene_s if self.scene_s > 0 else 0.0
         return (
             f"{self.meta.source}: {self.frames} frames, {n} events, "
@@ -123,28 +128,41 @@ class Simulator:
         # The buffer filled up: each chunk is in order on its own, their union is not.
         return sort_events(concat_events(chunks))
 
-    def run(
+    def stream(
         self,
         frames: Iterable[np.ndarray],
         source: str = "",
         total: int | None = None,
         progress: bool = False,
         frame_period_us: float | None = None,
-    ) -> Simulation:
-        """Simulate the sensor over `frames`, sampled every geometry.t_sample_us. `frame_period_us`
-        is the scene's frame period recorded in the metadata (velocities are per frame); by
-        default the sampling period."""
-        start = time.perf_counter()
+    ) -> "SimulationStream":
+        """Simulate the sensor over `frames`, sampled every geometry.t_sample_us, yielding the
+        events interval by interval (iterate the returned stream; its `meta` is known at once).
+        `frame_period_us` is the scene's frame period recorded in the metadata (velocities are per
+        frame); by default the sampling period. Stream effects see the whole stream, so with one on,
+        the events come out at the end, in one piece."""
+        g = self.geometry
+        meta = EventMeta(width=g.width, height=g.height, source=source, t_frame_us=frame_period_us or g.t_sample_us)
+        return SimulationStream(self, frames, meta, total, progress)
+
+    def run(self, frames: Iterable[np.ndarray], source: str = "", total: int | None = None, progress: bool = False,
+            frame_period_us: float | None = None) -> Simulation:  # fmt: skip
+        """The whole stream in memory: `stream` joined."""
+        stream = self.stream(frames, source, total, progress, frame_period_us)
+        events = concat_events(stream)
+        return Simulation(events, stream.meta, stream.samples, self.geometry.t_sample_us, stream.wall_s)
+
+    def _intervals(self, frames: Iterable[np.ndarray], total: int | None, progress: bool, counter: list[int]):
+        """The sorted events of each frame interval, as the interval effects leave them."""
         g = self.geometry
         shape = (g.height, g.width, 3)
         # Two detector-input buffers used in turn: frame k's and frame k-1's.
         levels = [np.empty(g.width * g.height, np.float32) for _ in range(2)]
-        chunks = []
         ref = rgb_prev = None
-        k = -1
         for k, rgb in enumerate(tqdm(frames, total=total, unit="frame", disable=None if progress else True, desc="simulate")):
             if rgb.shape[:2] != (g.height, g.width):
                 raise ValueError(f"frame {k} is {rgb.shape[1]}x{rgb.shape[0]}, the sensor is {g.width}x{g.height}")
+            counter[0] = k + 1
             level, l_prev = levels[k % 2], levels[(k + 1) % 2]
             colour = self._observe(rgb, level)
             if ref is None:
@@ -154,12 +172,59 @@ class Simulator:
                 events = self._detect(l_prev, level, rgb_prev, colour, ref, t0)
                 for effect in self.interval_effects:
                     events = effect.interval(events, Interval(k, t0, t0 + g.t_sample_us, rgb_prev.reshape(shape), colour.reshape(shape)))
-                if chunks:
-                    _join_at_boundary(chunks[-1], events)
-                chunks.append(events)
+                yield events
             rgb_prev = colour
-        events = concat_events(chunks)
-        for effect in self.stream_effects:
-            events = effect.stream(events)
-        meta = EventMeta(width=g.width, height=g.height, source=source, t_frame_us=frame_period_us or g.t_sample_us)
-        return Simulation(events, meta, k + 1, g.t_sample_us, time.perf_counter() - start)
+
+
+class SimulationStream:
+    """The events of a simulation as they are made: iterate it for chunks in stream order.
+
+    Each interval is held back until the next is made, because events that round to the same
+    microsecond at the boundary may need re-ordering across the two (`_join_at_boundary`).
+    After iteration, `samples` and `wall_s` describe the run.
+    """
+
+    def __init__(self, simulator: Simulator, frames, meta: EventMeta, total: int | None, progress: bool):
+        self.simulator, self.frames, self.meta = simulator, frames, meta
+        self.total, self.progress = total, progress
+        self.samples = 0
+        self.wall_s = 0.0
+
+    @property
+    def sample_period_us(self) -> float:
+        return self.simulator.geometry.t_sample_us
+
+    def __iter__(self):
+        start = time.perf_counter()
+        counter = [0]
+        sim = self.simulator
+        intervals = sim._intervals(self.frames, self.total, self.progress, counter)
+        try:
+            if sim.stream_effects:
+                events = _joined(intervals)
+                for effect in sim.stream_effects:
+                    events = effect.stream(events)
+                if events.size:
+                    yield events
+                return
+            held = None
+            for events in intervals:
+                if held is not None:
+                    _join_at_boundary(held, events)
+                    if held.size:
+                        yield held
+                held = events
+            if held is not None and held.size:
+                yield held
+        finally:
+            self.samples = counter[0]
+            self.wall_s = time.perf_counter() - start
+
+
+def _joined(intervals) -> np.ndarray:
+    chunks = []
+    for events in intervals:
+        if chunks:
+            _join_at_boundary(chunks[-1], events)
+        chunks.append(events)
+    return concat_events(chunks)
