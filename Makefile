@@ -63,6 +63,8 @@ bench: $(STAMP)
 	$(PY) bench/simulator.py --write docs/BENCHMARKS.md
 	$(PY) bench/clusterer.py --write docs/BENCHMARKS.md
 	$(PY) bench/rtl.py --write docs/BENCHMARKS.md
+	$(PY) bench/event_io.py --write docs/BENCHMARKS.md
+	$(PY) bench/startup.py --write docs/BENCHMARKS.md
 
 # The RTL parameter header, generated from the formats table (tests fail when it is stale).
 params: $(STAMP)
