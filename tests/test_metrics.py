@@ -235,6 +235,7 @@ def test_identity_switches_count_changes_of_track_id_per_object():
             records.append(dict(t_us=k * 1000 + 1, step=k, id=tid, slot=0, x=31, y=50))
     s = score(make_tracks(*records), make_meta(), truth)
     assert s.id_switches == 2
+    assert s.tracks_per_object == pytest.approx((2 + 1) / 2)  # object 1: ids {5, 7}; object 2: {9}
     assert s.n_matches == 11 and s.n_gt_evaluations == 12
     assert s.recall == pytest.approx(11 / 12) and s.precision == 1.0
 

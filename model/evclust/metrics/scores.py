@@ -61,6 +61,7 @@ class Scores:
     recall: float | None  # matched object evaluations / object evaluations
     precision: float | None  # matched track records / track records
     id_switches: int
+    tracks_per_object: float | None  # distinct track ids matched to each object matched at all
 
     def to_dict(self) -> dict:
         """Plain JSON-ready dict (nested for the velocity and colour groups; tuples as lists)."""
@@ -98,6 +99,16 @@ def _velocity(est: np.ndarray, gt: np.ndarray) -> VelocityScores:
     cosine[moving] = (est[moving] * gt[moving]).sum(axis=1) / (est_norm[moving] * gt_norm[moving])
     angle = np.degrees(np.arccos(np.clip(cosine, -1.0, 1.0)))
     return VelocityScores(rmse, _ratio(rmse, gt_norm.mean()), float(angle.mean()))
+
+
+def tracks_per_object(matches: np.ndarray) -> float | None:
+    """Distinct track ids matched to each object, averaged over the objects matched at all."""
+    if matches.size == 0:
+        return None
+    per = {}
+    for g, t in zip(matches["gt_id"].tolist(), matches["track_id"].tolist()):
+        per.setdefault(g, set()).add(t)
+    return float(np.mean([len(v) for v in per.values()]))
 
 
 def _id_switches(matches: np.ndarray) -> int:
@@ -183,6 +194,7 @@ def scores_from_matches(matches: np.ndarray, counts: MatchCounts, meta: TrackMet
         recall=_ratio(n, counts.n_gt_evaluations),
         precision=_ratio(n, counts.n_track_records),
         id_switches=_id_switches(m),
+        tracks_per_object=tracks_per_object(m),
     )
 
 

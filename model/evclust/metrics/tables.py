@@ -84,6 +84,7 @@ def format_tables(scores: Scores | Mapping[str, Scores]) -> str:
         ("Tracking", "Recall", each(lambda s: _pct(s.recall))),
         ("Tracking", "Precision", each(lambda s: _pct(s.precision))),
         ("Tracking", "ID switches", each(lambda s: str(s.id_switches))),
+        ("Tracking", "tracks per object", each(lambda s: "-" if s.tracks_per_object is None else f"{s.tracks_per_object:.2f}")),
         ("Evaluations", "filter steps", each(lambda s: str(s.n_steps))),
         ("Evaluations", "steps with no record", each(lambda s: str(s.n_steps_missing))),
         ("Evaluations", "track records", each(lambda s: str(s.n_track_records))),

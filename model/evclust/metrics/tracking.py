@@ -18,7 +18,7 @@ import numpy as np
 from scipy.optimize import linear_sum_assignment
 
 from evclust.metrics.match import nearest_palette_class
-from evclust.metrics.scores import class_correct
+from evclust.metrics.scores import class_correct, tracks_per_object  # noqa: F401 (tracks_per_object: re-exported)
 from evclust.scenes.truth import truth_array
 from evclust.tracks import TrackMeta
 
@@ -224,16 +224,6 @@ def combine_sequences(results: list[dict]) -> dict:
         name = type(metric).__name__
         out[name] = metric.combine_sequences({str(i): r[name] for i, r in enumerate(results)})
     return out
-
-
-def tracks_per_object(matches: np.ndarray) -> float | None:
-    """Distinct track ids matched to each object, averaged over the objects matched at all."""
-    if matches.size == 0:
-        return None
-    per = {}
-    for g, t in zip(matches["gt_id"].tolist(), matches["track_id"].tolist()):
-        per.setdefault(g, set()).add(t)
-    return float(np.mean([len(v) for v in per.values()]))
 
 
 def headline(te: dict) -> dict:
