@@ -154,3 +154,24 @@ def _without_colour(events):
     for name in ("Y", "Cb", "Cr"):
         dvs[name] = 0
     return dvs
+
+
+def test_a_scene_tracks_on_the_fly_as_its_event_file_does(crossing_events, capsys):
+    direct, via_file = crossing_events / "direct.parquet", crossing_events / "via_file.parquet"
+    code, stdout, err = run_cli(capsys, "track", "crossing", "-o", str(direct), "-q")
+    assert code == 0, err
+    assert main(["track", str(crossing_events / "e.npz"), "-o", str(via_file), "-q"]) == 0
+    got, got_meta = read_tracks(direct)
+    want, want_meta = read_tracks(via_file)
+    assert got.size > 0 and np.array_equal(got, want) and got_meta == want_meta
+
+
+def test_render_draws_from_the_scene_as_from_its_event_file(crossing_events, capsys):
+    tracks = crossing_events / "tracks.csv"
+    assert main(["track", str(crossing_events / "e.npz"), "-o", str(tracks), "-q"]) == 0
+    pictures = []
+    for events in ("crossing", str(crossing_events / "e.npz")):
+        out = crossing_events / f"r_{len(pictures)}.png"
+        assert main(["render", events, str(tracks), "-o", str(out), "-q"]) == 0
+        pictures.append(out.read_bytes())
+    assert pictures[0] == pictures[1]

@@ -19,7 +19,7 @@ def add_parser(sub) -> None:
             "(default: the end of the busiest window)."
         ),
     )
-    p.add_argument("events", metavar="EVENTS", help="event file (.npz, .h5, .aedat4, .raw)")
+    p.add_argument("events", metavar="EVENTS", help="event file (.npz, .h5, .aedat4, .raw), or the scene or video the tracks came from (simulated again)")
     p.add_argument("tracks", metavar="TRACKS", help="track file (tracks.csv from 'evclust track')")
     p.add_argument("-o", "--output", required=True, metavar="OUT", help="video (.mp4) or picture (.png) to write")
     p.add_argument("--t0", type=float, metavar="US", help="time of the first video frame in µs (default: the first frame with events)")
@@ -33,7 +33,7 @@ def add_parser(sub) -> None:
 
 
 def run(args) -> int:
-    from evclust.events import read_events
+    from evclust.simulator.source import open_events
     from evclust.render.tracks import PNG_SUFFIXES, VIDEO_SUFFIXES, render_png, render_video
     from evclust.tracks import read_tracks
 
@@ -51,7 +51,8 @@ def run(args) -> int:
         value = getattr(args, name)
         if value is not None and not value >= 0:
             raise EvclustError(f"--{name} {value:g}: must be a time in µs, >= 0")
-    events, ev_meta = read_events(args.events)
+    source = open_events(args.events)
+    events, ev_meta = source.read(), source.meta
     tracks, track_meta = read_tracks(args.tracks)
     common = dict(window_us=args.window, scale=args.scale, arrow_frames=args.arrow_frames)
     if suffix in VIDEO_SUFFIXES:

@@ -20,7 +20,7 @@ def add_parser(sub) -> None:
             "DVS-only event files (AEDAT4, EVT, or HDF5 without colour) run with colour off."
         ),
     )
-    p.add_argument("events", metavar="EVENTS", help="event file (.npz, .h5, .aedat4 or .raw EVT2/EVT3)")
+    p.add_argument("events", metavar="EVENTS", help="event file (.npz, .h5, .aedat4 or .raw EVT2/EVT3), or a scene or video to simulate on the fly (no event file written)")
     p.add_argument("-o", "--output", required=True, metavar="TRACKS", help="track file to write (.csv, or .parquet: smaller and faster)")
     p.add_argument("--params", metavar="P", help=f"parameter file (.toml) or preset ({preset_list()})")
     p.add_argument("--model", default="float", choices=TRACK_MODELS, help="clusterer model (default: float)")
@@ -38,7 +38,7 @@ def run(args) -> int:
     from evclust.clusterer import load_params
     from evclust.clusterer.run import prepare_run, track_stream
     from evclust.errors import EvclustError
-    from evclust.events import EventReader
+    from evclust.simulator.source import open_events
     from evclust.tracks import track_writer
     from evclust.tracks.thin import PerFrame
 
@@ -46,7 +46,7 @@ def run(args) -> int:
         raise EvclustError(f"--frame-us {args.frame_us}: the frame period must be positive")
     if (args.ranges or args.beta_shift) and args.model != "fixed":
         raise EvclustError("--ranges and --beta-shift are options of the fixed model: add --model fixed")
-    reader = EventReader(args.events)
+    reader = open_events(args.events, progress=not args.quiet)
     meta = reader.meta
     if args.frame_us is not None:
         meta = dataclasses.replace(meta, t_frame_us=args.frame_us)
