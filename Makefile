@@ -6,7 +6,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 BUILD  := build
 
-.PHONY: setup demo test cosim lint synth timing bench results report params vectors generalize clean
+.PHONY: setup demo demo-video test cosim lint synth timing bench results report params vectors generalize clean
 
 setup: $(STAMP)
 
@@ -88,6 +88,28 @@ report: $(SYNTH_STAMP)
 # events are kept in build/suite for the next run.
 generalize: $(STAMP)
 	$(VENV)/bin/evclust generalize --split test -o docs/GENERALIZATION.md
+
+# A real video end to end (outside CI): OpenCV's vtest.avi (768x576, 795 frames of people walking,
+# from Debian's opencv-doc package; fetched, not committed) simulated and tracked in one pass (no
+# event file), scored against the frame-based OpenCV reference, and drawn as a picture and an mp4.
+VIDEO_DIR := $(BUILD)/video
+VTEST := $(VIDEO_DIR)/vtest.avi
+$(VTEST):
+	mkdir -p $(VIDEO_DIR)/deb
+	cd $(VIDEO_DIR)/deb && { apt-get download opencv-doc 2>/dev/null || { apt-get update -qq && apt-get download opencv-doc; }; } \
+		|| { echo "evclust: apt-get cannot fetch Debian's opencv-doc; put vtest.avi at $@ yourself"; exit 2; }
+	dpkg-deb --fsys-tarfile $(VIDEO_DIR)/deb/opencv-doc_*.deb | tar -xO ./usr/share/doc/opencv-doc/examples/data/vtest.avi > $@.part
+	mv $@.part $@
+	rm -rf $(VIDEO_DIR)/deb
+
+demo-video: $(STAMP) $(VTEST)
+	$(VENV)/bin/evclust track $(VTEST) -o $(VIDEO_DIR)/vtest_tracks.parquet --per-frame
+	$(VENV)/bin/evclust reference $(VTEST) -o $(VIDEO_DIR)/vtest_reference.csv
+	$(VENV)/bin/evclust score $(VIDEO_DIR)/vtest_tracks.parquet --truth $(VIDEO_DIR)/vtest_reference.csv --json $(VIDEO_DIR)/vtest_scores.json
+	$(VENV)/bin/evclust render $(VTEST) $(VIDEO_DIR)/vtest_tracks.parquet -o $(VIDEO_DIR)/vtest_tracks.png
+	$(VENV)/bin/evclust render $(VTEST) $(VIDEO_DIR)/vtest_tracks.parquet -o $(VIDEO_DIR)/vtest_tracks.mp4
+	@du -ch $(VIDEO_DIR)/vtest_tracks.* $(VIDEO_DIR)/vtest_reference.csv $(VIDEO_DIR)/vtest_scores.json | tail -1 | sed 's/total/outputs in total/'
+	@echo "pictures: $(VIDEO_DIR)/vtest_tracks.png $(VIDEO_DIR)/vtest_tracks.mp4"
 
 clean:
 	rm -rf $(BUILD) .pytest_cache

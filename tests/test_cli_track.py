@@ -87,8 +87,9 @@ def test_tune_refuses_bad_options(tmp_path, capsys, args, fragment):
     assert not (tmp_path / "x.toml").exists()
 
 
+@pytest.mark.parametrize("model", ["float", "fixed"])
 @pytest.mark.parametrize("fmt", ["aedat4", "raw"])
-def test_camera_recordings_track_with_colour_off_as_the_same_dvs_stream_in_hdf5(crossing_events, capsys, fmt):
+def test_camera_recordings_track_with_colour_off_as_the_same_dvs_stream_in_hdf5(crossing_events, capsys, fmt, model):
     events, meta = read_events(crossing_events / "e.npz")
     dvs_h5 = crossing_events / "dvs_ref.h5"
     if not dvs_h5.exists():
@@ -96,10 +97,10 @@ def test_camera_recordings_track_with_colour_off_as_the_same_dvs_stream_in_hdf5(
     recording = crossing_events / f"e.{fmt}"
     assert main(["simulate", "crossing", "-o", str(recording), "-q"]) == 0
     frame = str(meta.t_frame_us)
-    out, ref = crossing_events / f"{fmt}.parquet", crossing_events / "dvs_ref.parquet"
-    code, stdout, err = run_cli(capsys, "track", str(recording), "-o", str(out), "--frame-us", frame, "-q")
+    out, ref = crossing_events / f"{fmt}_{model}.parquet", crossing_events / f"dvs_ref_{model}.parquet"
+    code, stdout, err = run_cli(capsys, "track", str(recording), "-o", str(out), "--frame-us", frame, "--model", model, "-q")
     assert code == 0, err
-    assert main(["track", str(dvs_h5), "-o", str(ref), "--frame-us", frame, "-q"]) == 0
+    assert main(["track", str(dvs_h5), "-o", str(ref), "--frame-us", frame, "--model", model, "-q"]) == 0
     got, got_meta = read_tracks(out)
     want, _ = read_tracks(ref)
     assert not got_meta.has_colour and got.size > 0 and np.array_equal(got, want)
@@ -175,3 +176,42 @@ def test_render_draws_from_the_scene_as_from_its_event_file(crossing_events, cap
         assert main(["render", events, str(tracks), "-o", str(out), "-q"]) == 0
         pictures.append(out.read_bytes())
     assert pictures[0] == pictures[1]
+
+
+@pytest.mark.parametrize(
+    "name, content, fragments",
+    [
+        ("bad.aedat4", b"garbage" * 40, ("bad.aedat4", "not a readable event-camera file")),
+        ("bad.raw", b"% evt 3.0\n% end\n" + b"\x00" * 64, ("bad.raw", "not a readable event-camera file")),
+        ("bad.h5", b"not hdf5 at all", ("bad.h5", "not a readable HDF5 file")),
+    ],
+)
+def test_track_refuses_unreadable_event_files_and_writes_nothing(tmp_path, capsys, name, content, fragments):
+    bad = tmp_path / name
+    bad.write_bytes(content)
+    out = tmp_path / "never.parquet"
+    code, _, err = run_cli(capsys, "track", str(bad), "-o", str(out), "--frame-us", "1000", "-q")
+    assert_one_line_error(code, err, *fragments)
+    assert not out.exists() and sorted(p.name for p in tmp_path.iterdir()) == [name]
+
+
+@pytest.mark.parametrize(
+    "args, fragments",
+    [
+        (["--frame-us", "0"], ("--frame-us 0",)),
+        (["--frame-us", "-5"], ("--frame-us -5",)),
+        (["-o", "tracks.json"], ("tracks.json", "unknown track file type '.json'")),
+    ],
+)
+def test_track_refuses_bad_options_and_writes_nothing(crossing_events, tmp_path, capsys, args, fragments):
+    args = [str(tmp_path / a) if a.endswith(".json") else a for a in args]
+    output = [] if "-o" in args else ["-o", str(tmp_path / "never.parquet")]
+    code, _, err = run_cli(capsys, "track", str(crossing_events / "e.npz"), *output, *args, "-q")
+    assert_one_line_error(code, err, *fragments)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_simulate_refuses_an_unknown_event_format_and_writes_nothing(tmp_path, capsys):
+    code, _, err = run_cli(capsys, "simulate", "crossing", "-o", str(tmp_path / "e.dat"), "-q")
+    assert_one_line_error(code, err, "e.dat", "unknown event file type '.dat'")
+    assert list(tmp_path.iterdir()) == []
