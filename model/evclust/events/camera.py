@@ -12,6 +12,7 @@ import json
 from pathlib import Path
 from typing import Iterator
 
+import numba
 import numpy as np
 
 from evclust.errors import EvclustError
@@ -31,12 +32,23 @@ def faery_dtype() -> np.dtype:
 
 def from_faery(packet: np.ndarray) -> np.ndarray:
     """faery's (t u64, x u16, y u16, on bool) records -> EVENT_DTYPE with p = ±1, no colour."""
-    ev = np.zeros(packet.size, EVENT_DTYPE)
-    ev["t"] = packet["t"]
-    ev["x"] = packet["x"]
-    ev["y"] = packet["y"]
-    ev["p"] = np.where(packet["on"], 1, -1)
+    ev = np.empty(packet.size, EVENT_DTYPE)
+    _convert(packet["t"], packet["x"], packet["y"], packet["on"], ev["t"], ev["x"], ev["y"], ev["p"], ev["Y"], ev["Cb"], ev["Cr"])
     return ev
+
+
+@numba.njit(cache=True, nogil=True)
+def _convert(t, x, y, on, t_out, x_out, y_out, p_out, lum, cb, cr):  # pragma: no cover (compiled)
+    # One pass writing every field of each record: several times faster than a numpy pass per
+    # field on fresh memory, which reading speed comes down to.
+    for i in range(t.size):
+        t_out[i] = t[i]
+        x_out[i] = x[i]
+        y_out[i] = y[i]
+        p_out[i] = 1 if on[i] else -1
+        lum[i] = 0
+        cb[i] = 0
+        cr[i] = 0
 
 
 def to_faery(ev: np.ndarray) -> np.ndarray:

@@ -85,7 +85,8 @@ class EventReader:
             pieces = self._hdf5_chunks(size)
         else:
             packets = camera.aedat_packets(self.path) if self.kind == "aedat" else camera.evt_packets(self.path)
-            pieces = _order_ties(_regroup((camera.from_faery(p) for p in packets), size))
+            # Cut faery's small packets into chunks first: one conversion per chunk, not per packet.
+            pieces = _order_ties(camera.from_faery(chunk) for chunk in _regroup(packets, size))
         offset, last = 0, None
         for piece in pieces:
             validate_events(piece, self.meta, name, offset=offset, previous=last)
@@ -198,7 +199,8 @@ def _assemble(path: Path, columns: dict[str, np.ndarray]) -> tuple[np.ndarray, b
 
 
 def _regroup(packets: Iterator[np.ndarray], size: int) -> Iterator[np.ndarray]:
-    """Cut a camera decoder's packets (of any size) into chunks of about `size` events. A chunk
+    """Cut a camera decoder's packets (of any size, any dtype with a `t` field) into chunks of
+    about `size` events. A chunk
     ends between two timestamps, never inside a run of equal ones, so ties can be ordered per
     chunk."""
     held: list[np.ndarray] = []
@@ -208,7 +210,7 @@ def _regroup(packets: Iterator[np.ndarray], size: int) -> Iterator[np.ndarray]:
         held_n += packet.size
         if held_n < size:
             continue
-        chunk = concat_events(held)
+        chunk = np.concatenate(held) if len(held) > 1 else held[0]
         t = chunk["t"]
         start = 0
         while chunk.size - start >= size:
@@ -222,7 +224,7 @@ def _regroup(packets: Iterator[np.ndarray], size: int) -> Iterator[np.ndarray]:
             start = cut
         held, held_n = [chunk[start:]], chunk.size - start
     if held_n:
-        yield concat_events(held)
+        yield np.concatenate(held) if len(held) > 1 else held[0]
 
 
 def _order_ties(chunks: Iterator[np.ndarray]) -> Iterator[np.ndarray]:
