@@ -35,8 +35,9 @@ def draw_events(ev: np.ndarray, meta: EventMeta, path: str | Path, t0_us: float 
         on = win["p"] > 0
         polarity[win["y"][on], win["x"][on]] = (1.0, 1.0, 1.0)
         polarity[win["y"][~on], win["x"][~on]] = (0.0, 0.0, 0.0)
-        ycc = np.stack([win["Y"], win["Cb"], win["Cr"]], axis=1).astype(np.float64)
-        colour[win["y"], win["x"]] = np.clip(ycbcr_to_rgb(ycc) / 255.0, 0, 1)  # the latest event wins
+        if meta.has_colour:
+            ycc = np.stack([win["Y"], win["Cb"], win["Cr"]], axis=1).astype(np.float64)
+            colour[win["y"], win["x"]] = np.clip(ycbcr_to_rgb(ycc) / 255.0, 0, 1)  # the latest event wins
     tall = meta.height > meta.width
     fig = plt.figure(figsize=(13, 7.5) if tall else (13, 6.5), constrained_layout=True)
     grid = fig.add_gridspec(2, 2, height_ratios=(3, 1))
@@ -44,6 +45,9 @@ def draw_events(ev: np.ndarray, meta: EventMeta, path: str | Path, t0_us: float 
     for col, (image, title) in enumerate(((polarity, "polarity (white ON, black OFF)"), (colour, "colour carried by the events"))):
         ax = fig.add_subplot(grid[0, col])
         ax.imshow(image, interpolation="nearest")
+        if col == 1 and not meta.has_colour:
+            title = "no colour: DVS events (an event-camera file)"
+            ax.text(0.5, 0.5, "no colour", transform=ax.transAxes, ha="center", va="center", color="0.6", fontsize=14)
         ax.set_title(f"{title}\n{window_ms}", fontsize=10)
         ax.set_xlabel("x (px)")
         ax.set_ylabel("y (px)")
