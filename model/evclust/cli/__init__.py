@@ -6,10 +6,10 @@ import argparse
 import sys
 
 from evclust import __version__
-from evclust.cli import formats, generalize, plot, render, report, scenes, score, show, simulate, track, tune, vectors
+from evclust.cli import formats, generalize, plot, reference, render, report, scenes, score, show, simulate, track, tune, vectors
 from evclust.errors import EvclustError
 
-VERBS = (simulate, track, score, tune, formats, vectors, report, show, render, plot, scenes, generalize)
+VERBS = (simulate, track, score, reference, tune, formats, vectors, report, show, render, plot, scenes, generalize)
 
 
 def build_parser() -> argparse.ArgumentParser:
