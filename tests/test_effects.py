@@ -18,6 +18,8 @@ from evclust.simulator.effects import EFFECTS, Effect, SensorGeometry, build_eff
 
 PIPELINE_ORDER = [
     "bayer",
+    "lin_log",
+    "photoreceptor_lowpass",
     "threshold_mismatch",
     "background_activity",
     "hot_pixels",
@@ -27,7 +29,7 @@ PIPELINE_ORDER = [
     "timestamp_quantisation",
     "readout_limit",
 ]
-HOOKS = ("observe", "thresholds", "interval", "stream")
+HOOKS = ("observe", "transfer", "photoreceptor", "thresholds", "interval", "stream")
 
 # BT.601 full range (JPEG, ITU-T T.871), written out here independently of evclust.colour.
 KR, KB = 0.299, 0.114

@@ -10,6 +10,7 @@ import numpy as np
 from tqdm import tqdm
 
 from evclust.colour import RGB_TO_YCBCR, frame_to_luma
+from evclust.errors import EvclustError
 from evclust.events.format import EventMeta, concat_events, sort_events
 from evclust.scenes.schema import SensorSpec
 from evclust.simulator.effects import Effect, Interval, SensorGeometry
@@ -81,6 +82,11 @@ class Simulator:
         if len(observers) > 1:
             raise ValueError("at most one effect may replace how frames are observed")
         self.observer = observers[0] if observers else None
+        transfer = _stage(self.effects, "transfer")
+        if transfer and sensor.detector != "log":
+            raise EvclustError(f"effects.{transfer[0].name}: it bends the log detector's curve; set sensor.detector = \"log\"")
+        self.transfer = transfer[0] if transfer else None
+        self.photoreceptor = _stage(self.effects, "photoreceptor")
         self.interval_effects = _stage(self.effects, "interval")
         self.stream_effects = _stage(self.effects, "stream")
         mismatch = _stage(self.effects, "thresholds")
@@ -102,11 +108,15 @@ class Simulator:
         else:
             intensity = frame_to_luma(rgb)
         intensity = np.asarray(intensity, dtype=np.float32).reshape(-1)
-        if self.sensor.detector == "log":
+        if self.transfer is not None:
+            self.transfer.transfer(intensity, level, self.sensor.log_eps)
+        elif self.sensor.detector == "log":
             np.add(intensity, np.float32(self.sensor.log_eps), out=level)
             np.log(level, out=level)
         else:
             level[:] = intensity
+        for effect in self.photoreceptor:
+            effect.photoreceptor(level, intensity)
         return np.ascontiguousarray(rgb, dtype=np.float32).reshape(-1, 3)
 
     def _detect(self, l0, l1, rgb0, rgb1, ref, t0_us: float) -> np.ndarray:

@@ -9,6 +9,8 @@ from evclust.simulator.effects.base import Effect, EffectParams, Interval, Senso
 from evclust.simulator.effects.background import BackgroundActivity
 from evclust.simulator.effects.bayer import Bayer
 from evclust.simulator.effects.hot_pixels import HotPixels
+from evclust.simulator.effects.lin_log import LinLog
+from evclust.simulator.effects.lowpass import PhotoreceptorLowpass
 from evclust.simulator.effects.mismatch import ThresholdMismatch
 from evclust.simulator.effects.readout import ReadoutLimit
 from evclust.simulator.effects.refractory import Refractory
@@ -16,11 +18,14 @@ from evclust.simulator.effects.tdc import TdcQuantisation
 from evclust.simulator.effects.tfs import TfsLatency
 from evclust.simulator.effects.timestamp import TimestampQuantisation
 
-# Pipeline order follows the physical chain: pixel -> intensity measurement -> timestamp -> readout.
+# Pipeline order follows the physical chain: pixel -> photoreceptor -> change detector -> intensity
+# measurement -> timestamp -> readout.
 EFFECTS: dict[str, type[Effect]] = {
     cls.name: cls
     for cls in (
         Bayer,
+        LinLog,
+        PhotoreceptorLowpass,
         ThresholdMismatch,
         BackgroundActivity,
         HotPixels,

@@ -1,7 +1,9 @@
 """What a sensor effect is: a stage of the pipeline that a scene switches on by name.
 
 An effect hooks into exactly one place of the pipeline (its `stage`):
-- "observe":    replaces how a frame becomes detector input and colour (e.g. a Bayer mosaic);
+- "observe":    replaces how a frame becomes intensity and colour (e.g. a Bayer mosaic);
+- "transfer":   replaces the photoreceptor's intensity -> L curve (e.g. lin-log);
+- "photoreceptor": filters L over time per pixel (e.g. an intensity-dependent low-pass);
 - "thresholds": gives per-pixel ON/OFF thresholds (e.g. mismatch);
 - "interval":   edits or adds events of one frame interval, seeing the frames (e.g. noise);
 - "stream":     edits the whole sorted stream (e.g. refractory period, readout limit).
@@ -57,6 +59,14 @@ class Effect:
     # Hooks; each effect implements the one of its stage.
     def observe(self, rgb: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(H, W, 3) RGB -> ((H, W) intensity the change detector sees, (H, W, 3) RGB the TFS measures)."""
+        raise NotImplementedError
+
+    def transfer(self, intensity: np.ndarray, level: np.ndarray, log_eps: float) -> None:
+        """Flat float32 intensity (0..255) -> detector input L, written into `level`."""
+        raise NotImplementedError
+
+    def photoreceptor(self, level: np.ndarray, intensity: np.ndarray) -> None:
+        """Filter this sample's L (flat float32) in place; the pixel's intensity beside it."""
         raise NotImplementedError
 
     def thresholds(self, th_on: float, th_off: float) -> tuple[np.ndarray, np.ndarray]:
