@@ -182,3 +182,20 @@ def test_a_small_event_buffer_gives_the_same_stream(capacity):
     small = make_simulator(scene)
     small.buffer = EventBuffer(capacity)
     assert np.array_equal(small.run(scene.source.frames()).events, reference)
+
+
+@pytest.mark.parametrize("threads", [2, 3, 7])
+@pytest.mark.parametrize("scene_name", ["traffic", "pedestrian"])
+def test_bands_on_several_threads_give_the_same_stream(scene_name, threads):
+    # Each band of rows is detected apart and the bands merged: the stream must not change.
+    from evclust.scenes import load_scene
+    from evclust.simulator import Simulator
+
+    scene = load_scene(scene_name, max_frames=40)
+    reference = make_simulator(scene).run(scene.source.frames())
+    one = Simulator(scene.spec.sensor, make_simulator(scene).geometry, threads=1)
+    many = Simulator(scene.spec.sensor, make_simulator(scene).geometry, threads=threads)
+    assert len(many.bands) == min(threads, one.geometry.width * one.geometry.height // (1 << 15)) and len(one.bands) == 1
+    events_one = one.run(scene.source.frames()).events
+    assert events_one.size > 1000 and np.array_equal(events_one, reference.events)
+    assert np.array_equal(many.run(scene.source.frames()).events, events_one)

@@ -100,9 +100,11 @@ class EventBuffer:
         self.words = np.empty(2 * capacity, np.uint64)
         self.keys = np.empty(capacity, np.uint64)
 
-    def time_ordered(self, n: int) -> np.ndarray:
-        """A copy of the first n events ordered by time, ties by emission (= y, then x) order.
+    def time_ordered(self, parts: list[tuple[int, int]]) -> np.ndarray:
+        """A copy of the events in the (offset, count) parts of the buffer, ordered by time, ties
+        by emission index (= y, then x: parts are in row order and their keys carry the offset).
 
         The keys are unique, so a plain (SIMD) sort of them gives the permutation."""
-        order = np.sort(self.keys[:n]) & np.uint64(0xFFFFFFFF)
+        keys = self.keys[parts[0][0] : parts[0][0] + parts[0][1]] if len(parts) == 1 else np.concatenate([self.keys[o : o + n] for o, n in parts])
+        order = np.sort(keys) & np.uint64(0xFFFFFFFF)
         return self.words.view(EVENT_DTYPE)[order.astype(np.intp)]

@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import dataclasses
+import os
 import time
+from concurrent.futures import ThreadPoolExecutor
 from typing import Iterable
 
 import numpy as np
@@ -74,7 +76,9 @@ def _join_at_boundary(previous: np.ndarray, current: np.ndarray) -> None:
 class Simulator:
     """The sensor model of SPEC §3 with the effects a scene switched on."""
 
-    def __init__(self, sensor: SensorSpec, geometry: SensorGeometry, effects: list[Effect] = ()):
+    def __init__(self, sensor: SensorSpec, geometry: SensorGeometry, effects: list[Effect] = (), threads: int | None = None):
+        """`threads`: pixel bands detected in parallel (default: EVCLUST_THREADS, else the cores).
+        The events are the same for any number."""
         self.sensor = sensor
         self.geometry = geometry
         self.effects = list(effects)
@@ -98,7 +102,12 @@ class Simulator:
             self.th_off = np.array([sensor.threshold_off], dtype=np.float64)
             self.th_stride = 0
         n_pixels = geometry.width * geometry.height
+        threads = threads or int(os.environ.get("EVCLUST_THREADS", 0)) or os.cpu_count() or 1
+        # Bands of whole rows, one per thread; a frame too small to be worth splitting stays whole.
+        n_bands = max(1, min(threads, geometry.height, n_pixels // (1 << 15)))
+        self._set_bands(np.linspace(0, geometry.height, n_bands + 1).round().astype(int))
         self.buffer = EventBuffer(max(1 << 16, n_pixels // 2))
+        self.pool = ThreadPoolExecutor(len(self.bands)) if len(self.bands) > 1 else None
 
     def _observe(self, rgb: np.ndarray, level: np.ndarray) -> np.ndarray:
         """Fill `level` (flat float32) with the detector input L; return the (H*W, 3) float32 RGB
@@ -120,23 +129,61 @@ class Simulator:
         return np.ascontiguousarray(rgb, dtype=np.float32).reshape(-1, 3)
 
     def _detect(self, l0, l1, rgb0, rgb1, ref, t0_us: float) -> np.ndarray:
-        """The events of one frame interval, ordered by (t, y, x)."""
+        """The events of one frame interval, ordered by (t, y, x).
+
+        Each band of rows runs on its own thread (the kernel releases the GIL) into its own part
+        of one buffer. Emission indices then still follow row-major order across the bands, so one
+        sort of the keys gives the same stream as a single thread."""
         buf = self.buffer
-        chunks = []
-        pixel = 0
-        while pixel < l0.size:
-            n, pixel = detect_interval(
-                l0, l1, rgb0, rgb1, ref, self.th_on, self.th_off, self.th_stride, self.geometry.width,
-                t0_us, self.geometry.t_sample_us, pixel, buf.words, buf.keys, RGB_TO_YCBCR,
-            )  # fmt: skip
-            if n == 0 and pixel < l0.size:  # one pixel crosses more levels than the buffer holds
-                self.buffer = buf = EventBuffer(2 * buf.keys.size)
-                continue
-            chunks.append(buf.time_ordered(n))
-        if len(chunks) == 1:
-            return chunks[0]
-        # The buffer filled up: each chunk is in order on its own, their union is not.
-        return sort_events(concat_events(chunks))
+        share = buf.keys.size // len(self.bands)
+
+        def band(b):
+            lo, hi = self.bands[b]
+            return self._kernel(l0, l1, rgb0, rgb1, ref, t0_us, lo, hi, b * share, share)
+
+        results = list(self.pool.map(band, range(len(self.bands)))) if self.pool else [band(0)]
+        chunks = [buf.time_ordered([(b * share, n) for b, (n, _) in enumerate(results)])]
+        for b, (_, pixel) in enumerate(results):  # a band that filled its share goes on alone
+            hi = self.bands[b][1]
+            while pixel < hi:
+                n, pixel = self._kernel(l0, l1, rgb0, rgb1, ref, t0_us, pixel, hi, 0, self.buffer.keys.size)
+                if n == 0 and pixel < hi:  # one pixel crosses more levels than the buffer holds
+                    self.buffer = EventBuffer(2 * self.buffer.keys.size)
+                    continue
+                chunks.append(self.buffer.time_ordered([(0, n)]))
+        events = chunks[0] if len(chunks) == 1 else sort_events(concat_events(chunks))  # each chunk is in order, not their union
+        if self.pool:
+            self._balance(events)
+        return events
+
+    def _kernel(self, l0, l1, rgb0, rgb1, ref, t0_us, first, end, offset, room) -> tuple[int, int]:
+        """Detect pixels first..end-1 into buffer slots offset..offset+room-1: (events, next pixel)."""
+        buf = self.buffer
+        keys = buf.keys[offset : offset + room]
+        n, pixel = detect_interval(
+            l0[:end], l1[:end], rgb0[:end], rgb1[:end], ref[:end], self.th_on, self.th_off, self.th_stride,
+            self.geometry.width, t0_us, self.geometry.t_sample_us, first, buf.words[2 * offset : 2 * (offset + room)], keys,
+            RGB_TO_YCBCR,
+        )  # fmt: skip
+        keys[:n] += np.uint64(offset)  # the kernel numbers its events from 0 in its slice
+        return n, pixel
+
+    def _set_bands(self, rows: np.ndarray) -> None:
+        w = self.geometry.width
+        self.bands = [(int(a) * w, int(b) * w) for a, b in zip(rows[:-1], rows[1:])]  # pixel ranges
+
+    def _balance(self, events: np.ndarray) -> None:
+        """Move the band limits so each band would have held an equal share of this interval's
+        events: consecutive frames are alike, and events crowd where objects are, not evenly."""
+        if events.size < 1000:
+            return
+        per_row = np.cumsum(np.bincount(events["y"], minlength=self.geometry.height))
+        n_bands = len(self.bands)
+        cuts = np.searchsorted(per_row, per_row[-1] * np.arange(1, n_bands) / n_bands) + 1
+        rows = np.concatenate([[0], cuts, [self.geometry.height]])
+        rows = np.maximum.accumulate(np.minimum(rows, self.geometry.height))
+        if np.all(np.diff(rows) > 0):  # every band keeps at least one row
+            self._set_bands(rows)
 
     def stream(
         self,
