@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import os
 
-for _var in ("NUMBA_NUM_THREADS", "OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+for _var in ("NUMBA_NUM_THREADS", "OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "EVCLUST_THREADS"):
     os.environ[_var] = "1"
 
 import platform  # noqa: E402
@@ -36,7 +36,7 @@ def machine() -> list[str]:
         f"- CPU: {cpu} ({extra}); {os.cpu_count()} logical cores; memory {int(mem.group(1)) / 2**20:.1f} GiB" if mem else f"- CPU: {cpu}",
         f"- OS: {platform.platform()}; load average at start {load}",
         f"- Python {platform.python_version()}, numpy {np.__version__}, numba {numba.__version__}, OpenCV {cv2.__version__}",
-        f"- One core: NUMBA_NUM_THREADS=OMP_NUM_THREADS=OPENBLAS_NUM_THREADS=MKL_NUM_THREADS=1, cv2.setNumThreads(1); numba threads {numba.config.NUMBA_NUM_THREADS}, OpenCV threads {cv2.getNumThreads()}",
+        f"- One core: NUMBA_NUM_THREADS=OMP_NUM_THREADS=OPENBLAS_NUM_THREADS=MKL_NUM_THREADS=EVCLUST_THREADS=1, cv2.setNumThreads(1); numba threads {numba.config.NUMBA_NUM_THREADS}, OpenCV threads {cv2.getNumThreads()}",
     ]
 
 
