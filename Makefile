@@ -6,7 +6,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 BUILD  := build
 
-.PHONY: setup demo demo-video test cosim lint synth timing bench results report params vectors generalize clean
+.PHONY: setup demo demo-video results-video bench-peers test cosim lint synth timing bench results report params vectors generalize clean
 
 setup: $(STAMP)
 
@@ -110,6 +110,17 @@ demo-video: $(STAMP) $(VTEST)
 	$(VENV)/bin/evclust render $(VTEST) $(VIDEO_DIR)/vtest_tracks.parquet -o $(VIDEO_DIR)/vtest_tracks.mp4
 	@du -ch $(VIDEO_DIR)/vtest_tracks.* $(VIDEO_DIR)/vtest_reference.csv $(VIDEO_DIR)/vtest_scores.json | tail -1 | sed 's/total/outputs in total/'
 	@echo "pictures: $(VIDEO_DIR)/vtest_tracks.png $(VIDEO_DIR)/vtest_tracks.mp4"
+
+# The simulator beside ESIM's esim_py (built from uzh-rpg/rpg_vid2e into build/peers; set PEERS_SRC
+# to a checkout when GitHub is out of reach), alternately on the same frames: docs/BENCHMARKS.md.
+bench-peers: $(STAMP) $(VTEST)
+	bash bench/build_esim.sh $(BUILD)/peers $(PY)
+	$(PY) bench/peers.py --write docs/BENCHMARKS.md
+
+# The vtest.avi section of docs/RESULTS.md: the demo's path timed, and what each sensor effect and
+# the table size do to the event count and the tracking figures (about 3 minutes).
+results-video: $(STAMP) $(VTEST)
+	$(PY) bench/video.py --write docs/RESULTS.md
 
 clean:
 	rm -rf $(BUILD) .pytest_cache

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import collections
+import os
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import cv2
@@ -10,6 +13,23 @@ import numpy as np
 from evclust.errors import EvclustError
 
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".webp", ".ppm", ".pgm")
+
+
+def _decoded_ahead(load, n: int, ahead: int = 4):
+    """load(0), load(1), ... in order, up to `ahead` decoded at once on threads: images are
+    independent files and OpenCV decodes without the GIL, so a folder reads at the speed of all
+    cores. The window bounds the memory."""
+    workers = min(ahead, os.cpu_count() or 1)
+    if workers < 2:
+        yield from (load(k) for k in range(n))
+        return
+    with ThreadPoolExecutor(workers) as pool:
+        pending = collections.deque(pool.submit(load, k) for k in range(min(ahead, n)))
+        for k in range(n):
+            frame = pending.popleft().result()
+            if k + ahead < n:
+                pending.append(pool.submit(load, k + ahead))
+            yield frame
 
 
 class VideoSource:
@@ -64,10 +84,8 @@ class VideoSource:
     def frames(self):
         limit = self.max_frames or np.inf
         if self.images is not None:
-            for k, path in enumerate(self.images):
-                if k >= limit:
-                    return
-                yield self._check_size(self._read_image(path), k)
+            paths = self.images[: int(min(limit, len(self.images)))]
+            yield from _decoded_ahead(lambda k: self._check_size(self._read_image(paths[k]), k), len(paths))
             return
         capture = cv2.VideoCapture(str(self.path))
         try:

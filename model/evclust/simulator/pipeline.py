@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import dataclasses
 import os
+import queue
+import threading
 import time
 from concurrent.futures import ThreadPoolExecutor
 from typing import Iterable
@@ -209,19 +211,26 @@ class Simulator:
         events = concat_events(stream)
         return Simulation(events, stream.meta, stream.samples, self.geometry.t_sample_us, stream.wall_s)
 
+    def _observed(self, frames: Iterable[np.ndarray]):
+        """(detector input L, measured colour) of each frame, in order."""
+        g = self.geometry
+        for k, rgb in enumerate(frames):
+            if rgb.shape[:2] != (g.height, g.width):
+                raise ValueError(f"frame {k} is {rgb.shape[1]}x{rgb.shape[0]}, the sensor is {g.width}x{g.height}")
+            level = np.empty(g.width * g.height, np.float32)
+            yield level, self._observe(rgb, level)
+
     def _intervals(self, frames: Iterable[np.ndarray], total: int | None, progress: bool, counter: list[int]):
         """The sorted events of each frame interval, as the interval effects leave them."""
         g = self.geometry
         shape = (g.height, g.width, 3)
-        # Two detector-input buffers used in turn: frame k's and frame k-1's.
-        levels = [np.empty(g.width * g.height, np.float32) for _ in range(2)]
-        ref = rgb_prev = None
-        for k, rgb in enumerate(tqdm(frames, total=total, unit="frame", disable=None if progress else True, desc="simulate")):
-            if rgb.shape[:2] != (g.height, g.width):
-                raise ValueError(f"frame {k} is {rgb.shape[1]}x{rgb.shape[0]}, the sensor is {g.width}x{g.height}")
+        observed = self._observed(frames)
+        if self.pool is not None:  # decode and observe the next frames while this one is detected
+            observed = _prefetched(observed)
+        ref = l_prev = rgb_prev = None
+        bar = tqdm(observed, total=total, unit="frame", disable=None if progress else True, desc="simulate")
+        for k, (level, colour) in enumerate(bar):
             counter[0] = k + 1
-            level, l_prev = levels[k % 2], levels[(k + 1) % 2]
-            colour = self._observe(rgb, level)
             if ref is None:
                 ref = level.astype(np.float64)  # the reference starts at the first frame: no events
             else:
@@ -230,7 +239,7 @@ class Simulator:
                 for effect in self.interval_effects:
                     events = effect.interval(events, Interval(k, t0, t0 + g.t_sample_us, rgb_prev.reshape(shape), colour.reshape(shape)))
                 yield events
-            rgb_prev = colour
+            l_prev, rgb_prev = level, colour
 
 
 class SimulationStream:
@@ -276,6 +285,38 @@ class SimulationStream:
         finally:
             self.samples = counter[0]
             self.wall_s = time.perf_counter() - start
+
+
+def _prefetched(frames: Iterable[np.ndarray], depth: int = 3):
+    """`frames`, read ahead on a thread; an error of the reader is raised here, in order."""
+    done = object()
+    slots: queue.Queue = queue.Queue(depth)
+    stop = threading.Event()
+
+    def read():
+        try:
+            for frame in frames:
+                if stop.is_set():
+                    return
+                slots.put(frame)
+            slots.put(done)
+        except BaseException as exc:  # handed to the consumer, which raises it
+            slots.put(exc)
+
+    reader = threading.Thread(target=read, daemon=True, name="evclust-frames")
+    reader.start()
+    try:
+        while (item := slots.get()) is not done:
+            if isinstance(item, BaseException):
+                raise item
+            yield item
+    finally:
+        stop.set()
+        while reader.is_alive():  # let a reader blocked on a full queue finish
+            try:
+                slots.get_nowait()
+            except queue.Empty:
+                reader.join(0.01)
 
 
 def _joined(intervals) -> np.ndarray:
