@@ -105,10 +105,18 @@ def test_a_bright_pixel_follows_faster_than_a_dark_one():
     assert median_frame(100, 250) < median_frame(10, 40)
 
 
-def test_lowpass_passes_a_constant_scene_and_a_very_high_cutoff_changes_nothing():
+def test_lowpass_passes_a_constant_scene_and_a_cutoff_above_the_sampling_changes_nothing():
     assert run([80] * 10, {"photoreceptor_lowpass": {}}).size == 0
     values = [30, 80, 50, 200, 10]
     assert np.array_equal(run(values, {"photoreceptor_lowpass": {"cutoff_hz": 1e6}}), run(values))
+    # Textured frames: at 1 kHz every pixel's ε is 1 at 100 fps, so L must pass bit for bit.
+    rng = np.random.default_rng(5)
+    frames = [rng.uniform(0, 255, (H, W, 1)).repeat(3, axis=2).astype(np.float32) for _ in range(12)]
+    geometry = SensorGeometry(W, H, T_FRAME)
+    sensor = SensorSpec(threshold_on=THETA, threshold_off=THETA)
+    plain = Simulator(sensor, geometry).run(frames).events
+    filtered = Simulator(sensor, geometry, build_effects({"photoreceptor_lowpass": {"cutoff_hz": 1000.0}}, geometry, 0)).run(frames).events
+    assert plain.size > 100 and np.array_equal(filtered, plain)
 
 
 @pytest.mark.parametrize(

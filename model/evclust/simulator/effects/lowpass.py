@@ -36,4 +36,5 @@ class PhotoreceptorLowpass(Effect):
             return
         eps = np.minimum((intensity + np.float32(20.0)) * self.rate, np.float32(1.0))
         self.filtered += eps * (level - self.filtered)
+        np.copyto(self.filtered, level, where=eps >= 1.0)  # a pixel faster than the sampling follows exactly
         level[:] = self.filtered
