@@ -215,3 +215,16 @@ def test_simulate_refuses_an_unknown_event_format_and_writes_nothing(tmp_path, c
     code, _, err = run_cli(capsys, "simulate", "crossing", "-o", str(tmp_path / "e.dat"), "-q")
     assert_one_line_error(code, err, "e.dat", "unknown event file type '.dat'")
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("version", ["evt2", "evt3"])
+def test_simulate_writes_the_evt_version_asked_for(tmp_path, version):
+    out = tmp_path / "e.raw"
+    assert main(["simulate", "crossing", "-o", str(out), "--evt", version, "-q"]) == 0
+    header = out.read_bytes()[:64].decode(errors="replace")
+    assert f"format {version.upper()}" in header
+    events, _ = read_events(out)
+    assert main(["simulate", "crossing", "-o", str(tmp_path / "e.npz"), "-q"]) == 0
+    want, _ = read_events(tmp_path / "e.npz")
+    for name in ("t", "x", "y", "p"):
+        assert np.array_equal(events[name], want[name])

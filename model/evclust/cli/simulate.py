@@ -24,6 +24,7 @@ def add_parser(sub) -> None:
     p.add_argument("--seed", type=int, metavar="N", help="seed of the sensor effects (default: the scene's)")
     p.add_argument("--frames", type=int, metavar="N", help="simulate only the first N frames")
     p.add_argument("--fps", type=float, metavar="F", help="frame rate of a video or image folder (default: the video's)")
+    p.add_argument("--evt", choices=("evt3", "evt2"), default="evt3", help="EVT version of a .raw output (default: evt3)")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     p.set_defaults(run=run)
 
@@ -42,7 +43,7 @@ def run(args) -> int:
         raise EvclustError(f"{args.scene}: no ground truth for this scene (a video needs a CSV of the same name beside it)")
     stream = stream_scene(scene, seed=args.seed, progress=not args.quiet)
     # Written as made, so memory does not grow with the video; a failure leaves no file.
-    with event_writer(args.output, stream.meta) as writer:
+    with event_writer(args.output, stream.meta, evt_version=args.evt) as writer:
         for chunk in stream:
             writer.write(chunk)
         result = Simulation(None, stream.meta, stream.samples, stream.sample_period_us, stream.wall_s, count=writer.count)
