@@ -111,10 +111,11 @@ demo-video: $(STAMP) $(VTEST)
 	@du -ch $(VIDEO_DIR)/vtest_tracks.* $(VIDEO_DIR)/vtest_reference.csv $(VIDEO_DIR)/vtest_scores.json | tail -1 | sed 's/total/outputs in total/'
 	@echo "pictures: $(VIDEO_DIR)/vtest_tracks.png $(VIDEO_DIR)/vtest_tracks.mp4"
 
-# The simulator beside ESIM's esim_py (built from uzh-rpg/rpg_vid2e into build/peers; set PEERS_SRC
-# to a checkout when GitHub is out of reach), alternately on the same frames: docs/BENCHMARKS.md.
+# The simulator beside ESIM's esim_py and v2e's emulator (built from uzh-rpg/rpg_vid2e and
+# SensorsINI/v2e into build/peers; set PEERS_SRC and V2E_SRC to checkouts when GitHub is out of
+# reach), alternately on the same frames: docs/BENCHMARKS.md.
 bench-peers: $(STAMP) $(VTEST)
-	bash bench/build_esim.sh $(BUILD)/peers $(PY)
+	bash bench/build_peers.sh $(BUILD)/peers $(PY)
 	$(PY) bench/peers.py --write docs/BENCHMARKS.md
 
 # The vtest.avi section of docs/RESULTS.md: the demo's path timed, and what each sensor effect and

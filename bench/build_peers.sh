@@ -1,10 +1,29 @@
 #!/usr/bin/env bash
-# Build ESIM's Python simulator (esim_py, from uzh-rpg/rpg_vid2e) into $1/esim_py for bench/peers.py.
-# Sources: $PEERS_SRC (a checkout of rpg_vid2e) if set, else a clone from GitHub. Needs Debian's
-# libopencv-dev, libeigen3-dev, libboost-filesystem-dev and cmake; pybind11 comes from PyPI.
+# The peers of bench/peers.py, in $1 (build/peers):
+# - ESIM's Python simulator (esim_py, from uzh-rpg/rpg_vid2e) into $1/esim_py. Sources: $PEERS_SRC
+#   (a checkout of rpg_vid2e) if set, else a clone from GitHub. Needs Debian's libopencv-dev,
+#   libeigen3-dev, libboost-filesystem-dev and cmake; pybind11 comes from PyPI.
+# - v2e's emulator (SensorsINI/v2e, its v2ecore package) into $1/src/v2e, with its own environment
+#   $1/v2e-venv (CPU torch from PyPI, about 6 GB). Sources: $V2E_SRC (a checkout) if set, else a
+#   clone from GitHub.
 set -euo pipefail
 out="$1"
 python="$2"
+build_v2e() {
+  [ -f "$out/v2e-venv/done" ] && return 0
+  mkdir -p "$out/src"
+  if [ -n "${V2E_SRC:-}" ]; then
+    rm -rf "$out/src/v2e" && mkdir -p "$out/src/v2e" && cp -r "$V2E_SRC/v2ecore" "$out/src/v2e/"
+  elif [ ! -d "$out/src/v2e/v2ecore" ]; then
+    git clone --depth 1 https://github.com/SensorsINI/v2e "$out/src/v2e" 2>/dev/null \
+      || { echo "evclust: cannot clone github.com/SensorsINI/v2e; set V2E_SRC to a checkout of it" >&2; exit 2; }
+  fi
+  python3 -m venv "$out/v2e-venv"
+  "$out/v2e-venv/bin/pip" install --quiet torch numpy opencv-python-headless h5py screeninfo tqdm scipy \
+    engineering-notation easygui numba dv-processing
+  touch "$out/v2e-venv/done"
+}
+build_v2e
 if [ -f "$out/esim_py/done" ]; then exit 0; fi
 for pkg in libopencv-dev libeigen3-dev libboost-filesystem-dev; do
   dpkg -s "$pkg" >/dev/null 2>&1 || { echo "evclust: bench-peers needs $pkg: apt-get install libopencv-dev libeigen3-dev libboost-filesystem-dev libboost-system-dev" >&2; exit 2; }
