@@ -18,30 +18,45 @@
 //
 // N, every width and every constant come from evclust_params.vh, generated from the model's
 // formats table (`evclust formats --verilog`).
-module evclust_core (
-    clk,
-    rst,
-    ev_valid,
-    ev_ready,
-    ev_data,
-    rec_valid,
-    rec_ready,
-    rec_data,
-    trace_valid,
-    trace_data,
-    filter_active
+`default_nettype none
+module evclust_core #(
+`define EVCLUST_PORT_PARAMETERS
+`include "evclust_params.vh"
+`undef EVCLUST_PORT_PARAMETERS
+) (
+    input  wire               clk,
+    input  wire               rst,
+    input  wire               clear,          // restart the datapath: a reset that spares the configuration
+    input  wire [CFG_W-1:0]   cfg,            // the configuration block (evclust_regs; CFG_* word indices)
+    input  wire               ev_valid,
+    output wire               ev_ready,
+    input  wire [EV_W-1:0]    ev_data,
+    output reg                rec_valid,
+    input  wire               rec_ready,
+    output reg  [REC_W-1:0]   rec_data,
+    output reg                trace_valid,
+    output reg  [TRACE_W-1:0] trace_data,
+    output wire               filter_active,  // a filter step: its phase cycle(s), sweep, merges and tail
+    output wire               idle,           // no event in flight, no filter step, no record waiting
+    output reg  [COUNT_W-1:0] count_inc       // what the last cycle adds to each status counter (COUNT_*)
 );
 `include "evclust_params.vh"
 `include "evclust_arith.vh"
 
-    localparam integer N = N_CLUSTERS;
+    // The port parameters must be the header's: they are given for the instantiating design's sake.
+    generate
+        if (N != N_CLUSTERS || EV_W != IN_WORD_W || REC_W != REC_WORD_W || TRACE_W != TRACE_WORD_W || CFG_W != 32 * CFG_WORDS
+            || COUNT_W != N_COUNTERS * COUNTER_INC_W) begin : parameters_differ_from_evclust_params_vh
+`ifdef VERILATOR
+            $fatal(1, "evclust_core: N, EV_W, REC_W, TRACE_W, CFG_W or COUNT_W differs from evclust_params.vh");
+`endif
+            initial $fatal(1, "evclust_core: N, EV_W, REC_W, TRACE_W, CFG_W or COUNT_W differs from evclust_params.vh");
+        end
+    endgenerate
+
     localparam integer P = PALETTE_SIZE;
     localparam integer SLOT_W = N > 1 ? $clog2(N) : 1;
     localparam integer CLASS_W = P > 1 ? $clog2(P) : 1;
-    localparam integer EV_W = EV_T_W + 2 * EV_XY_W + 1 + 3 * EV_COLOUR_W;
-    localparam integer REC_W = EV_T_W + 32 + SLOT_W + ID_W + 2 * CENTRE_W + 2 * HALF_SIZE_W + ACTIVITY_W
-                             + 2 * V_MCM_W + 2 * V_INT_W + 3 * COLOUR_W + 8 + 4;
-    localparam integer TRACE_W = 11;
     localparam integer SWEEP_LEN = N > P ? N : P;
     // The sweep tail: the operand register and the divider's stages (SWEEP_DIV_STEP bits each).
     localparam integer INV_STAGES = (INV_WW_W + SWEEP_DIV_STEP - 1) / SWEEP_DIV_STEP;  // 2^32 / |w|^2
@@ -50,17 +65,6 @@ module evclust_core (
     localparam integer SWEEP_W = $clog2(SWEEP_LEN + TAIL + 1);
     localparam integer EVERY_W = $clog2(FILTER_EVERY + 1);
 
-    input  wire               clk;
-    input  wire               rst;
-    input  wire               ev_valid;
-    output wire               ev_ready;
-    input  wire [EV_W-1:0]    ev_data;
-    output reg                rec_valid;
-    input  wire               rec_ready;
-    output reg  [REC_W-1:0]   rec_data;
-    output reg                trace_valid;
-    output reg  [TRACE_W-1:0] trace_data;
-    output wire               filter_active;  // a filter step: its phase cycle(s), sweep, merges and tail
 
     // ---------------------------------------------------------------- formats and constants
     localparam integer FP = CENTRE_FRAC, FR = HALF_SIZE_FRAC, FA = ACTIVITY_FRAC, FV = V_MCM_FRAC;
@@ -77,20 +81,20 @@ module evclust_core (
     localparam signed [63:0] MAX_VI = (64'sd1 <<< (V_INT_W - 1)) - 1, MIN_VI = -(64'sd1 <<< (V_INT_W - 1));
     localparam signed [63:0] MAX_STEP = (64'sd1 <<< (CENTRE_STEP_W - 1)) - 1, MIN_STEP = -(64'sd1 <<< (CENTRE_STEP_W - 1));
     localparam signed [63:0] H_MAX = (64'sd1 <<< HIST_W) - 1;
-    localparam signed [63:0] K_B_POS = $signed({{(64 - BETA_POS_W){1'b0}}, BETA_POS}), K_B_SIZE = $signed({{(64 - BETA_SIZE_W){1'b0}}, BETA_SIZE});
-    localparam signed [63:0] K_B_VM = $signed({{(64 - BETA_VEL_MCM_W){1'b0}}, BETA_VEL_MCM}), K_B_VI = $signed({{(64 - BETA_VEL_INT_W){1'b0}}, BETA_VEL_INT});
-    localparam signed [63:0] K_B_LUM = $signed({{(64 - BETA_LUM_W){1'b0}}, BETA_LUM}), K_B_CHRO = $signed({{(64 - BETA_CHRO_W){1'b0}}, BETA_CHRO});
-    localparam signed [63:0] K_B_BG = $signed({{(64 - BETA_BG_W){1'b0}}, BETA_BG}), K_GAIN = $signed({{(64 - SIZE_GAIN_W){1'b0}}, SIZE_GAIN});
-    localparam signed [63:0] K_GAMMA_GLOBAL = $signed({{(64 - GAMMA_GLOBAL_W){1'b0}}, GAMMA_GLOBAL}), K_GPA = $signed({{(64 - GAMMA_PER_ACTIVITY_W){1'b0}}, GAMMA_PER_ACTIVITY});
-    localparam signed [63:0] K_INV_P = $signed({{(64 - INV_P_W){1'b0}}, INV_P});
-    localparam signed [63:0] K_R_MIN = $signed({{(64 - R_MIN_W){1'b0}}, R_MIN});
-    localparam signed [63:0] K_R_MAX = $signed({{(64 - R_MAX_W){1'b0}}, R_MAX}), K_SEEK = $signed({{(64 - SEEK_MARGIN_W){1'b0}}, SEEK_MARGIN});
-    localparam signed [63:0] K_EXIT_M = $signed({{(64 - EXIT_MARGIN_W){1'b0}}, EXIT_MARGIN}), K_A_MIN = $signed({{(64 - A_MIN_W){1'b0}}, A_MIN});
-    localparam signed [63:0] K_A_VALID = $signed({{(64 - A_VALID_W){1'b0}}, A_VALID}), K_V_MIN_SQ = $signed({{(64 - V_MIN_SQ_W){1'b0}}, V_MIN_SQ});
-    localparam signed [63:0] K_V_EXIT_SQ = $signed({{(64 - V_EXIT_SQ_W){1'b0}}, V_EXIT_SQ}), K_COS_SQ = $signed({{(64 - COS_SQ_EXIT_W){1'b0}}, COS_SQ_EXIT});
-    localparam signed [63:0] HI_X = (($signed({32'd0, SENSOR_WIDTH[31:0]}) - 64'sd1) <<< FP) - K_EXIT_M;
-    localparam signed [63:0] HI_Y = (($signed({32'd0, SENSOR_HEIGHT[31:0]}) - 64'sd1) <<< FP) - K_EXIT_M;
-    localparam [63:0] TAU = {32'd0, TAU_US[31:0]};
+    wire signed [63:0] K_B_POS = $signed({{(64 - BETA_POS_W){1'b0}}, cfg[32 * CFG_BETA_POS +: BETA_POS_W]}), K_B_SIZE = $signed({{(64 - BETA_SIZE_W){1'b0}}, cfg[32 * CFG_BETA_SIZE +: BETA_SIZE_W]});
+    wire signed [63:0] K_B_VM = $signed({{(64 - BETA_VEL_MCM_W){1'b0}}, cfg[32 * CFG_BETA_VEL_MCM +: BETA_VEL_MCM_W]}), K_B_VI = $signed({{(64 - BETA_VEL_INT_W){1'b0}}, cfg[32 * CFG_BETA_VEL_INT +: BETA_VEL_INT_W]});
+    wire signed [63:0] K_B_LUM = $signed({{(64 - BETA_LUM_W){1'b0}}, cfg[32 * CFG_BETA_LUM +: BETA_LUM_W]}), K_B_CHRO = $signed({{(64 - BETA_CHRO_W){1'b0}}, cfg[32 * CFG_BETA_CHRO +: BETA_CHRO_W]});
+    wire signed [63:0] K_B_BG = $signed({{(64 - BETA_BG_W){1'b0}}, cfg[32 * CFG_BETA_BG +: BETA_BG_W]}), K_GAIN = $signed({{(64 - SIZE_GAIN_W){1'b0}}, cfg[32 * CFG_SIZE_GAIN +: SIZE_GAIN_W]});
+    wire signed [63:0] K_GAMMA_GLOBAL = $signed({{(64 - GAMMA_GLOBAL_W){1'b0}}, cfg[32 * CFG_GAMMA_GLOBAL +: GAMMA_GLOBAL_W]}), K_GPA = $signed({{(64 - GAMMA_PER_ACTIVITY_W){1'b0}}, cfg[32 * CFG_GAMMA_PER_ACTIVITY +: GAMMA_PER_ACTIVITY_W]});
+    wire signed [63:0] K_INV_P = $signed({{(64 - INV_P_W){1'b0}}, cfg[32 * CFG_INV_P +: INV_P_W]});
+    wire signed [63:0] K_R_MIN = $signed({{(64 - R_MIN_W){1'b0}}, cfg[32 * CFG_R_MIN +: R_MIN_W]});
+    wire signed [63:0] K_R_MAX = $signed({{(64 - R_MAX_W){1'b0}}, cfg[32 * CFG_R_MAX +: R_MAX_W]}), K_SEEK = $signed({{(64 - SEEK_MARGIN_W){1'b0}}, cfg[32 * CFG_SEEK_MARGIN +: SEEK_MARGIN_W]});
+    wire signed [63:0] K_EXIT_M = $signed({{(64 - EXIT_MARGIN_W){1'b0}}, cfg[32 * CFG_EXIT_MARGIN +: EXIT_MARGIN_W]}), K_A_MIN = $signed({{(64 - A_MIN_W){1'b0}}, cfg[32 * CFG_A_MIN +: A_MIN_W]});
+    wire signed [63:0] K_A_VALID = $signed({{(64 - A_VALID_W){1'b0}}, cfg[32 * CFG_A_VALID +: A_VALID_W]}), K_V_MIN_SQ = $signed({{(64 - V_MIN_SQ_W){1'b0}}, cfg[32 * CFG_V_MIN_SQ +: V_MIN_SQ_W]});
+    wire signed [63:0] K_V_EXIT_SQ = $signed({{(64 - V_EXIT_SQ_W){1'b0}}, cfg[32 * CFG_V_EXIT_SQ +: V_EXIT_SQ_W]}), K_COS_SQ = $signed({{(64 - COS_SQ_EXIT_W){1'b0}}, cfg[32 * CFG_COS_SQ_EXIT +: COS_SQ_EXIT_W]});
+    wire signed [63:0] HI_X = (($signed({32'd0, SENSOR_WIDTH[31:0]}) - 64'sd1) <<< FP) - K_EXIT_M;
+    wire signed [63:0] HI_Y = (($signed({32'd0, SENSOR_HEIGHT[31:0]}) - 64'sd1) <<< FP) - K_EXIT_M;
+    wire [63:0] TAU = {{(64 - TAU_PHASE_W){1'b0}}, cfg[32 * CFG_TAU_US +: TAU_PHASE_W]};
     localparam integer LAST_SLOT_I = N - 1, LAST_SWEEP_I = SWEEP_LEN + TAIL - 1;
     localparam [SWEEP_W-1:0] LAST_SLOT = LAST_SLOT_I[SWEEP_W-1:0];
     localparam [SWEEP_W-1:0] LAST_SWEEP = LAST_SWEEP_I[SWEEP_W-1:0];
@@ -99,12 +103,39 @@ module evclust_core (
     localparam [SWEEP_W-1:0] N_SLOTS = N[SWEEP_W-1:0], N_ENTRIES = P[SWEEP_W-1:0];
     localparam integer COS_SQ_F = COS_SQ_EXIT_FRAC;
     // One cluster per object (beyond the paper): scaled seek, merging, noise gate, creation support.
-    localparam signed [63:0] K_SEEK_SCALE = $signed({{(64 - SEEK_SCALE_W){1'b0}}, SEEK_SCALE});
-    localparam signed [63:0] K_MERGE_SCALE = $signed({{(64 - MERGE_SCALE_W){1'b0}}, MERGE_SCALE});
-    localparam signed [63:0] K_MERGE_V_TOL = $signed({{(64 - MERGE_V_TOL_W){1'b0}}, MERGE_V_TOL});
-    localparam signed [63:0] K_MERGE_V_REL = $signed({{(64 - MERGE_V_REL_W){1'b0}}, MERGE_V_REL});
-    localparam signed [63:0] K_NOISE_GATE = $signed({{(64 - NOISE_GATE_W){1'b0}}, NOISE_GATE});
-    localparam [31:0] K_SUPPORT_WINDOW = {{(32 - SUPPORT_WINDOW_W){1'b0}}, SUPPORT_WINDOW};
+    wire signed [63:0] K_SEEK_SCALE = $signed({{(64 - SEEK_SCALE_W){1'b0}}, cfg[32 * CFG_SEEK_SCALE +: SEEK_SCALE_W]});
+    wire signed [63:0] K_MERGE_SCALE = $signed({{(64 - MERGE_SCALE_W){1'b0}}, cfg[32 * CFG_MERGE_SCALE +: MERGE_SCALE_W]});
+    wire signed [63:0] K_MERGE_V_TOL = $signed({{(64 - MERGE_V_TOL_W){1'b0}}, cfg[32 * CFG_MERGE_V_TOL +: MERGE_V_TOL_W]});
+    wire signed [63:0] K_MERGE_V_REL = $signed({{(64 - MERGE_V_REL_W){1'b0}}, cfg[32 * CFG_MERGE_V_REL +: MERGE_V_REL_W]});
+    wire signed [63:0] K_NOISE_GATE = $signed({{(64 - NOISE_GATE_W){1'b0}}, cfg[32 * CFG_NOISE_GATE +: NOISE_GATE_W]});
+    wire [31:0] K_SUPPORT_WINDOW = {{(32 - SUPPORT_WINDOW_W){1'b0}}, cfg[32 * CFG_SUPPORT_WINDOW +: SUPPORT_WINDOW_W]};
+    // Run-time values and switches (registers, docs/REGISTERS.md); their widths are the build's.
+    wire [INV_T_HALF_W-1:0]    K_INV_T_HALF = cfg[32 * CFG_INV_T_HALF +: INV_T_HALF_W];
+    wire [LUMA_WEIGHT_W-1:0]   K_LUMA_WEIGHT = cfg[32 * CFG_LUMA_WEIGHT +: LUMA_WEIGHT_W];
+    wire [MIXING_TOLERANCE_W-1:0] K_MIXING_TOLERANCE = cfg[32 * CFG_MIXING_TOLERANCE +: MIXING_TOLERANCE_W];
+    wire [HALF_SIZE_W-1:0]     K_R_INIT = cfg[32 * CFG_R_INIT +: HALF_SIZE_W];
+    wire [FRAME_PER_TAU_W-1:0] K_FRAME_PER_TAU = cfg[32 * CFG_FRAME_PER_TAU +: FRAME_PER_TAU_W];
+    wire [EVERY_W-1:0]         K_FILTER_EVERY = cfg[32 * CFG_FILTER_EVERY +: EVERY_W];
+    wire [1:0]                 gamma_mode = cfg[32 * CFG_GAMMA_MODE +: 2];
+    wire                       warm_start = cfg[32 * CFG_WARM_START];
+    wire                       mcm_correct = cfg[32 * CFG_MCM_CORRECT];
+    wire                       vote_contrast = cfg[32 * CFG_VOTE_CONTRAST];
+    wire                       mixing = cfg[32 * CFG_MIXING];
+    wire                       bg_fixed = cfg[32 * CFG_BG_FIXED];
+    wire [P-1:0]               background_mask = cfg[32 * CFG_BACKGROUND_MASK +: P];
+    wire [BACKGROUND_W-1:0]    bg_init_y = cfg[32 * CFG_BG_INIT_Y +: BACKGROUND_W];
+    wire [BACKGROUND_W-1:0]    bg_init_cb = cfg[32 * CFG_BG_INIT_CB +: BACKGROUND_W];
+    wire [BACKGROUND_W-1:0]    bg_init_cr = cfg[32 * CFG_BG_INIT_CR +: BACKGROUND_W];
+    // The palette, entry j in bits [8j +: 8] (its registers are Y, Cb, Cr for each entry in turn).
+    wire [8*P-1:0]             palette_y, palette_cb, palette_cr;
+    genvar pj;
+    generate
+        for (pj = 0; pj < P; pj = pj + 1) begin : palette_entry
+            assign palette_y[8*pj +: 8] = cfg[32 * (CFG_PALETTE_0_Y + 3 * pj) +: 8];
+            assign palette_cb[8*pj +: 8] = cfg[32 * (CFG_PALETTE_0_CB + 3 * pj) +: 8];
+            assign palette_cr[8*pj +: 8] = cfg[32 * (CFG_PALETTE_0_CR + 3 * pj) +: 8];
+        end
+    endgenerate
     localparam signed [63:0] LAST_X = ($signed({32'd0, SENSOR_WIDTH[31:0]}) - 64'sd1) <<< FP;  // the last column, in P's format
     localparam signed [63:0] LAST_Y = ($signed({32'd0, SENSOR_HEIGHT[31:0]}) - 64'sd1) <<< FP;
     localparam signed [63:0] SENSOR_PIXELS = $signed({32'd0, SENSOR_WIDTH[31:0]}) * $signed({32'd0, SENSOR_HEIGHT[31:0]});
@@ -131,10 +162,12 @@ module evclust_core (
     function automatic signed [63:0] margin;
         input [HALF_SIZE_W-1:0] r_x;
         input [HALF_SIZE_W-1:0] r_y;
+        input signed [63:0]     seek;
+        input signed [63:0]     seek_scale;
         reg   [HALF_SIZE_W-1:0] r;
         begin
             r = r_x > r_y ? r_x : r_y;
-            margin = K_SEEK + align(u64({{(63 - HALF_SIZE_W){1'b0}}, r}) * K_SEEK_SCALE, SEEK_SCALE_FRAC + FR, FP);
+            margin = seek + align(u64({{(63 - HALF_SIZE_W){1'b0}}, r}) * seek_scale, SEEK_SCALE_FRAC + FR, FP);
         end
     endfunction
 
@@ -175,18 +208,22 @@ module evclust_core (
     function automatic signed [63:0] corrected;
         input signed [63:0] colour;
         input signed [63:0] background;
+        input signed [63:0] inv_p;
         reg signed [63:0] bg, obj;
         begin
             bg = align(background, FB, FC);
-            obj = bg + (((colour - bg) * K_INV_P) >>> INV_P_FRAC);
+            obj = bg + (((colour - bg) * inv_p) >>> INV_P_FRAC);
             corrected = saturate(obj, 0, 64'sd255 <<< FC);
         end
     endfunction
 
     function automatic signed [63:0] gamma_from_activity;
         input signed [63:0] a;
+        input [1:0]         mode;
+        input signed [63:0] global_gamma;
+        input signed [63:0] per_activity;
         begin
-            gamma_from_activity = GAMMA_MODE == GAMMA_MODE_GLOBAL ? K_GAMMA_GLOBAL : (a * K_GPA) >>> (FA + GAMMA_PER_ACTIVITY_FRAC - FG);
+            gamma_from_activity = mode == GAMMA_MODE_GLOBAL[1:0] ? global_gamma : (a * per_activity) >>> (FA + GAMMA_PER_ACTIVITY_FRAC - FG);
         end
     endfunction
 
@@ -274,6 +311,8 @@ module evclust_core (
     reg [FRAME_PER_TAU_W-1:0] per_frame; // T_frame / (boundaries * tau)
 
     assign filter_active = state == ST_PHASE || state == ST_SWEEP || state == ST_MERGE;
+    // The datapath restarts on a reset or a clear; the configuration lives outside (evclust_regs).
+    wire dp_rst = rst || clear;
 
     // ---------------------------------------------------------------- step 1: the seek
     // Stage A holds an accepted event while every slot compares it against its window in
@@ -282,14 +321,15 @@ module evclust_core (
     // smallest of each, registered into stage B with the event. The slot that the event before
     // writes on that same clock edge is tested again in B (`seek_w`), so the search sees the
     // table exactly as the model does.
-    wire [EV_T_W-1:0]  in_t = ev_data[EV_W-1 -: EV_T_W];
+    // The event word's fields (IN_*: the layout vectors/pack.py packs).
     localparam integer CW = EV_COLOUR_W;
-    wire [EV_XY_W-1:0] in_x = ev_data[EV_W-EV_T_W-1 -: EV_XY_W];
-    wire [EV_XY_W-1:0] in_y = ev_data[EV_W-EV_T_W-EV_XY_W-1 -: EV_XY_W];
-    wire [CW-1:0]      in_lum = ev_data[3*CW-1 -: CW];
-    wire [CW-1:0]      in_cb = ev_data[2*CW-1 -: CW];
-    wire [CW-1:0]      in_cr = ev_data[CW-1:0];
-    wire               unused_polarity = ev_data[3*CW];  // the clusterer is blind to polarity
+    wire [EV_T_W-1:0]  in_t = ev_data[IN_T_LSB +: IN_T_W];
+    wire [EV_XY_W-1:0] in_x = ev_data[IN_X_LSB +: IN_X_W];
+    wire [EV_XY_W-1:0] in_y = ev_data[IN_Y_LSB +: IN_Y_W];
+    wire [CW-1:0]      in_lum = ev_data[IN_LUM_LSB +: IN_LUM_W];
+    wire [CW-1:0]      in_cb = ev_data[IN_CB_LSB +: IN_CB_W];
+    wire [CW-1:0]      in_cr = ev_data[IN_CR_LSB +: IN_CR_W];
+    wire               unused_polarity = ev_data[IN_ON_LSB];  // the clusterer is blind to polarity
 
     reg                a_valid;
     reg [EV_T_W-1:0]   a_t;
@@ -311,14 +351,16 @@ module evclust_core (
         input [HALF_SIZE_W-1:0] r_x;
         input [HALF_SIZE_W-1:0] r_y;
         input [SLOT_W-1:0]      slot;
+        input signed [63:0]     seek;
+        input signed [63:0]     seek_scale;
         reg signed [63:0] dx, dy;
         reg hit;
         begin
             dx = abs64((u64({{(63 - EV_XY_W){1'b0}}, x}) <<< FP) - u64({{(63 - CENTRE_W){1'b0}}, c_x}));
             dy = abs64((u64({{(63 - EV_XY_W){1'b0}}, y}) <<< FP) - u64({{(63 - CENTRE_W){1'b0}}, c_y}));
             hit = live
-                && dx <= (u64({{(63 - HALF_SIZE_W){1'b0}}, r_x}) <<< (FP - FR)) + margin(r_x, r_y)
-                && dy <= (u64({{(63 - HALF_SIZE_W){1'b0}}, r_y}) <<< (FP - FR)) + margin(r_x, r_y);
+                && dx <= (u64({{(63 - HALF_SIZE_W){1'b0}}, r_x}) <<< (FP - FR)) + margin(r_x, r_y, seek, seek_scale)
+                && dy <= (u64({{(63 - HALF_SIZE_W){1'b0}}, r_y}) <<< (FP - FR)) + margin(r_x, r_y, seek, seek_scale);
             seek_key = {!hit, hit ? dx[DIST_W-1:0] + dy[DIST_W-1:0] : {DIST_W{1'b0}}, slot};
         end
     endfunction
@@ -328,7 +370,7 @@ module evclust_core (
     reg [N*FREE_KEY_W-1:0] free_keys;
     always @* begin
         for (s = 0; s < N; s = s + 1) begin
-            seek_keys[s*SEEK_KEY_W +: SEEK_KEY_W] = seek_key(a_x, a_y, valid[s], px[s], py[s], rx[s], ry[s], s[SLOT_W-1:0]);
+            seek_keys[s*SEEK_KEY_W +: SEEK_KEY_W] = seek_key(a_x, a_y, valid[s], px[s], py[s], rx[s], ry[s], s[SLOT_W-1:0], K_SEEK, K_SEEK_SCALE);
             free_keys[s*FREE_KEY_W +: FREE_KEY_W] = {valid[s], s[SLOT_W-1:0]};
         end
     end
@@ -342,7 +384,7 @@ module evclust_core (
     reg [SEEK_KEY_W-1:0] e_seek_first, e_seek_second;
     reg [FREE_KEY_W-1:0] e_free_first, e_free_second;
     reg [SLOT_W-1:0]     seek_w;
-    wire [SEEK_KEY_W-1:0] w_key = seek_key(e_x, e_y, valid[seek_w], px[seek_w], py[seek_w], rx[seek_w], ry[seek_w], seek_w);
+    wire [SEEK_KEY_W-1:0] w_key = seek_key(e_x, e_y, valid[seek_w], px[seek_w], py[seek_w], rx[seek_w], ry[seek_w], seek_w, K_SEEK, K_SEEK_SCALE);
     wire [SEEK_KEY_W-1:0] other_key = e_seek_first[SLOT_W-1:0] == seek_w ? e_seek_second : e_seek_first;
     wire [SEEK_KEY_W-1:0] chosen_key = w_key < other_key ? w_key : other_key;
     wire [FREE_KEY_W-1:0] w_free_key = {valid[seek_w], seek_w};
@@ -359,11 +401,12 @@ module evclust_core (
     wire [SLOT_W-1:0] dec_slot = state == ST_EXEC ? e_slot : index[SLOT_W-1:0];
     wire [ACTIVITY_W-1:0] dec_a;
     wire [DECAY_RESIDUAL_W-1:0] dec_residual;
-    evclust_decay decay_unit (
+    evclust_decay #(.ACTIVITY_BITS(ACTIVITY_W), .DT_BITS(DT_W), .RESIDUAL_BITS(DECAY_RESIDUAL_W), .INV_T_HALF_BITS(INV_T_HALF_W)) decay_unit (
         .activity(act[dec_slot]),
         .dt(e_t - t_last[dec_slot]),
         .residual(residual[dec_slot]),
         .use_residual(state != ST_SCAN),
+        .inv_t_half(K_INV_T_HALF),
         .decayed(dec_a),
         .residual_out(dec_residual)
     );
@@ -372,11 +415,12 @@ module evclust_core (
     // The background's activity decayed to the event's time (model: _decay_background).
     wire [ACTIVITY_W-1:0] bg_dec_a;
     wire [DECAY_RESIDUAL_W-1:0] bg_dec_residual;
-    evclust_decay bg_decay_unit (
+    evclust_decay #(.ACTIVITY_BITS(ACTIVITY_W), .DT_BITS(DT_W), .RESIDUAL_BITS(DECAY_RESIDUAL_W), .INV_T_HALF_BITS(INV_T_HALF_W)) bg_decay_unit (
         .activity(bg_act),
         .dt(e_t - bg_t),
         .residual(bg_residual),
         .use_residual(1'b1),
+        .inv_t_half(K_INV_T_HALF),
         .decayed(bg_dec_a),
         .residual_out(bg_dec_residual)
     );
@@ -407,10 +451,16 @@ module evclust_core (
     // ---------------------------------------------------------------- step 3: the update
     wire [CLASS_W-1:0] vote_class;
     wire [VOTE_W-1:0]  vote;
-    evclust_palette palette (
+    evclust_palette #(
+        .P(P), .CLASS_W(CLASS_W), .BG_BITS(BACKGROUND_W), .INV_BITS(INV_WW_W), .VOTE_BITS(VOTE_W),
+        .LUMA_BITS(LUMA_WEIGHT_W), .TOL_BITS(MIXING_TOLERANCE_W)
+    ) palette (
         .lum(e_lum), .cb(e_cb), .cr(e_cr),
         .bg_y(bg_y), .bg_cb(bg_cb), .bg_cr(bg_cr),
         .inv_ww(inv_ww),
+        .palette_y(palette_y), .palette_cb(palette_cb), .palette_cr(palette_cr),
+        .luma_weight(K_LUMA_WEIGHT), .mixing_tolerance(K_MIXING_TOLERANCE), .background_mask(background_mask),
+        .mixing(mixing), .vote_contrast(vote_contrast),
         .class_index(vote_class),
         .vote(vote)
     );
@@ -477,18 +527,18 @@ module evclust_core (
         f_expire = a_decayed < K_A_MIN;
         f_vi_count = vi_count[k];
         f_gamma = u64({{(63 - GAMMA_W){1'b0}}, gamma[k]});
-        if (GAMMA_MODE != GAMMA_MODE_COUNT || vi_count[k] == VI_NONE)
-            f_gamma = saturate(gamma_from_activity(a_decayed), 0, MAX_GAMMA);
+        if (gamma_mode != GAMMA_MODE_COUNT[1:0] || vi_count[k] == VI_NONE)
+            f_gamma = saturate(gamma_from_activity(a_decayed, gamma_mode, K_GAMMA_GLOBAL, K_GPA), 0, MAX_GAMMA);
         f_evc = u64({{(63 - EVENTS_IN_INTERVAL_W){1'b0}}, ev_count[k]});
         f_vix = $signed({{(64 - V_INT_W){vix[k][V_INT_W-1]}}, vix[k]});
         f_viy = $signed({{(64 - V_INT_W){viy[k][V_INT_W-1]}}, viy[k]});
         f_mx = saturate(align((u64({{(63 - CENTRE_W){1'b0}}, px[k]}) - u64({{(63 - CENTRE_W){1'b0}}, ppx[k]})) * f_per_frame, FP + FPT_F, FI), MIN_VI, MAX_VI);
         f_my = saturate(align((u64({{(63 - CENTRE_W){1'b0}}, py[k]}) - u64({{(63 - CENTRE_W){1'b0}}, ppy[k]})) * f_per_frame, FP + FPT_F, FI), MIN_VI, MAX_VI);
         if (boundaries != 33'd0) begin
-            if (GAMMA_MODE == GAMMA_MODE_COUNT && vi_count[k] != VI_NONE)
+            if (gamma_mode == GAMMA_MODE_COUNT[1:0] && vi_count[k] != VI_NONE)
                 f_gamma = saturate((f_evc * f_per_frame) >>> (FPT_F - FG), 0, MAX_GAMMA);
             f_evc = 0;
-            if (WARM_START == 0 || vi_count[k] >= VI_WARM_END) begin
+            if (!warm_start || vi_count[k] >= VI_WARM_END) begin
                 f_vix = alpha_step(f_vix, f_mx, K_B_VI, BETA_VEL_INT_FRAC, 0, 1'b0);
                 f_viy = alpha_step(f_viy, f_my, K_B_VI, BETA_VEL_INT_FRAC, 0, 1'b0);
             end else if (vi_count[k] == VI_FIRST) begin  // the first full interval: as it is
@@ -510,24 +560,31 @@ module evclust_core (
     wire [MCM_NORM_W-1:0] norm_cut = norm[k] >> (FW - MCM_WEIGHT_FRAC);  // w floored to mcm_weight's format
     wire [QUOTIENT_W-1:0] p_mag_x = floor_magnitude(p_vmx, p_w20);
     wire [QUOTIENT_W-1:0] p_mag_y = floor_magnitude(p_vmy, p_w20);
-    wire              p_correct = MCM_CORRECT != 0 && p_w20 != {W20_W{1'b0}};
+    wire              p_correct = mcm_correct && p_w20 != {W20_W{1'b0}};
     wire              p_sat_x = p_mag_x[QUOTIENT_W-1:Q_W] >= {{(QUOTIENT_W - Q_W - W20_W){1'b0}}, p_w20};
     wire              p_sat_y = p_mag_y[QUOTIENT_W-1:Q_W] >= {{(QUOTIENT_W - Q_W - W20_W){1'b0}}, p_w20};
     wire [W20_W-1:0]  p_divisor = p_correct ? p_w20 : {{(W20_W - 1){1'b0}}, 1'b1};  // no division by zero
-    localparam integer TAG_W = 1 + SLOT_W + 5;
+    // The model's saturation of V / w, for the counter: a negative quotient of exactly -2^Q_W
+    // fits V's format (saturating gives the same word), so it saturates only from
+    // -(2^Q_W + 1), that is a magnitude |a| + b - 1 of at least (2^Q_W + 1) b.
+    wire [QUOTIENT_W-1:0] p_b = {{(QUOTIENT_W - W20_W){1'b0}}, p_w20};
+    wire [QUOTIENT_W-1:0] p_less_x = p_mag_x - p_b, p_less_y = p_mag_y - p_b;
+    wire              p_over_x = p_vmx[V_MCM_W-1] ? p_mag_x >= p_b && p_less_x[QUOTIENT_W-1:Q_W] >= p_b[QUOTIENT_W-Q_W-1:0] : p_sat_x;
+    wire              p_over_y = p_vmy[V_MCM_W-1] ? p_mag_y >= p_b && p_less_y[QUOTIENT_W-1:Q_W] >= p_b[QUOTIENT_W-Q_W-1:0] : p_sat_y;
+    localparam integer TAG_W = 1 + SLOT_W + 7;
     wire [TAG_W-1:0]  t_tag;
     wire [Q_W-1:0]    t_qx, t_qy;
     wire              tail_en;
     evclust_pipediv #(.Q_W(Q_W), .DEN_W(W20_W), .STEP(SWEEP_DIV_STEP), .TAG_W(TAG_W)) div_vmx (
-        .clk(clk), .rst(rst), .en(tail_en),
+        .clk(clk), .rst(dp_rst), .en(tail_en),
         .remainder_in(p_sat_x || !p_correct ? {W20_W{1'b0}} : p_mag_x[Q_W +: W20_W]), .bits_in(p_mag_x[Q_W-1:0]),
         .divisor(p_divisor),
-        .tag_in({p_live, p_slot, p_correct, p_vmx[V_MCM_W-1], p_sat_x, p_vmy[V_MCM_W-1], p_sat_y}),
+        .tag_in({p_live, p_slot, p_correct, p_vmx[V_MCM_W-1], p_sat_x, p_vmy[V_MCM_W-1], p_sat_y, p_over_x, p_over_y}),
         .quotient(t_qx), .tag_out(t_tag)
     );
     wire [TAG_W-1:0] unused_tag_y;
     evclust_pipediv #(.Q_W(Q_W), .DEN_W(W20_W), .STEP(SWEEP_DIV_STEP), .TAG_W(TAG_W)) div_vmy (
-        .clk(clk), .rst(rst), .en(tail_en),
+        .clk(clk), .rst(dp_rst), .en(tail_en),
         .remainder_in(p_sat_y || !p_correct ? {W20_W{1'b0}} : p_mag_y[Q_W +: W20_W]), .bits_in(p_mag_y[Q_W-1:0]),
         .divisor(p_divisor),
         .tag_in({TAG_W{1'b0}}),
@@ -535,7 +592,8 @@ module evclust_core (
     );
     wire             t_live = t_tag[TAG_W-1];
     wire [SLOT_W-1:0] t = t_tag[TAG_W-2 -: SLOT_W];
-    wire             t_correct = t_tag[4], t_neg_x = t_tag[3], t_sat_x = t_tag[2], t_neg_y = t_tag[1], t_sat_y = t_tag[0];
+    wire             t_correct = t_tag[6], t_neg_x = t_tag[5], t_sat_x = t_tag[4], t_neg_y = t_tag[3], t_sat_y = t_tag[2];
+    wire             t_over_x = t_tag[1], t_over_y = t_tag[0];
 
     // The tail's last stage: the reported MCM velocity V / w, exit, report, class, record.
     function automatic signed [63:0] corrected_v;
@@ -599,7 +657,7 @@ module evclust_core (
         f_class = 8'hff;
         f_best = 0;
         for (cls = 0; cls < P; cls = cls + 1) begin
-            if (!BACKGROUND_MASK[cls] && u64({{(63 - HIST_W){1'b0}}, hist[t * P + cls]}) > f_best) begin
+            if (!background_mask[cls] && u64({{(63 - HIST_W){1'b0}}, hist[t * P + cls]}) > f_best) begin
                 f_best = u64({{(63 - HIST_W){1'b0}}, hist[t * P + cls]});
                 f_class = cls[7:0];
             end
@@ -609,14 +667,28 @@ module evclust_core (
     end
 
     // The record of slot t, in the layout of expected.hex.
-    wire signed [63:0] r_cy = corrected(u64({{(63 - COLOUR_W){1'b0}}, col_y[t]}), u64({{(63 - BACKGROUND_W){1'b0}}, bg_y}));
-    wire signed [63:0] r_cb = corrected(u64({{(63 - COLOUR_W){1'b0}}, col_cb[t]}), u64({{(63 - BACKGROUND_W){1'b0}}, bg_cb}));
-    wire signed [63:0] r_cr = corrected(u64({{(63 - COLOUR_W){1'b0}}, col_cr[t]}), u64({{(63 - BACKGROUND_W){1'b0}}, bg_cr}));
-    wire [REC_W-1:0] record = {
-        e_t, step, t, id[t], px[t], py[t], rx[t], ry[t], act[t],
-        f_vmx[V_MCM_W-1:0], f_vmy[V_MCM_W-1:0], vix[t], viy[t],
-        r_cy[COLOUR_W-1:0], r_cb[COLOUR_W-1:0], r_cr[COLOUR_W-1:0], f_class, f_flags
-    };
+    wire signed [63:0] r_cy = corrected(u64({{(63 - COLOUR_W){1'b0}}, col_y[t]}), u64({{(63 - BACKGROUND_W){1'b0}}, bg_y}), K_INV_P);
+    wire signed [63:0] r_cb = corrected(u64({{(63 - COLOUR_W){1'b0}}, col_cb[t]}), u64({{(63 - BACKGROUND_W){1'b0}}, bg_cb}), K_INV_P);
+    wire signed [63:0] r_cr = corrected(u64({{(63 - COLOUR_W){1'b0}}, col_cr[t]}), u64({{(63 - BACKGROUND_W){1'b0}}, bg_cr}), K_INV_P);
+    wire [REC_W-1:0] record;  // the fields at the layout's REC_* places
+    assign record[REC_T_US_LSB +: REC_T_US_W] = e_t;
+    assign record[REC_STEP_LSB +: REC_STEP_W] = step;
+    assign record[REC_SLOT_LSB +: REC_SLOT_W] = t;
+    assign record[REC_ID_LSB +: REC_ID_W] = id[t];
+    assign record[REC_X_LSB +: REC_X_W] = px[t];
+    assign record[REC_Y_LSB +: REC_Y_W] = py[t];
+    assign record[REC_RX_LSB +: REC_RX_W] = rx[t];
+    assign record[REC_RY_LSB +: REC_RY_W] = ry[t];
+    assign record[REC_ACTIVITY_LSB +: REC_ACTIVITY_W] = act[t];
+    assign record[REC_VX_MCM_LSB +: REC_VX_MCM_W] = f_vmx[V_MCM_W-1:0];
+    assign record[REC_VY_MCM_LSB +: REC_VY_MCM_W] = f_vmy[V_MCM_W-1:0];
+    assign record[REC_VX_INT_LSB +: REC_VX_INT_W] = vix[t];
+    assign record[REC_VY_INT_LSB +: REC_VY_INT_W] = viy[t];
+    assign record[REC_LUM_LSB +: REC_LUM_W] = r_cy[COLOUR_W-1:0];
+    assign record[REC_CB_LSB +: REC_CB_W] = r_cb[COLOUR_W-1:0];
+    assign record[REC_CR_LSB +: REC_CR_W] = r_cr[COLOUR_W-1:0];
+    assign record[REC_CLASS_LSB +: REC_CLASS_W] = f_class;
+    assign record[REC_FLAGS_LSB +: REC_FLAGS_W] = f_flags;
 
     // ---------------------------------------------------------------- merging (model: _mergeable, _merge)
     // The swept slot k absorbs the lowest later slot j that is the same object: boxes that
@@ -681,12 +753,12 @@ module evclust_core (
     wire [MOMENT_W-1:0]   div_x_q, div_y_q;
     wire [ACTIVITY_W:0]   unused_left_x, unused_left_y;
     evclust_udiv #(.NUM_W(MOMENT_W), .DEN_W(ACTIVITY_W + 1)) div_x (
-        .clk(clk), .rst(rst), .start(div_start),
+        .clk(clk), .rst(dp_rst), .start(div_start),
         .numerator(m_moment_x[MOMENT_W-1:0]), .denominator(m_weight[ACTIVITY_W:0]),
         .done(div_x_done), .quotient(div_x_q), .remainder_out(unused_left_x)
     );
     evclust_udiv #(.NUM_W(MOMENT_W), .DEN_W(ACTIVITY_W + 1)) div_y (
-        .clk(clk), .rst(rst), .start(div_start),
+        .clk(clk), .rst(dp_rst), .start(div_start),
         .numerator(m_moment_y[MOMENT_W-1:0]), .denominator(m_weight[ACTIVITY_W:0]),
         .done(div_y_done), .quotient(div_y_q), .remainder_out(unused_left_y)
     );
@@ -724,7 +796,7 @@ module evclust_core (
     wire [32:0] by_tau_q;
     wire [TAU_PHASE_W:0] by_tau_left;
     evclust_udiv #(.NUM_W(33), .DEN_W(TAU_PHASE_W + 1)) div_phase (
-        .clk(clk), .rst(rst), .start(phase_start),
+        .clk(clk), .rst(dp_rst), .start(phase_start),
         .numerator(phase_q), .denominator(TAU[TAU_PHASE_W:0]),
         .done(by_tau_done), .quotient(by_tau_q), .remainder_out(by_tau_left)
     );
@@ -733,25 +805,25 @@ module evclust_core (
     wire [FRAME_PER_TAU_W-1:0] frame_q;
     wire [FRAME_PER_TAU_W-1:0] unused_frame_left;
     evclust_udiv #(.NUM_W(FRAME_PER_TAU_W), .DEN_W(FRAME_PER_TAU_W)) div_frame (
-        .clk(clk), .rst(rst), .start(frame_start),
-        .numerator(FRAME_PER_TAU), .denominator(by_tau_q[FRAME_PER_TAU_W-1:0]),
+        .clk(clk), .rst(dp_rst), .start(frame_start),
+        .numerator(K_FRAME_PER_TAU), .denominator(by_tau_q[FRAME_PER_TAU_W-1:0]),
         .done(frame_done), .quotient(frame_q), .remainder_out(unused_frame_left)
     );
 
     // 1/|palette_j - BG|^2 for the mixing rule (model: refresh_mixing), one entry per cycle.
     wire [CLASS_W-1:0] refresh_j = index[CLASS_W-1:0];
-    wire signed [63:0] w_y = u64({55'd0, PALETTE_Y[refresh_j * 8 +: 8]}) - (u64({{(63 - BACKGROUND_W){1'b0}}, bg_y}) >>> FB);
-    wire signed [63:0] w_cb = u64({55'd0, PALETTE_CB[refresh_j * 8 +: 8]}) - (u64({{(63 - BACKGROUND_W){1'b0}}, bg_cb}) >>> FB);
-    wire signed [63:0] w_cr = u64({55'd0, PALETTE_CR[refresh_j * 8 +: 8]}) - (u64({{(63 - BACKGROUND_W){1'b0}}, bg_cr}) >>> FB);
+    wire signed [63:0] w_y = u64({55'd0, palette_y[refresh_j * 8 +: 8]}) - (u64({{(63 - BACKGROUND_W){1'b0}}, bg_y}) >>> FB);
+    wire signed [63:0] w_cb = u64({55'd0, palette_cb[refresh_j * 8 +: 8]}) - (u64({{(63 - BACKGROUND_W){1'b0}}, bg_cb}) >>> FB);
+    wire signed [63:0] w_cr = u64({55'd0, palette_cr[refresh_j * 8 +: 8]}) - (u64({{(63 - BACKGROUND_W){1'b0}}, bg_cr}) >>> FB);
     wire signed [63:0] ww = w_y * w_y + w_cb * w_cb + w_cr * w_cr;  // < 3 * 255^2 < 2^18
     // 2^32 / ww in a pipelined divider, INV_STAGES cycles behind the entry fed (INIT and the
     // sweep feed one entry per cycle; the sweep's tail and INIT wait for it).
     wire               inv_en = state == ST_INIT || tail_en;
-    wire               inv_live = index < N_ENTRIES && (state == ST_INIT || (MIXING != 0 && BG_FIXED == 0));
+    wire               inv_live = index < N_ENTRIES && (state == ST_INIT || (mixing && !bg_fixed));
     wire [CLASS_W+1:0] inv_tag;
     wire [INV_WW_W-1:0] inverse;
     evclust_pipediv #(.Q_W(INV_WW_W), .DEN_W(18), .STEP(SWEEP_DIV_STEP), .TAG_W(CLASS_W + 2)) div_inverse (
-        .clk(clk), .rst(rst), .en(inv_en),
+        .clk(clk), .rst(dp_rst), .en(inv_en),
         .remainder_in(18'd0), .bits_in({1'b1, {(INV_WW_W - 1){1'b0}}}), .divisor(ww == 64'sd0 ? 18'd1 : ww[17:0]),
         .tag_in({inv_live, ww == 64'sd0, refresh_j}),
         .quotient(inverse), .tag_out(inv_tag)
@@ -803,10 +875,10 @@ module evclust_core (
     wire signed [63:0] bg_y_next = alpha_step(u64({{(63 - BACKGROUND_W){1'b0}}, bg_y}), u64({{(63 - CW){1'b0}}, e_lum}), K_B_BG, BETA_BG_FRAC, FB, 1'b0);
     wire signed [63:0] bg_cb_next = alpha_step(u64({{(63 - BACKGROUND_W){1'b0}}, bg_cb}), u64({{(63 - CW){1'b0}}, e_cb}), K_B_BG, BETA_BG_FRAC, FB, 1'b0);
     wire signed [63:0] bg_cr_next = alpha_step(u64({{(63 - BACKGROUND_W){1'b0}}, bg_cr}), u64({{(63 - CW){1'b0}}, e_cr}), K_B_BG, BETA_BG_FRAC, FB, 1'b0);
-    wire signed [63:0] gamma_new = gamma_from_activity(ONE_A);
-    wire sweep_due = {{(32 - EVERY_W){1'b0}}, since_filter} + 32'd1 >= FILTER_EVERY;
+    wire signed [63:0] gamma_new = gamma_from_activity(ONE_A, gamma_mode, K_GAMMA_GLOBAL, K_GPA);
+    wire sweep_due = {{(32 - EVERY_W){1'b0}}, since_filter} + 32'd1 >= {{(32 - EVERY_W){1'b0}}, K_FILTER_EVERY};
     // An update of a reported cluster is the object's colour, not the background's.
-    wire bg_learns = finish && BG_FIXED == 0 && !(do_update && reported[e_slot]);
+    wire bg_learns = finish && !bg_fixed && !(do_update && reported[e_slot]);
     wire sweep_advance = state == ST_SWEEP && (!rec_valid || rec_ready);
     wire sweep_live = sweep_advance && index < N_SLOTS && valid[k];
     wire sweep_merge = sweep_live && !f_expire && merge_found;  // k absorbs merge_j first
@@ -820,14 +892,69 @@ module evclust_core (
     wire b_takes = state == ST_IDLE || (finish && !sweep_due);
     wire a_advance = a_valid && b_takes;
     wire [SLOT_W-1:0] written_slot = do_update ? e_slot : create_slot;
-    assign ev_ready = !rst && (!a_valid || a_advance);  // no handshake during a reset
+    assign ev_ready = !dp_rst && (!a_valid || a_advance);  // no handshake during a reset or clear
+
+    // ---------------------------------------------------------------- status counters
+    // What this cycle adds to each counter of evclust_regs, registered into count_inc. The
+    // saturations are the model's `_store` sites (fixed_model.py), each counted where it applies.
+    function automatic [1:0] outside;  // 1 if v lies outside [lo, hi]
+        input signed [63:0] v;
+        input signed [63:0] lo;
+        input signed [63:0] hi;
+        begin
+            outside = (v < lo || v > hi) ? 2'd1 : 2'd0;
+        end
+    endfunction
+    wire signed [63:0] u_gx_raw = (u64({{(64 - OFFSET_W){1'b0}}, u_ox[OFFSET_W-2:0]}) * K_GAIN) >>> (SIZE_GAIN_FRAC + FP - FR);
+    wire signed [63:0] u_gy_raw = (u64({{(64 - OFFSET_W){1'b0}}, u_oy[OFFSET_W-2:0]}) * K_GAIN) >>> (SIZE_GAIN_FRAC + FP - FR);
+    wire signed [63:0] u_ux_raw = align(u_gamma * $signed({{(64 - CENTRE_STEP_W){u_step_x[CENTRE_STEP_W-1]}}, u_step_x[CENTRE_STEP_W-1:0]}), FG + FP, FV);
+    wire signed [63:0] u_uy_raw = align(u_gamma * $signed({{(64 - CENTRE_STEP_W){u_step_y[CENTRE_STEP_W-1]}}, u_step_y[CENTRE_STEP_W-1:0]}), FG + FP, FV);
+    wire signed [63:0] f_evc_in = u64({{(63 - EVENTS_IN_INTERVAL_W){1'b0}}, ev_count[k]});
+    wire signed [63:0] f_gamma_count = (f_evc_in * f_per_frame) >>> (FPT_F - FG);
+    wire signed [63:0] f_mx_raw = align((c64(px[k]) - c64(ppx[k])) * f_per_frame, FP + FPT_F, FI);
+    wire signed [63:0] f_my_raw = align((c64(py[k]) - c64(ppy[k])) * f_per_frame, FP + FPT_F, FI);
+    wire signed [63:0] f_speed_raw = speed_sq({1'b0, f_sq_x} + {1'b0, f_sq_y}, FV);
+    wire               stage0 = sweep_slot && !f_expire;
+    wire               counted_gamma_activity = gamma_mode != GAMMA_MODE_COUNT[1:0] || vi_count[k] == VI_NONE;
+    wire               counted_gamma_count = boundaries != 33'd0 && gamma_mode == GAMMA_MODE_COUNT[1:0] && vi_count[k] != VI_NONE;
+    wire               tail_out = tail_en && t_live;
+    wire               bg_counts = finish && !(do_update && reported[e_slot]) && K_NOISE_GATE != 0;
+    reg [COUNT_W-1:0]  inc;
+    always @* begin
+        inc = {COUNT_W{1'b0}};
+        inc[COUNT_EVENTS * COUNTER_INC_W +: 2] = {1'b0, ev_valid && ev_ready};
+        inc[COUNT_UPDATES * COUNTER_INC_W +: 2] = {1'b0, do_update};
+        inc[COUNT_CREATES * COUNTER_INC_W +: 2] = {1'b0, do_create};
+        inc[COUNT_EVICTIONS * COUNTER_INC_W +: 2] = {1'b0, state == ST_EVICT && evict};
+        inc[COUNT_DROPS * COUNTER_INC_W +: 2] = {1'b0, state == ST_EVICT && !evict};
+        inc[COUNT_UNSUPPORTED * COUNTER_INC_W +: 2] = {1'b0, finish && action == TRACE_UNSUPPORTED};
+        inc[COUNT_EXPIRIES * COUNTER_INC_W +: 2] = {1'b0, sweep_slot && f_expire};
+        inc[COUNT_EXITS * COUNTER_INC_W +: 2] = {1'b0, tail_out && f_exit};
+        inc[COUNT_MERGES * COUNTER_INC_W +: 2] = {1'b0, m_write};
+        inc[COUNT_RECORDS * COUNTER_INC_W +: 2] = {1'b0, tail_out && !f_exit && f_report};
+        inc[COUNT_SAT_ACTIVITY * COUNTER_INC_W +: 2] = (do_update ? outside(a_decayed + ONE_A, 0, MAX_ACT) : 2'd0)
+            + (bg_counts ? outside(u64({{(63 - ACTIVITY_W){1'b0}}, bg_dec_a}) + ONE_A, 0, MAX_ACT) : 2'd0)
+            + (m_write ? outside(m_weight, 0, MAX_ACT) : 2'd0);
+        inc[COUNT_SAT_SIZE_TARGET * COUNTER_INC_W +: 2] = do_update ? outside(u_gx_raw, 0, MAX_SIZE_TARGET) + outside(u_gy_raw, 0, MAX_SIZE_TARGET) : 2'd0;
+        inc[COUNT_SAT_CENTRE_STEP * COUNTER_INC_W +: 2] = do_update ? outside(u_px_new - u_px, MIN_STEP, MAX_STEP) + outside(u_py_new - u_py, MIN_STEP, MAX_STEP) : 2'd0;
+        inc[COUNT_SAT_MCM_STEP * COUNTER_INC_W +: 2] = do_update ? outside(u_ux_raw, MIN_V, MAX_V) + outside(u_uy_raw, MIN_V, MAX_V) : 2'd0;
+        inc[COUNT_SAT_EVENTS_IN_INTERVAL * COUNTER_INC_W +: 2] = (do_update ? outside(u64({{(63 - EVENTS_IN_INTERVAL_W){1'b0}}, ev_count[e_slot]}) + 1, 0, MAX_EVCOUNT) : 2'd0)
+            + (m_write ? outside(u64({{(63 - EVENTS_IN_INTERVAL_W){1'b0}}, ev_count[k]}) + u64({{(63 - EVENTS_IN_INTERVAL_W){1'b0}}, ev_count[m_j]}), 0, MAX_EVCOUNT) : 2'd0);
+        inc[COUNT_SAT_GAMMA * COUNTER_INC_W +: 2] = (stage0 && counted_gamma_activity ? outside(gamma_from_activity(a_decayed, gamma_mode, K_GAMMA_GLOBAL, K_GPA), 0, MAX_GAMMA) : 2'd0)
+            + (stage0 && counted_gamma_count ? outside(f_gamma_count, 0, MAX_GAMMA) : 2'd0);
+        inc[COUNT_SAT_V_INT * COUNTER_INC_W +: 2] = stage0 && boundaries != 33'd0 ? outside(f_mx_raw, MIN_VI, MAX_VI) + outside(f_my_raw, MIN_VI, MAX_VI) : 2'd0;
+        inc[COUNT_SAT_V_MCM * COUNTER_INC_W +: 2] = tail_out && t_correct ? {1'b0, t_over_x} + {1'b0, t_over_y} : 2'd0;
+        inc[COUNT_SAT_SPEED_SQ * COUNTER_INC_W +: 2] = tail_out ? outside(f_speed_raw, 0, MAX_SPEED_SQ) : 2'd0;
+    end
+    assign idle = state == ST_IDLE && !a_valid && !rec_valid;
 
     integer i;
     always @(posedge clk) begin
+        count_inc <= rst ? {COUNT_W{1'b0}} : inc;
         trace_valid <= 1'b0;
         if (rec_valid && rec_ready)
             rec_valid <= 1'b0;
-        if (rst) begin
+        if (dp_rst) begin
             state <= ST_INIT;
             index <= {SWEEP_W{1'b0}};
             rec_valid <= 1'b0;
@@ -839,9 +966,9 @@ module evclust_core (
             init_cell <= {CELL_W{1'b0}};
             m_j <= {SLOT_W{1'b0}};
             m_started <= 1'b0;
-            bg_y <= BG_INIT_Y[BACKGROUND_W-1:0];
-            bg_cb <= BG_INIT_CB[BACKGROUND_W-1:0];
-            bg_cr <= BG_INIT_CR[BACKGROUND_W-1:0];
+            bg_y <= bg_init_y;
+            bg_cb <= bg_init_cb;
+            bg_cr <= bg_init_cr;
             inv_ww <= {(P * INV_WW_W){1'b0}};
             next_id <= {ID_W{1'b0}};
             step <= 32'd0;
@@ -901,12 +1028,12 @@ module evclust_core (
                     PHASE_DECIDE: if (phase_q < {1'b0, TAU[31:0]}) begin
                         boundaries <= 33'd0;
                         tau_phase <= phase_q[TAU_PHASE_W-1:0];
-                        per_frame <= FRAME_PER_TAU;  // T_frame / tau: n counts as 1
+                        per_frame <= K_FRAME_PER_TAU;  // T_frame / tau: n counts as 1
                         state <= ST_SWEEP;
                     end else if (!phase_start) begin  // one boundary
                         boundaries <= 33'd1;
                         tau_phase <= phase_q[TAU_PHASE_W-1:0] - TAU[TAU_PHASE_W-1:0];
-                        per_frame <= FRAME_PER_TAU;
+                        per_frame <= K_FRAME_PER_TAU;
                         state <= ST_SWEEP;
                     end else begin
                         phase_step <= PHASE_BY_TAU;
@@ -939,7 +1066,9 @@ module evclust_core (
             // The end of an event: trace, background, the filter-step counter.
             if (finish) begin
                 trace_valid <= 1'b1;
-                trace_data <= {action, {(8 - SLOT_W){1'b0}}, action_slot};
+                trace_data <= {TRACE_W{1'b0}};
+                trace_data[TRACE_ACTION_LSB +: TRACE_ACTION_W] <= action;
+                trace_data[TRACE_SLOT_LSB +: SLOT_W] <= action_slot;
                 if (CREATE_SUPPORT != 0) begin
                     support_t[ev_cell] <= e_t;
                     support_seen[ev_cell] <= 1'b1;
@@ -1033,8 +1162,8 @@ module evclust_core (
                 py[create_slot] <= {{(CENTRE_W - EV_XY_W - FP){1'b0}}, e_y, {FP{1'b0}}};
                 ppx[create_slot] <= {{(CENTRE_W - EV_XY_W - FP){1'b0}}, e_x, {FP{1'b0}}};
                 ppy[create_slot] <= {{(CENTRE_W - EV_XY_W - FP){1'b0}}, e_y, {FP{1'b0}}};
-                rx[create_slot] <= R_INIT;
-                ry[create_slot] <= R_INIT;
+                rx[create_slot] <= K_R_INIT;
+                ry[create_slot] <= K_R_INIT;
                 act[create_slot] <= ONE_A[ACTIVITY_W-1:0];
                 residual[create_slot] <= {DECAY_RESIDUAL_W{1'b0}};
                 gamma[create_slot] <= gamma_new[GAMMA_W-1:0];
@@ -1128,3 +1257,4 @@ module evclust_core (
         end
     end
 endmodule
+`default_nettype wire

@@ -3,22 +3,31 @@
 // back as the new residual, so many short decays add up to one long one. The integer part
 // of m = n / 2^DROP shifts, its low 6 bits index the 2^-(i/64) table: one multiplier, one
 // barrel shifter, no exponential. Without the residual (eviction's comparison) it is arith.decay.
-module evclust_decay (
-    activity,
-    dt,
-    residual,
-    use_residual,
-    decayed,
-    residual_out
+`default_nettype none
+module evclust_decay #(
+    parameter integer ACTIVITY_BITS = 25,  // the header's ACTIVITY_W (checked below)
+    parameter integer DT_BITS = 32,
+    parameter integer RESIDUAL_BITS = 32,
+    parameter integer INV_T_HALF_BITS = 38
+) (
+    input  wire [ACTIVITY_BITS-1:0]   activity,
+    input  wire [DT_BITS-1:0]         dt,
+    input  wire [RESIDUAL_BITS-1:0]   residual,
+    input  wire                       use_residual,
+    input  wire [INV_T_HALF_BITS-1:0] inv_t_half,  // 1/T_half, a run-time register
+    output wire [ACTIVITY_BITS-1:0]   decayed,
+    output wire [RESIDUAL_BITS-1:0]   residual_out
 );
 `include "evclust_params.vh"
 
-    input  wire [ACTIVITY_W-1:0]       activity;
-    input  wire [DT_W-1:0]             dt;
-    input  wire [DECAY_RESIDUAL_W-1:0] residual;
-    input  wire                        use_residual;
-    output wire [ACTIVITY_W-1:0]       decayed;
-    output wire [DECAY_RESIDUAL_W-1:0] residual_out;
+    generate
+        if (ACTIVITY_BITS != ACTIVITY_W || DT_BITS != DT_W || RESIDUAL_BITS != DECAY_RESIDUAL_W || INV_T_HALF_BITS != INV_T_HALF_W) begin : widths_differ_from_evclust_params_vh
+`ifdef VERILATOR
+            $fatal(1, "evclust_decay: a width differs from evclust_params.vh");
+`endif
+            initial $fatal(1, "evclust_decay: a width differs from evclust_params.vh");
+        end
+    endgenerate
 
     localparam integer DROP = INV_T_HALF_FRAC - DECAY_TABLE_BITS;  // n's bits below one table step
     localparam integer ENTRY_W = DECAY_TABLE_W;
@@ -27,7 +36,7 @@ module evclust_decay (
     localparam [6:0] FRACTION_SHIFT = DECAY_TABLE_FRAC[6:0];
     localparam [63:0] MAX_HALVINGS = {32'd0, MAX_SHIFT[31:0]};
 
-    wire [63:0] steps = {{(64 - DT_W){1'b0}}, dt} * {{(64 - INV_T_HALF_W){1'b0}}, INV_T_HALF}
+    wire [63:0] steps = {{(64 - DT_W){1'b0}}, dt} * {{(64 - INV_T_HALF_W){1'b0}}, inv_t_half}
                       + (use_residual ? {{(64 - DECAY_RESIDUAL_W){1'b0}}, residual} : 64'd0);
     wire [63:0] m = steps >> DROP;
     wire [63:0] halvings = m >> DECAY_TABLE_BITS;
@@ -40,3 +49,4 @@ module evclust_decay (
     assign decayed = halvings > MAX_HALVINGS ? {ACTIVITY_W{1'b0}} : shifted[ACTIVITY_W-1:0];
     assign residual_out = steps[DECAY_RESIDUAL_W-1:0];  // DECAY_RESIDUAL_W == DROP
 endmodule
+`default_nettype wire

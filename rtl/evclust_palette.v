@@ -5,36 +5,53 @@
 //    of the event's colour, the nearest; q = clamp(u.w / |w|^2, 0, 1) from 1/|w|^2 (inv_ww,
 //    refreshed at filter steps), so there is no divider here;
 //  - the vote: 1, or the event's L1 contrast to the background, rounded half up.
-module evclust_palette (
-    lum,
-    cb,
-    cr,
-    bg_y,
-    bg_cb,
-    bg_cr,
-    inv_ww,
-    class_index,
-    vote
+`default_nettype none
+module evclust_palette #(
+    parameter integer P = 8,            // entries: the header's PALETTE_SIZE (checked below)
+    parameter integer CLASS_W = 3,
+    parameter integer BG_BITS = 24,     // the header's BACKGROUND_W
+    parameter integer INV_BITS = 33,    // INV_WW_W
+    parameter integer VOTE_BITS = 10,   // VOTE_W
+    parameter integer LUMA_BITS = 8,    // LUMA_WEIGHT_W
+    parameter integer TOL_BITS = 11     // MIXING_TOLERANCE_W
+) (
+    input  wire [7:0]            lum,
+    input  wire [7:0]            cb,
+    input  wire [7:0]            cr,
+    input  wire [BG_BITS-1:0]    bg_y,
+    input  wire [BG_BITS-1:0]    bg_cb,
+    input  wire [BG_BITS-1:0]    bg_cr,
+    input  wire [P*INV_BITS-1:0] inv_ww,
+    // Run-time registers: the palette (entry j in bits [8j +: 8]), w_Y, the mixing tolerance, the
+    // background entries and the switches.
+    input  wire [8*P-1:0]        palette_y,
+    input  wire [8*P-1:0]        palette_cb,
+    input  wire [8*P-1:0]        palette_cr,
+    input  wire [LUMA_BITS-1:0]  luma_weight,
+    input  wire [TOL_BITS-1:0]   mixing_tolerance,
+    input  wire [P-1:0]          background_mask,
+    input  wire                  mixing,
+    input  wire                  vote_contrast,
+    output reg  [CLASS_W-1:0]    class_index,
+    output wire [VOTE_BITS-1:0]  vote
 );
 `include "evclust_params.vh"
 `include "evclust_arith.vh"
 
-    localparam integer CLASS_W = PALETTE_SIZE > 1 ? $clog2(PALETTE_SIZE) : 1;
-
-    input  wire [EV_COLOUR_W-1:0]              lum;
-    input  wire [EV_COLOUR_W-1:0]              cb;
-    input  wire [EV_COLOUR_W-1:0]              cr;
-    input  wire [BACKGROUND_W-1:0]             bg_y;
-    input  wire [BACKGROUND_W-1:0]             bg_cb;
-    input  wire [BACKGROUND_W-1:0]             bg_cr;
-    input  wire [PALETTE_SIZE*INV_WW_W-1:0]    inv_ww;
-    output reg  [CLASS_W-1:0]                  class_index;
-    output wire [VOTE_W-1:0]                   vote;
+    generate
+        if (P != PALETTE_SIZE || CLASS_W != (P > 1 ? $clog2(P) : 1) || BG_BITS != BACKGROUND_W || INV_BITS != INV_WW_W
+            || VOTE_BITS != VOTE_W || LUMA_BITS != LUMA_WEIGHT_W || TOL_BITS != MIXING_TOLERANCE_W || EV_COLOUR_W != 8) begin : widths_differ_from_evclust_params_vh
+`ifdef VERILATOR
+            $fatal(1, "evclust_palette: a width differs from evclust_params.vh");
+`endif
+            initial $fatal(1, "evclust_palette: a width differs from evclust_params.vh");
+        end
+    endgenerate
 
     localparam integer FW = LUMA_WEIGHT_FRAC;
     localparam integer FB = BACKGROUND_FRAC;
-    localparam signed [63:0] W_Y = $signed({{(64 - LUMA_WEIGHT_W){1'b0}}, LUMA_WEIGHT});
-    localparam signed [63:0] TOLERANCE = $signed({{(64 - MIXING_TOLERANCE_W){1'b0}}, MIXING_TOLERANCE}) <<< FW;
+    wire signed [63:0] W_Y = $signed({{(64 - LUMA_WEIGHT_W){1'b0}}, luma_weight});
+    wire signed [63:0] TOLERANCE = $signed({{(64 - MIXING_TOLERANCE_W){1'b0}}, mixing_tolerance}) <<< FW;
     localparam signed [63:0] FAR = 64'sd1 <<< 62;
 
     wire signed [63:0] e_y = $signed({{(64 - EV_COLOUR_W){1'b0}}, lum});
@@ -74,10 +91,10 @@ module evclust_palette (
         mixed = {CLASS_W{1'b0}};
         mixed_d = FAR;
         mixed_found = 1'b0;
-        for (j = 0; j < PALETTE_SIZE; j = j + 1) begin
-            p_y = $signed({56'd0, PALETTE_Y[j*8 +: 8]});
-            p_cb = $signed({56'd0, PALETTE_CB[j*8 +: 8]});
-            p_cr = $signed({56'd0, PALETTE_CR[j*8 +: 8]});
+        for (j = 0; j < P; j = j + 1) begin
+            p_y = $signed({56'd0, palette_y[j*8 +: 8]});
+            p_cb = $signed({56'd0, palette_cb[j*8 +: 8]});
+            p_cr = $signed({56'd0, palette_cr[j*8 +: 8]});
             t_y = abs64(e_y - p_y);
             t_cb = abs64(e_cb - p_cb);
             t_cr = abs64(e_cr - p_cr);
@@ -105,18 +122,19 @@ module evclust_palette (
             t_y = abs64({{(64 - RES_W){r_y[RES_W-1]}}, r_y});
             t_cb = abs64({{(64 - RES_W){r_cb[RES_W-1]}}, r_cb});
             t_cr = abs64({{(64 - RES_W){r_cr[RES_W-1]}}, r_cr});
-            d_line = BACKGROUND_MASK[j] ? d_end : (W_Y * t_y + ((t_cb + t_cr) <<< FW)) >>> QF;
+            d_line = background_mask[j] ? d_end : (W_Y * t_y + ((t_cb + t_cr) <<< FW)) >>> QF;
             if (d_line <= TOLERANCE && d_end < mixed_d) begin
                 mixed = j[CLASS_W-1:0];
                 mixed_d = d_end;
                 mixed_found = 1'b1;
             end
         end
-        class_index = (MIXING != 0 && mixed_found) ? mixed : nearest;
+        class_index = (mixing && mixed_found) ? mixed : nearest;
     end
 
     // |e - BG|_1 from the exact background, rounded half up.
     wire signed [63:0] contrast = (abs64((e_y <<< FB) - b_y) + abs64((e_cb <<< FB) - b_cb) + abs64((e_cr <<< FB) - b_cr)
                                    + (64'sd1 <<< (FB - 1))) >>> FB;
-    assign vote = VOTE_CONTRAST != 0 ? contrast[VOTE_W-1:0] : {{(VOTE_W - 1){1'b0}}, 1'b1};
+    assign vote = vote_contrast ? contrast[VOTE_W-1:0] : {{(VOTE_W - 1){1'b0}}, 1'b1};
 endmodule
+`default_nettype wire

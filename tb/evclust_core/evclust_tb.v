@@ -2,7 +2,10 @@
 // ev_mem and pulses start; the harness streams them into evclust_core at full speed, with random
 // input gaps and random output back-pressure from a xorshift generator, and captures every
 // record (tagged with the number of events traced before it) and every trace word. Python thus
-// touches each event twice, not each clock cycle, which keeps co-simulation fast.
+// touches each event twice, not each clock cycle, which keeps co-simulation fast. The register
+// file's AXI4-Lite port is the harness's own (cocotbext-axi drives it); it holds the build's
+// parameter set from reset.
+`default_nettype none
 module evclust_tb #(
     parameter integer DEPTH = 4096,      // events per batch
     parameter integer REC_DEPTH = 16384  // records per batch
@@ -21,19 +24,38 @@ module evclust_tb #(
     output reg         overflow,
     output reg  [31:0] cycles,
     output reg  [31:0] filter_cycles,
-    output reg  [31:0] filter_steps
+    output reg  [31:0] filter_steps,
+    output wire        idle,
+    output wire        irq,
+    // AXI4-Lite: the register file
+    input  wire [11:0] s_axil_awaddr,
+    input  wire [2:0]  s_axil_awprot,
+    input  wire        s_axil_awvalid,
+    output wire        s_axil_awready,
+    input  wire [31:0] s_axil_wdata,
+    input  wire [3:0]  s_axil_wstrb,
+    input  wire        s_axil_wvalid,
+    output wire        s_axil_wready,
+    output wire [1:0]  s_axil_bresp,
+    output wire        s_axil_bvalid,
+    input  wire        s_axil_bready,
+    input  wire [11:0] s_axil_araddr,
+    input  wire [2:0]  s_axil_arprot,
+    input  wire        s_axil_arvalid,
+    output wire        s_axil_arready,
+    output wire [31:0] s_axil_rdata,
+    output wire [1:0]  s_axil_rresp,
+    output wire        s_axil_rvalid,
+    input  wire        s_axil_rready
 );
 `include "evclust_params.vh"
 
-    localparam integer SLOT_W = N_CLUSTERS > 1 ? $clog2(N_CLUSTERS) : 1;
-    localparam integer EV_W = 32 + 2 * EV_XY_W + 1 + 24;
-    localparam integer REC_W = 32 + 32 + SLOT_W + 32 + 2 * CENTRE_W + 2 * HALF_SIZE_W + ACTIVITY_W
-                             + 2 * V_MCM_W + 2 * V_INT_W + 3 * COLOUR_W + 8 + 4;
+    localparam integer EV_W = IN_WORD_W, REC_W = REC_WORD_W;  // the layouts of vectors/pack.py
 
     reg [EV_W-1:0]  ev_mem    [0:DEPTH-1];
     reg [REC_W-1:0] rec_mem   [0:REC_DEPTH-1];
     reg [31:0]      rec_tag   [0:REC_DEPTH-1];  // events traced when the record left
-    reg [10:0]      trace_mem [0:DEPTH-1];
+    reg [TRACE_WORD_W-1:0] trace_mem [0:DEPTH-1];
 
     reg              running;
     reg [31:0]       random;
@@ -43,7 +65,10 @@ module evclust_tb #(
     wire             rec_valid;
     wire [REC_W-1:0] rec_data;
     wire             trace_valid;
-    wire [10:0]      trace_data;
+    wire [TRACE_WORD_W-1:0] trace_data;
+    wire [32*CFG_WORDS-1:0] cfg;
+    wire             clear;
+    wire [N_COUNTERS*COUNTER_INC_W-1:0] count_inc;
     wire             filter_active;
     reg              filter_was_active;
     wire             rec_ready = running && random[15:8] >= stall_threshold;
@@ -52,9 +77,21 @@ module evclust_tb #(
     wire [31:0]      xs2 = xs1 ^ (xs1 >> 17);
     wire [31:0]      next_random = xs2 ^ (xs2 << 5);
 
+    evclust_regs regs (
+        .clk(clk), .rst(rst),
+        .s_axil_awaddr(s_axil_awaddr), .s_axil_awprot(s_axil_awprot), .s_axil_awvalid(s_axil_awvalid), .s_axil_awready(s_axil_awready),
+        .s_axil_wdata(s_axil_wdata), .s_axil_wstrb(s_axil_wstrb), .s_axil_wvalid(s_axil_wvalid), .s_axil_wready(s_axil_wready),
+        .s_axil_bresp(s_axil_bresp), .s_axil_bvalid(s_axil_bvalid), .s_axil_bready(s_axil_bready),
+        .s_axil_araddr(s_axil_araddr), .s_axil_arprot(s_axil_arprot), .s_axil_arvalid(s_axil_arvalid), .s_axil_arready(s_axil_arready),
+        .s_axil_rdata(s_axil_rdata), .s_axil_rresp(s_axil_rresp), .s_axil_rvalid(s_axil_rvalid), .s_axil_rready(s_axil_rready),
+        .cfg(cfg), .clear(clear), .idle(idle), .count_inc(count_inc), .irq(irq)
+    );
+
     evclust_core core (
         .clk(clk),
         .rst(rst),
+        .clear(clear),
+        .cfg(cfg),
         .ev_valid(ev_valid),
         .ev_ready(ev_ready),
         .ev_data(ev_data),
@@ -63,7 +100,9 @@ module evclust_tb #(
         .rec_data(rec_data),
         .trace_valid(trace_valid),
         .trace_data(trace_data),
-        .filter_active(filter_active)
+        .filter_active(filter_active),
+        .idle(idle),
+        .count_inc(count_inc)
     );
 
     // The next event to offer, once the current one (if any) has been taken.
@@ -121,3 +160,4 @@ module evclust_tb #(
         end
     end
 endmodule
+`default_nettype wire
