@@ -103,6 +103,39 @@ class Harness:
         return trace, records, tags
 
 
+class Registers:
+    """The register file through cocotbext-axi's AXI4-Lite master (docs/REGISTERS.md)."""
+
+    def __init__(self, dut):
+        from cocotbext.axi import AxiLiteBus, AxiLiteMaster
+
+        self.dut = dut
+        self.bus = AxiLiteMaster(AxiLiteBus.from_prefix(dut, "s_axil"), dut.clk, dut.rst)
+
+    async def program(self, writes) -> None:
+        for address, word in writes:
+            await self.bus.write_dword(address, word)
+
+    async def counters(self) -> dict[str, int]:
+        from evclust.fixed.registers import COUNTERS, counter_address
+
+        return {name: await self.bus.read_dword(counter_address(name)) for name in COUNTERS}
+
+    async def clear(self) -> None:
+        """CTRL.CLEAR and CLEAR_COUNTERS, once the core is idle; then INIT runs."""
+        from evclust.fixed.registers import CTRL_CLEAR, CTRL_CLEAR_COUNTERS, REG_CTRL
+
+        while not int(self.dut.idle.value):
+            await RisingEdge(self.dut.clk)
+        await self.bus.write_dword(REG_CTRL, CTRL_CLEAR | CTRL_CLEAR_COUNTERS)
+        await ClockCycles(self.dut.clk, 2)
+
+
+def _counter_mismatch(expected: dict, got: dict) -> str | None:
+    wrong = {name: (expected[name], got[name]) for name in expected if expected[name] != got[name]}
+    return f"status counters (model, RTL): {wrong}" if wrong else None
+
+
 def _seed(*parts) -> int:
     return int.from_bytes(hashlib.sha256(repr(parts).encode()).digest()[:4], "little") or 1
 
@@ -115,6 +148,7 @@ def _compare(name, events, expected_trace, trace, expected, records, tags, table
 
 
 if cocotb is not None:
+    from evclust.fixed.registers import model_counters
 
     @cocotb.test()
     async def replay_vectors(dut):
@@ -174,6 +208,7 @@ if cocotb is not None:
         if verilog_header(model.table) != Path(config["header"]).read_text():
             return "the RTL was built with another header than these parameters make", {}
         harness = Harness(dut, params.n_clusters, params.filter_every)
+        registers = Registers(dut)
         await harness.reset()
         if config.get("reset_at"):
             # Part of the stream, with the same gaps and stalls, cut off by a reset while it flows.
@@ -194,7 +229,59 @@ if cocotb is not None:
         trace, records, tags = await harness.stream(event_list, config["seed"], config["gap"], config["stall"], params.n_clusters)
         name = Path(config["events"]).stem if config.get("events") else f"random stream {config['seed']}"
         error = _compare(name, event_list, expected_trace, trace, expected, records, tags, model.table)
-        return error, harness.stats | {"records": len(records)}
+        counters = await registers.counters()
+        if not error:
+            error = _counter_mismatch(model_counters(model.stats(), len(expected)), counters)
+        return error, harness.stats | {"records": len(records), "counters": counters}
+
+    @cocotb.test()
+    async def reconfigure(dut):
+        """Two streams with two parameter sets: the build's from reset, then another written over
+        AXI4-Lite and a CTRL.CLEAR (no reset); records, trace and counters bit-exact to the model."""
+        config = _config()
+        try:
+            error, stats = await _reconfigure(dut, config)
+        except Exception as exc:
+            error, stats = f"{type(exc).__name__}: {exc}", {}
+        _finish(config, stats | {"error": error})
+
+    async def _reconfigure(dut, config):
+        from evclust.clusterer import ClustererParams
+        from evclust.fixed.model import FixedClusterer
+        from evclust.fixed.registers import ID_VALUE, REG_BUILD, REG_ID, register_writes
+        from evclust.vectors.stimulus import random_stream
+        from evclust.vectors.write import model_words
+
+        cocotb.start_soon(Clock(dut.clk, CLOCK_NS, unit="ns").start())
+        width, height, t_frame = config["width"], config["height"], config["t_frame_us"]
+        built = ClustererParams(**config["parameters"])
+        build = FixedClusterer(built, width, height, t_frame).table
+        registers = Registers(dut)
+        harness = Harness(dut, built.n_clusters, built.filter_every)
+        await harness.reset()
+        if await registers.bus.read_dword(REG_ID) != ID_VALUE:
+            return "the ID register does not read EVCL", {}
+        if await registers.bus.read_dword(REG_BUILD) != build.n_clusters | build.palette_size << 16:
+            return "the BUILD register does not give N and the palette size", {}
+        out = {}
+        for step, (params, seed) in enumerate(((built, config["seed"]), (ClustererParams(**config["second"]), config["seed"] + 1))):
+            if step:
+                model = FixedClusterer(params, width, height, t_frame, build=build)
+                await registers.program(register_writes(build, model.table))
+                await registers.clear()
+            else:
+                model = FixedClusterer(params, width, height, t_frame)
+            harness = Harness(dut, params.n_clusters, params.filter_every)  # its batch follows the filter period
+            events = random_stream(seed, config["count"], width, height, t_frame)
+            event_list, expected, expected_trace = model_words(model, events)
+            trace, records, tags = await harness.stream(event_list, seed, config["gap"], config["stall"], params.n_clusters)
+            error = _compare(f"stream {step + 1}", event_list, expected_trace, trace, expected, records, tags, model.table)
+            counters = await registers.counters()
+            error = error or _counter_mismatch(model_counters(model.stats(), len(expected)), counters)
+            if error:
+                return f"stream {step + 1}: {error}", out
+            out[f"stream {step + 1}"] = {"records": len(records), "counters": counters}
+        return None, out
 
 
 # ------------------------------------------------------------------------------------------
@@ -238,6 +325,44 @@ def test_random_streams_match_the_model_in_the_loop(sim, preset, n_clusters):
     result = run(sim, header, "model_in_the_loop", config)
     assert result["events"] == 10_000
     assert result["records"] > 0, "a stream that reports nothing checks little"
+
+
+def _second_parameter_set(params):
+    """Another parameter set for the same build: every run-time switch flipped and most constants
+    moved (build-time ones kept: N, palette size, merging, creation support, warm-up length)."""
+    return params.model_copy(update=dict(
+        alpha_pos=0.99, alpha_size=0.995, alpha_lum=0.99, alpha_chro=0.98, alpha_bg=0.998, alpha_vel_mcm=0.9999,
+        gamma_mode="activity", velocity_warm_start=not params.velocity_warm_start, mcm_bias_correction=not params.mcm_bias_correction,
+        palette_assign="nearest", palette_vote="count", tau_us=15000.0, filter_every=5, a_valid=4.0, a_min=0.8,
+        seek_margin=3.0, r_init=3.0, size_gain=1.3, background=(90, 120, 140), luma_weight=1.5, p_correction=0.6,
+        palette=tuple(entry.model_copy(update={"rgb": tuple(reversed(entry.rgb))}) for entry in params.palette),
+    ))  # fmt: skip
+
+
+@pytest.mark.parametrize("sim", SIMS)
+def test_parameters_written_over_axi_lite_between_two_streams_are_bit_exact(sim):
+    from evclust.clusterer import ClustererParams
+
+    header, config = _random_config("small", 4, seed=77, count=6000)
+    second = _second_parameter_set(ClustererParams(**config["parameters"]))
+    result = run(sim, header, "reconfigure", config | {"second": second.model_dump(mode="json", exclude_none=True)})
+    first, then = result["stream 1"], result["stream 2"]
+    assert first["records"] > 0 and then["records"] > 0, "streams that report nothing check little"
+    assert first["counters"]["events"] == then["counters"]["events"] == 6000  # CLEAR_COUNTERS between them
+
+
+def test_a_second_parameter_set_needing_another_build_is_refused():
+    from evclust.clusterer import ClustererParams
+    from evclust.errors import EvclustError
+    from evclust.fixed.model import FixedClusterer
+
+    header, config = _random_config("small", 4, seed=77, count=10)
+    built = ClustererParams(**config["parameters"])
+    build = FixedClusterer(built, 64, 48, 10000.0).table
+    for change, message in (({"n_clusters": 8}, "build-time"), ({"r_max": 1000.0}, "saturates"),
+                            ({"merge": not built.merge}, "build-time")):  # fmt: skip
+        with pytest.raises(EvclustError, match=message):
+            FixedClusterer(built.model_copy(update=change), 64, 48, 10000.0, build=build)
 
 
 @pytest.mark.parametrize("variant", list(FORMAT_VARIANTS))
