@@ -235,6 +235,32 @@ if cocotb is not None:
         return error, harness.stats | {"records": len(records), "counters": counters}
 
     @cocotb.test()
+    async def serve(dut):
+        """The RTL as a clusterer model (evclust.rtl.session): batches of event words in over a
+        named pipe, record words back, the status counters at the end. No model here: the
+        caller's own tests compare it with the fixed model."""
+        import numpy as np
+
+        config = _config()
+        cocotb.start_soon(Clock(dut.clk, CLOCK_NS, unit="ns").start())
+        registers = Registers(dut)
+        harness = Harness(dut, config["n_clusters"], config["filter_every"])
+        await harness.reset()
+        with open(config["requests"]) as requests, open(config["answers"], "w") as answers:
+            for line in requests:
+                if not line.strip():
+                    answers.write(json.dumps(await registers.counters()) + "\n")
+                    answers.flush()
+                    break
+                words = [int(w) for w in np.load(line.strip()).tolist()]
+                _, records, _ = await harness.stream(words, 1, 0, 0, config["n_clusters"])
+                out = line.strip()[: -len(".npy")] + "-records.npy"
+                np.save(out, np.array([str(r) for r in records]))
+                answers.write(out + "\n")
+                answers.flush()
+        _finish(config, {"error": None})
+
+    @cocotb.test()
     async def reconfigure(dut):
         """Two streams with two parameter sets: the build's from reset, then another written over
         AXI4-Lite and a CTRL.CLEAR (no reset); records, trace and counters bit-exact to the model."""

@@ -79,7 +79,13 @@ def _fixed_clusterer(*args, **kwargs):
     return FixedClusterer(*args, **kwargs)
 
 
-MODELS = dict(zip(TRACK_MODELS, (FloatClusterer, _fixed_clusterer)))  # names: evclust.choices, for the CLI
+def _rtl_clusterer(*args, **kwargs):
+    from evclust.rtl.session import RtlClusterer  # Verilator and cocotb: only when asked for
+
+    return RtlClusterer(*args, **kwargs)
+
+
+MODELS = dict(zip(TRACK_MODELS, (FloatClusterer, _fixed_clusterer, _rtl_clusterer)))  # names: evclust.choices, for the CLI
 
 
 def records_to_tracks(rows: np.ndarray) -> np.ndarray:
@@ -142,8 +148,9 @@ def track_stream(
     kept, n_records = [], 0
     with tqdm(total=total, unit="ev", unit_scale=True, disable=None if progress else True, desc=f"track ({model})") as bar:
         for chunk in chunks:
-            for lo in range(0, chunk.size, CHUNK):
-                piece = chunk[lo : lo + CHUNK]
+            step = getattr(clusterer, "feed_size", CHUNK)  # the RTL takes smaller bites, for the progress bar
+            for lo in range(0, chunk.size, step):
+                piece = chunk[lo : lo + step]
                 tracks = records_to_tracks(clusterer.feed(piece))
                 n_records += tracks.size
                 if sink is None:
