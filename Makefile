@@ -68,7 +68,7 @@ bench: $(STAMP)
 
 # The RTL parameter header, generated from the formats table (tests fail when it is stale).
 params: $(STAMP)
-	$(VENV)/bin/evclust formats --verilog rtl/evclust_params.vh > /dev/null
+	$(VENV)/bin/evclust formats --verilog rtl/evclust_params.vh --c-header rtl/evclust_regs.h --registers docs/REGISTERS.md > /dev/null
 
 # Golden vectors for the RTL, from the fixed model (tests fail when they are stale).
 vectors: $(STAMP)

@@ -1,4 +1,4 @@
-"""evclust formats [--params P.toml] [--width W --height H] [--verilog rtl/evclust_params.vh]"""
+"""evclust formats [--params P.toml] [--width W --height H] [--verilog rtl/evclust_params.vh] [--c-header H] [--registers MD]"""
 
 from __future__ import annotations
 
@@ -23,6 +23,10 @@ def add_parser(sub) -> None:
     p.add_argument("--height", type=int, default=REFERENCE[2], help="sensor height, px")
     p.add_argument("--t-frame-us", type=float, default=None, help="frame period, µs (default: the parameters', else 50000)")
     p.add_argument("--verilog", metavar="VH", help="write the Verilog parameter header here")
+    p.add_argument("--c-header", metavar="H", help="write the register map as a C header here (a driver's)")
+    p.add_argument("--registers", metavar="MD", help="write the register map as a Markdown document here")
+    p.add_argument("--write-for", metavar="P", help="with --registers/--c-header: the register values that program parameter set P "
+                   "(.toml or preset) into this build, printed as address/value lines")
     p.set_defaults(run=run)
 
 
@@ -45,8 +49,16 @@ def run(args) -> int:
     table = build_formats(params, args.width, args.height, t_frame)
     print(f"formats for {origin} on {args.width}x{args.height}, T_frame {t_frame:g} µs")
     print(render_table(table))
-    if args.verilog:
-        with atomic_output(args.verilog) as tmp:
-            tmp.write_text(verilog_header(table))
-        print(f"{args.verilog}: written")
+    from evclust.fixed import registers
+
+    for path, text in ((args.verilog, verilog_header), (args.c_header, registers.c_header), (args.registers, registers.markdown)):
+        if path:
+            with atomic_output(path) as tmp:
+                tmp.write_text(text(table))
+            print(f"{path}: written")
+    if args.write_for:
+        other, _ = load_params(args.write_for)
+        runtime = registers.runtime_table(table, other, other.t_frame_us or t_frame)
+        for address, word in registers.register_writes(table, runtime):
+            print(f"0x{address:03x} 0x{word:08x}")
     return 0
