@@ -568,7 +568,9 @@ module evclust_core #(
     // fits V's format (saturating gives the same word), so it saturates only from
     // -(2^Q_W + 1), that is a magnitude |a| + b - 1 of at least (2^Q_W + 1) b.
     wire [QUOTIENT_W-1:0] p_b = {{(QUOTIENT_W - W20_W){1'b0}}, p_w20};
+    /* verilator lint_off UNUSEDSIGNAL */  // only the bits above the quotient's are compared
     wire [QUOTIENT_W-1:0] p_less_x = p_mag_x - p_b, p_less_y = p_mag_y - p_b;
+    /* verilator lint_on UNUSEDSIGNAL */
     wire              p_over_x = p_vmx[V_MCM_W-1] ? p_mag_x >= p_b && p_less_x[QUOTIENT_W-1:Q_W] >= p_b[QUOTIENT_W-Q_W-1:0] : p_sat_x;
     wire              p_over_y = p_vmy[V_MCM_W-1] ? p_mag_y >= p_b && p_less_y[QUOTIENT_W-1:Q_W] >= p_b[QUOTIENT_W-Q_W-1:0] : p_sat_y;
     localparam integer TAG_W = 1 + SLOT_W + 7;
