@@ -19,6 +19,7 @@
 // N, every width and every constant come from evclust_params.vh, generated from the model's
 // formats table (`evclust formats --verilog`).
 `default_nettype none
+`include "evclust_require.vh"
 module evclust_core #(
 `define EVCLUST_PORT_PARAMETERS
 `include "evclust_params.vh"
@@ -47,10 +48,7 @@ module evclust_core #(
     generate
         if (N != N_CLUSTERS || EV_W != IN_WORD_W || REC_W != REC_WORD_W || TRACE_W != TRACE_WORD_W || CFG_W != 32 * CFG_WORDS
             || COUNT_W != N_COUNTERS * COUNTER_INC_W) begin : parameters_differ_from_evclust_params_vh
-`ifdef VERILATOR
-            $fatal(1, "evclust_core: N, EV_W, REC_W, TRACE_W, CFG_W or COUNT_W differs from evclust_params.vh");
-`endif
-            initial $fatal(1, "evclust_core: N, EV_W, REC_W, TRACE_W, CFG_W or COUNT_W differs from evclust_params.vh");
+            `EVCLUST_FAIL("evclust_core: N, EV_W, REC_W, TRACE_W, CFG_W or COUNT_W differs from evclust_params.vh")
         end
     endgenerate
 
@@ -424,7 +422,8 @@ module evclust_core #(
         .decayed(bg_dec_a),
         .residual_out(bg_dec_residual)
     );
-    wire signed [63:0] bg_counted = saturate(u64({{(63 - ACTIVITY_W){1'b0}}, bg_dec_a}) + ONE_A, 0, MAX_ACT);
+    wire signed [63:0] bg_counted_full = u64({{(63 - ACTIVITY_W){1'b0}}, bg_dec_a}) + ONE_A;
+    wire signed [63:0] bg_counted = saturate(bg_counted_full, 0, MAX_ACT);
 
     // ---------------------------------------------------------------- creation support
     // Some event of the 3x3 cells around the event's cell at most SUPPORT_WINDOW us old (mod 2^32).
@@ -468,6 +467,8 @@ module evclust_core #(
     reg signed [63:0] u_ox, u_oy;
     reg signed [63:0] ex, ey, u_px, u_py, u_px_new, u_py_new, u_gx, u_gy, u_rx, u_ry, u_step_x, u_step_y;
     reg signed [63:0] u_ux, u_uy, u_vmx, u_vmy, u_norm, u_act, u_cy, u_ccb, u_ccr, u_evc, u_gamma;
+    // *_full: a value before its format's saturation (the status counters compare it too).
+    reg signed [63:0] u_act_full, u_gx_full, u_gy_full, u_step_x_full, u_step_y_full, u_ux_full, u_uy_full, u_evc_full;
     reg signed [63:0] u_hist [0:P-1];
     reg               u_halve;
     integer c;  // the update's loop; the sweep has its own (one variable per always block)
@@ -475,7 +476,8 @@ module evclust_core #(
         ex = u64({{(63 - EV_XY_W){1'b0}}, e_x});
         ey = u64({{(63 - EV_XY_W){1'b0}}, e_y});
         // 3a. Activity: decay to t, then count the event.
-        u_act = saturate(a_decayed + ONE_A, 0, MAX_ACT);
+        u_act_full = a_decayed + ONE_A;
+        u_act = saturate(u_act_full, 0, MAX_ACT);
         // 3b. Centre.
         u_px = u64({{(63 - CENTRE_W){1'b0}}, px[e_slot]});
         u_py = u64({{(63 - CENTRE_W){1'b0}}, py[e_slot]});
@@ -484,17 +486,23 @@ module evclust_core #(
         // 3c. Size.
         u_ox = abs64((ex <<< FP) - u_px);  // |e - P|: the offset format's magnitude
         u_oy = abs64((ey <<< FP) - u_py);
-        u_gx = saturate((u64({{(64 - OFFSET_W){1'b0}}, u_ox[OFFSET_W-2:0]}) * K_GAIN) >>> (SIZE_GAIN_FRAC + FP - FR), 0, MAX_SIZE_TARGET);
-        u_gy = saturate((u64({{(64 - OFFSET_W){1'b0}}, u_oy[OFFSET_W-2:0]}) * K_GAIN) >>> (SIZE_GAIN_FRAC + FP - FR), 0, MAX_SIZE_TARGET);
+        u_gx_full = (u64({{(64 - OFFSET_W){1'b0}}, u_ox[OFFSET_W-2:0]}) * K_GAIN) >>> (SIZE_GAIN_FRAC + FP - FR);
+        u_gy_full = (u64({{(64 - OFFSET_W){1'b0}}, u_oy[OFFSET_W-2:0]}) * K_GAIN) >>> (SIZE_GAIN_FRAC + FP - FR);
+        u_gx = saturate(u_gx_full, 0, MAX_SIZE_TARGET);
+        u_gy = saturate(u_gy_full, 0, MAX_SIZE_TARGET);
         u_rx = saturate(alpha_step(u64({{(63 - HALF_SIZE_W){1'b0}}, rx[e_slot]}), u_gx, K_B_SIZE, BETA_SIZE_FRAC, 0, 1'b0), K_R_MIN, K_R_MAX);
         u_ry = saturate(alpha_step(u64({{(63 - HALF_SIZE_W){1'b0}}, ry[e_slot]}), u_gy, K_B_SIZE, BETA_SIZE_FRAC, 0, 1'b0), K_R_MIN, K_R_MAX);
         // 3d. MCM velocity and its bias-correction weight.
         u_gamma = u64({{(63 - GAMMA_W){1'b0}}, gamma[e_slot]});
-        u_step_x = saturate(u_px_new - u_px, MIN_STEP, MAX_STEP);
-        u_step_y = saturate(u_py_new - u_py, MIN_STEP, MAX_STEP);
+        u_step_x_full = u_px_new - u_px;
+        u_step_y_full = u_py_new - u_py;
+        u_step_x = saturate(u_step_x_full, MIN_STEP, MAX_STEP);
+        u_step_y = saturate(u_step_y_full, MIN_STEP, MAX_STEP);
         // gamma * (P_new - P): the step saturated to centre_step's format, so 22 x 22 bits.
-        u_ux = saturate(align(u_gamma * $signed({{(64 - CENTRE_STEP_W){u_step_x[CENTRE_STEP_W-1]}}, u_step_x[CENTRE_STEP_W-1:0]}), FG + FP, FV), MIN_V, MAX_V);
-        u_uy = saturate(align(u_gamma * $signed({{(64 - CENTRE_STEP_W){u_step_y[CENTRE_STEP_W-1]}}, u_step_y[CENTRE_STEP_W-1:0]}), FG + FP, FV), MIN_V, MAX_V);
+        u_ux_full = align(u_gamma * $signed({{(64 - CENTRE_STEP_W){u_step_x[CENTRE_STEP_W-1]}}, u_step_x[CENTRE_STEP_W-1:0]}), FG + FP, FV);
+        u_uy_full = align(u_gamma * $signed({{(64 - CENTRE_STEP_W){u_step_y[CENTRE_STEP_W-1]}}, u_step_y[CENTRE_STEP_W-1:0]}), FG + FP, FV);
+        u_ux = saturate(u_ux_full, MIN_V, MAX_V);
+        u_uy = saturate(u_uy_full, MIN_V, MAX_V);
         u_vmx = alpha_step($signed({{(64 - V_MCM_W){vmx[e_slot][V_MCM_W-1]}}, vmx[e_slot]}), u_ux, K_B_VM, BETA_VEL_MCM_FRAC, 0, 1'b1);
         u_vmy = alpha_step($signed({{(64 - V_MCM_W){vmy[e_slot][V_MCM_W-1]}}, vmy[e_slot]}), u_uy, K_B_VM, BETA_VEL_MCM_FRAC, 0, 1'b1);
         u_norm = alpha_step(u64({{(63 - MCM_NORM_W){1'b0}}, norm[e_slot]}), 64'sd1, K_B_VM, BETA_VEL_MCM_FRAC, FW, 1'b1);
@@ -510,7 +518,8 @@ module evclust_core #(
         for (c = 0; c < P; c = c + 1)
             if (u_halve)
                 u_hist[c] = u_hist[c] >>> 1;
-        u_evc = saturate(u64({{(63 - EVENTS_IN_INTERVAL_W){1'b0}}, ev_count[e_slot]}) + 1, 0, MAX_EVCOUNT);
+        u_evc_full = u64({{(63 - EVENTS_IN_INTERVAL_W){1'b0}}, ev_count[e_slot]}) + 1;
+        u_evc = saturate(u_evc_full, 0, MAX_EVCOUNT);
     end
 
     // ---------------------------------------------------------------- the filter sweep
@@ -520,6 +529,8 @@ module evclust_core #(
     // t's stage 0 (later slots' merges touch only later slots), so the tail reads the table.
     wire [SLOT_W-1:0] k = index[SLOT_W-1:0];
     reg signed [63:0] f_gamma, f_mx, f_my, f_vix, f_viy, f_per_frame, f_evc;
+    reg signed [63:0] f_gamma_activity, f_gamma_count, f_mx_full, f_my_full;  // before saturation
+    reg               f_gamma_by_activity, f_gamma_by_count;  // which γ the slot takes, if any
     reg [INTERVAL_UPDATES_W-1:0] f_vi_count;
     reg               f_expire;
     always @* begin
@@ -527,16 +538,22 @@ module evclust_core #(
         f_expire = a_decayed < K_A_MIN;
         f_vi_count = vi_count[k];
         f_gamma = u64({{(63 - GAMMA_W){1'b0}}, gamma[k]});
-        if (gamma_mode != GAMMA_MODE_COUNT[1:0] || vi_count[k] == VI_NONE)
-            f_gamma = saturate(gamma_from_activity(a_decayed, gamma_mode, K_GAMMA_GLOBAL, K_GPA), 0, MAX_GAMMA);
         f_evc = u64({{(63 - EVENTS_IN_INTERVAL_W){1'b0}}, ev_count[k]});
+        f_gamma_activity = gamma_from_activity(a_decayed, gamma_mode, K_GAMMA_GLOBAL, K_GPA);
+        f_gamma_count = (f_evc * f_per_frame) >>> (FPT_F - FG);
+        f_gamma_by_activity = gamma_mode != GAMMA_MODE_COUNT[1:0] || vi_count[k] == VI_NONE;
+        f_gamma_by_count = boundaries != 33'd0 && !f_gamma_by_activity;
+        if (f_gamma_by_activity)
+            f_gamma = saturate(f_gamma_activity, 0, MAX_GAMMA);
         f_vix = $signed({{(64 - V_INT_W){vix[k][V_INT_W-1]}}, vix[k]});
         f_viy = $signed({{(64 - V_INT_W){viy[k][V_INT_W-1]}}, viy[k]});
-        f_mx = saturate(align((u64({{(63 - CENTRE_W){1'b0}}, px[k]}) - u64({{(63 - CENTRE_W){1'b0}}, ppx[k]})) * f_per_frame, FP + FPT_F, FI), MIN_VI, MAX_VI);
-        f_my = saturate(align((u64({{(63 - CENTRE_W){1'b0}}, py[k]}) - u64({{(63 - CENTRE_W){1'b0}}, ppy[k]})) * f_per_frame, FP + FPT_F, FI), MIN_VI, MAX_VI);
+        f_mx_full = align((u64({{(63 - CENTRE_W){1'b0}}, px[k]}) - u64({{(63 - CENTRE_W){1'b0}}, ppx[k]})) * f_per_frame, FP + FPT_F, FI);
+        f_my_full = align((u64({{(63 - CENTRE_W){1'b0}}, py[k]}) - u64({{(63 - CENTRE_W){1'b0}}, ppy[k]})) * f_per_frame, FP + FPT_F, FI);
+        f_mx = saturate(f_mx_full, MIN_VI, MAX_VI);
+        f_my = saturate(f_my_full, MIN_VI, MAX_VI);
         if (boundaries != 33'd0) begin
-            if (gamma_mode == GAMMA_MODE_COUNT[1:0] && vi_count[k] != VI_NONE)
-                f_gamma = saturate((f_evc * f_per_frame) >>> (FPT_F - FG), 0, MAX_GAMMA);
+            if (f_gamma_by_count)
+                f_gamma = saturate(f_gamma_count, 0, MAX_GAMMA);
             f_evc = 0;
             if (!warm_start || vi_count[k] >= VI_WARM_END) begin
                 f_vix = alpha_step(f_vix, f_mx, K_B_VI, BETA_VEL_INT_FRAC, 0, 1'b0);
@@ -615,7 +632,7 @@ module evclust_core #(
     endfunction
     integer cls;
     reg signed [63:0] f_vmx, f_vmy, f_vmx_raw, f_vmy_raw, f_px, f_py, f_act, f_vix_t, f_viy_t;
-    reg signed [63:0] f_speed_sq, f_limit;
+    reg signed [63:0] f_speed_sq, f_speed_full, f_limit;
     reg [2*SQ_MAG_W-1:0] f_sq_x, f_sq_y;
     reg               f_exit, f_left, f_right, f_top, f_bottom, f_moving_mcm, f_moving_int, f_report;
     reg signed [63:0] f_box, f_noise_signal, f_noise_floor;
@@ -635,7 +652,8 @@ module evclust_core #(
         // Exit prediction on the squared speed.
         f_sq_x = square(f_vmx, FV);
         f_sq_y = square(f_vmy, FV);
-        f_speed_sq = saturate(speed_sq({1'b0, f_sq_x} + {1'b0, f_sq_y}, FV), 0, MAX_SPEED_SQ);
+        f_speed_full = speed_sq({1'b0, f_sq_x} + {1'b0, f_sq_y}, FV);
+        f_speed_sq = saturate(f_speed_full, 0, MAX_SPEED_SQ);
         f_left = f_px < K_EXIT_M;
         f_right = f_px > HI_X;
         f_top = f_py < K_EXIT_M;
@@ -782,8 +800,8 @@ module evclust_core #(
     wire signed [63:0]    m_ppx = saturate(c64(ppx[m_surv]) + m_px - c64(px[m_surv]), 0, LAST_X);  // inside the sensor
     wire signed [63:0]    m_ppy = saturate(c64(ppy[m_surv]) + m_py - c64(py[m_surv]), 0, LAST_Y);
     wire signed [63:0]    m_act = saturate(m_weight, 0, MAX_ACT);
-    wire signed [63:0]    m_evc = saturate(u64({{(63 - EVENTS_IN_INTERVAL_W){1'b0}}, ev_count[k]})
-                                           + u64({{(63 - EVENTS_IN_INTERVAL_W){1'b0}}, ev_count[m_j]}), 0, MAX_EVCOUNT);
+    wire signed [63:0]    m_evc_full = u64({{(63 - EVENTS_IN_INTERVAL_W){1'b0}}, ev_count[k]}) + u64({{(63 - EVENTS_IN_INTERVAL_W){1'b0}}, ev_count[m_j]});
+    wire signed [63:0]    m_evc = saturate(m_evc_full, 0, MAX_EVCOUNT);
 
     // tau boundaries since the last filter step, from the phase counter (33 bits: a 32-bit time
     // difference plus the phase); T_frame/(n tau), nothing once n reaches 2^FRAME_PER_TAU_W.
@@ -907,18 +925,7 @@ module evclust_core #(
             outside = (v < lo || v > hi) ? 2'd1 : 2'd0;
         end
     endfunction
-    wire signed [63:0] u_gx_raw = (u64({{(64 - OFFSET_W){1'b0}}, u_ox[OFFSET_W-2:0]}) * K_GAIN) >>> (SIZE_GAIN_FRAC + FP - FR);
-    wire signed [63:0] u_gy_raw = (u64({{(64 - OFFSET_W){1'b0}}, u_oy[OFFSET_W-2:0]}) * K_GAIN) >>> (SIZE_GAIN_FRAC + FP - FR);
-    wire signed [63:0] u_ux_raw = align(u_gamma * $signed({{(64 - CENTRE_STEP_W){u_step_x[CENTRE_STEP_W-1]}}, u_step_x[CENTRE_STEP_W-1:0]}), FG + FP, FV);
-    wire signed [63:0] u_uy_raw = align(u_gamma * $signed({{(64 - CENTRE_STEP_W){u_step_y[CENTRE_STEP_W-1]}}, u_step_y[CENTRE_STEP_W-1:0]}), FG + FP, FV);
-    wire signed [63:0] f_evc_in = u64({{(63 - EVENTS_IN_INTERVAL_W){1'b0}}, ev_count[k]});
-    wire signed [63:0] f_gamma_count = (f_evc_in * f_per_frame) >>> (FPT_F - FG);
-    wire signed [63:0] f_mx_raw = align((c64(px[k]) - c64(ppx[k])) * f_per_frame, FP + FPT_F, FI);
-    wire signed [63:0] f_my_raw = align((c64(py[k]) - c64(ppy[k])) * f_per_frame, FP + FPT_F, FI);
-    wire signed [63:0] f_speed_raw = speed_sq({1'b0, f_sq_x} + {1'b0, f_sq_y}, FV);
     wire               stage0 = sweep_slot && !f_expire;
-    wire               counted_gamma_activity = gamma_mode != GAMMA_MODE_COUNT[1:0] || vi_count[k] == VI_NONE;
-    wire               counted_gamma_count = boundaries != 33'd0 && gamma_mode == GAMMA_MODE_COUNT[1:0] && vi_count[k] != VI_NONE;
     wire               tail_out = tail_en && t_live;
     wire               bg_counts = finish && !(do_update && reported[e_slot]) && K_NOISE_GATE != 0;
     reg [COUNT_W-1:0]  inc;
@@ -934,19 +941,19 @@ module evclust_core #(
         inc[COUNT_EXITS * COUNTER_INC_W +: 2] = {1'b0, tail_out && f_exit};
         inc[COUNT_MERGES * COUNTER_INC_W +: 2] = {1'b0, m_write};
         inc[COUNT_RECORDS * COUNTER_INC_W +: 2] = {1'b0, tail_out && !f_exit && f_report};
-        inc[COUNT_SAT_ACTIVITY * COUNTER_INC_W +: 2] = (do_update ? outside(a_decayed + ONE_A, 0, MAX_ACT) : 2'd0)
-            + (bg_counts ? outside(u64({{(63 - ACTIVITY_W){1'b0}}, bg_dec_a}) + ONE_A, 0, MAX_ACT) : 2'd0)
+        inc[COUNT_SAT_ACTIVITY * COUNTER_INC_W +: 2] = (do_update ? outside(u_act_full, 0, MAX_ACT) : 2'd0)
+            + (bg_counts ? outside(bg_counted_full, 0, MAX_ACT) : 2'd0)
             + (m_write ? outside(m_weight, 0, MAX_ACT) : 2'd0);
-        inc[COUNT_SAT_SIZE_TARGET * COUNTER_INC_W +: 2] = do_update ? outside(u_gx_raw, 0, MAX_SIZE_TARGET) + outside(u_gy_raw, 0, MAX_SIZE_TARGET) : 2'd0;
-        inc[COUNT_SAT_CENTRE_STEP * COUNTER_INC_W +: 2] = do_update ? outside(u_px_new - u_px, MIN_STEP, MAX_STEP) + outside(u_py_new - u_py, MIN_STEP, MAX_STEP) : 2'd0;
-        inc[COUNT_SAT_MCM_STEP * COUNTER_INC_W +: 2] = do_update ? outside(u_ux_raw, MIN_V, MAX_V) + outside(u_uy_raw, MIN_V, MAX_V) : 2'd0;
-        inc[COUNT_SAT_EVENTS_IN_INTERVAL * COUNTER_INC_W +: 2] = (do_update ? outside(u64({{(63 - EVENTS_IN_INTERVAL_W){1'b0}}, ev_count[e_slot]}) + 1, 0, MAX_EVCOUNT) : 2'd0)
-            + (m_write ? outside(u64({{(63 - EVENTS_IN_INTERVAL_W){1'b0}}, ev_count[k]}) + u64({{(63 - EVENTS_IN_INTERVAL_W){1'b0}}, ev_count[m_j]}), 0, MAX_EVCOUNT) : 2'd0);
-        inc[COUNT_SAT_GAMMA * COUNTER_INC_W +: 2] = (stage0 && counted_gamma_activity ? outside(gamma_from_activity(a_decayed, gamma_mode, K_GAMMA_GLOBAL, K_GPA), 0, MAX_GAMMA) : 2'd0)
-            + (stage0 && counted_gamma_count ? outside(f_gamma_count, 0, MAX_GAMMA) : 2'd0);
-        inc[COUNT_SAT_V_INT * COUNTER_INC_W +: 2] = stage0 && boundaries != 33'd0 ? outside(f_mx_raw, MIN_VI, MAX_VI) + outside(f_my_raw, MIN_VI, MAX_VI) : 2'd0;
+        inc[COUNT_SAT_SIZE_TARGET * COUNTER_INC_W +: 2] = do_update ? outside(u_gx_full, 0, MAX_SIZE_TARGET) + outside(u_gy_full, 0, MAX_SIZE_TARGET) : 2'd0;
+        inc[COUNT_SAT_CENTRE_STEP * COUNTER_INC_W +: 2] = do_update ? outside(u_step_x_full, MIN_STEP, MAX_STEP) + outside(u_step_y_full, MIN_STEP, MAX_STEP) : 2'd0;
+        inc[COUNT_SAT_MCM_STEP * COUNTER_INC_W +: 2] = do_update ? outside(u_ux_full, MIN_V, MAX_V) + outside(u_uy_full, MIN_V, MAX_V) : 2'd0;
+        inc[COUNT_SAT_EVENTS_IN_INTERVAL * COUNTER_INC_W +: 2] = (do_update ? outside(u_evc_full, 0, MAX_EVCOUNT) : 2'd0)
+            + (m_write ? outside(m_evc_full, 0, MAX_EVCOUNT) : 2'd0);
+        inc[COUNT_SAT_GAMMA * COUNTER_INC_W +: 2] = (stage0 && f_gamma_by_activity ? outside(f_gamma_activity, 0, MAX_GAMMA) : 2'd0)
+            + (stage0 && f_gamma_by_count ? outside(f_gamma_count, 0, MAX_GAMMA) : 2'd0);
+        inc[COUNT_SAT_V_INT * COUNTER_INC_W +: 2] = stage0 && boundaries != 33'd0 ? outside(f_mx_full, MIN_VI, MAX_VI) + outside(f_my_full, MIN_VI, MAX_VI) : 2'd0;
         inc[COUNT_SAT_V_MCM * COUNTER_INC_W +: 2] = tail_out && t_correct ? {1'b0, t_over_x} + {1'b0, t_over_y} : 2'd0;
-        inc[COUNT_SAT_SPEED_SQ * COUNTER_INC_W +: 2] = tail_out ? outside(f_speed_raw, 0, MAX_SPEED_SQ) : 2'd0;
+        inc[COUNT_SAT_SPEED_SQ * COUNTER_INC_W +: 2] = tail_out ? outside(f_speed_full, 0, MAX_SPEED_SQ) : 2'd0;
     end
     assign idle = state == ST_IDLE && !a_valid && !rec_valid;
 

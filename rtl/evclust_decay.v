@@ -4,6 +4,7 @@
 // of m = n / 2^DROP shifts, its low 6 bits index the 2^-(i/64) table: one multiplier, one
 // barrel shifter, no exponential. Without the residual (eviction's comparison) it is arith.decay.
 `default_nettype none
+`include "evclust_require.vh"
 module evclust_decay #(
     parameter integer ACTIVITY_BITS = 25,  // the header's ACTIVITY_W (checked below)
     parameter integer DT_BITS = 32,
@@ -22,10 +23,7 @@ module evclust_decay #(
 
     generate
         if (ACTIVITY_BITS != ACTIVITY_W || DT_BITS != DT_W || RESIDUAL_BITS != DECAY_RESIDUAL_W || INV_T_HALF_BITS != INV_T_HALF_W) begin : widths_differ_from_evclust_params_vh
-`ifdef VERILATOR
-            $fatal(1, "evclust_decay: a width differs from evclust_params.vh");
-`endif
-            initial $fatal(1, "evclust_decay: a width differs from evclust_params.vh");
+            `EVCLUST_FAIL("evclust_decay: a width differs from evclust_params.vh")
         end
     endgenerate
 

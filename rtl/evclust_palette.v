@@ -6,6 +6,7 @@
 //    refreshed at filter steps), so there is no divider here;
 //  - the vote: 1, or the event's L1 contrast to the background, rounded half up.
 `default_nettype none
+`include "evclust_require.vh"
 module evclust_palette #(
     parameter integer P = 8,            // entries: the header's PALETTE_SIZE (checked below)
     parameter integer CLASS_W = 3,
@@ -41,10 +42,7 @@ module evclust_palette #(
     generate
         if (P != PALETTE_SIZE || CLASS_W != (P > 1 ? $clog2(P) : 1) || BG_BITS != BACKGROUND_W || INV_BITS != INV_WW_W
             || VOTE_BITS != VOTE_W || LUMA_BITS != LUMA_WEIGHT_W || TOL_BITS != MIXING_TOLERANCE_W || EV_COLOUR_W != 8) begin : widths_differ_from_evclust_params_vh
-`ifdef VERILATOR
-            $fatal(1, "evclust_palette: a width differs from evclust_params.vh");
-`endif
-            initial $fatal(1, "evclust_palette: a width differs from evclust_params.vh");
+            `EVCLUST_FAIL("evclust_palette: a width differs from evclust_params.vh")
         end
     endgenerate
 

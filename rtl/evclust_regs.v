@@ -8,6 +8,7 @@
 // where IRQ_ENABLE allows. One transaction at a time per direction; responses are OKAY, and an
 // address outside the map reads 0 and ignores writes.
 `default_nettype none
+`include "evclust_require.vh"
 module evclust_regs #(
 `define EVCLUST_PORT_PARAMETERS
 `include "evclust_params.vh"
@@ -48,10 +49,7 @@ module evclust_regs #(
 
     generate
         if (N != N_CLUSTERS || CFG_W != 32 * CFG_WORDS || COUNT_W != N_COUNTERS * COUNTER_INC_W || ADDR_W < 12) begin : parameters_differ_from_evclust_params_vh
-`ifdef VERILATOR
-            $fatal(1, "evclust_regs: N, CFG_W or COUNT_W differs from evclust_params.vh, or ADDR_W < 12");
-`endif
-            initial $fatal(1, "evclust_regs: N, CFG_W or COUNT_W differs from evclust_params.vh, or ADDR_W < 12");
+            `EVCLUST_FAIL("evclust_regs: N, CFG_W or COUNT_W differs from evclust_params.vh, or ADDR_W < 12")
         end
     endgenerate
 

@@ -11,7 +11,7 @@ from pathlib import Path
 
 from cosim import RTL, use_simulator
 
-from evclust.rtl.sources import RTL_SOURCES
+from evclust.rtl.sources import RTL_INCLUDES, RTL_SOURCES
 
 
 def lint(header: str | None = None) -> str:
@@ -19,7 +19,7 @@ def lint(header: str | None = None) -> str:
     use_simulator("verilator")
     with tempfile.TemporaryDirectory() as tmp:
         src = Path(tmp)
-        for name in (*RTL_SOURCES, "evclust_arith.vh", "evclust_lint.vlt", "evclust_params.vh"):
+        for name in (*RTL_SOURCES, *RTL_INCLUDES, "evclust_lint.vlt", "evclust_params.vh"):
             shutil.copy(RTL / name, src / name)
         if header is not None:
             (src / "evclust_params.vh").write_text(header)

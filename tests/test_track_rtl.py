@@ -13,8 +13,6 @@ from evclust.events.io import EventReader, event_writer
 from evclust.scenes import load_scene
 from evclust.simulator import simulate_scene
 
-pytest.importorskip("cocotb")
-
 
 @pytest.fixture(scope="module")
 def segment(tmp_path_factory):

@@ -107,7 +107,7 @@ def config_fields(table: FormatTable) -> tuple[Field, ...]:
     fields, word = [], 0
     for name, width, reset, doc in rows:
         fields.append(Field(name, width, word, reset, doc))
-        word += -(-width // 32)
+        word += fields[-1].words
     return tuple(fields)
 
 

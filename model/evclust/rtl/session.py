@@ -22,7 +22,7 @@ import numpy as np
 from evclust.errors import EvclustError
 from evclust.fixed.formats import verilog_header
 from evclust.fixed.model import FixedClusterer
-from evclust.vectors.pack import event_fields, record_fields, unpack
+from evclust.vectors.pack import event_words, record_rows
 
 SIMULATOR = "verilator"  # the fast one; `make cosim SIM=icarus` covers the other
 
@@ -81,28 +81,16 @@ class RtlClusterer:
 
     def feed(self, events: np.ndarray) -> np.ndarray:
         """Record rows (as the fixed model's) of the filter steps these events complete."""
-        fields = event_fields(self.table)
-        t = (events["t"] & np.uint64(0xFFFFFFFF)).astype(object)
-        columns = (t, events["x"].astype(object), events["y"].astype(object), (events["p"] > 0).astype(object),
-                   events["Y"].astype(object), events["Cb"].astype(object), events["Cr"].astype(object))  # fmt: skip
-        words = np.zeros(events.size, dtype=object)
-        for column, (_, width, _) in zip(columns, fields):
-            words = (words << width) | column
         path = self._dir / f"batch-{self._batch}.npy"
         self._batch += 1
-        np.save(path, np.array([str(w) for w in words]))
+        np.save(path, np.array([str(w) for w in event_words(events, self.table)]))
         self._send.write(f"{path}\n")
         self._send.flush()
         answer = Path(self._answer())
-        raw = np.load(answer)
+        words = np.load(answer).tolist()
         answer.unlink()
         path.unlink()
-        fields = record_fields(self.table)
-        rows = np.zeros((raw.size, len(fields)))
-        scale = np.array([2.0**-f[3] for f in fields])
-        for i, word in enumerate(raw.tolist()):
-            rows[i] = np.array(unpack(int(word), fields), dtype=np.float64) * scale
-        return rows
+        return record_rows(words, self.table)
 
     def stats(self) -> dict:
         """The status counters read from the register file; ends the session."""

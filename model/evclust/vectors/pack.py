@@ -71,6 +71,14 @@ def event_words(events: np.ndarray, table: FormatTable) -> list[int]:
     return [pack(row, fields) for row in cols]
 
 
+def record_rows(words, table: FormatTable) -> np.ndarray:
+    """Record words (the RTL's) as the fixed model's record rows: each field in its real units."""
+    fields = record_fields(table)
+    scale = np.array([2.0**-frac for *_, frac in fields])
+    rows = np.array([unpack(int(word), fields) for word in words], dtype=np.float64).reshape(-1, len(fields))
+    return rows * scale
+
+
 def record_words(tracks: np.ndarray, table: FormatTable) -> list[int]:
     """Track records (values converted from their formats) back to raw integers, exactly."""
     fields = record_fields(table)
