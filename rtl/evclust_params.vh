@@ -4,12 +4,14 @@
 // with EVCLUST_PORT_PARAMETERS defined, in a module's parameter list instead.
 // Each module reads the part of the table it needs:
 `ifdef EVCLUST_PORT_PARAMETERS
+// verilator lint_off UNUSEDPARAM
 parameter integer N = 16,  // clusters
 parameter integer EV_W = 75,  // event word
 parameter integer REC_W = 411,  // record word
 parameter integer TRACE_W = 11,  // trace word
 parameter integer CFG_W = 2240,  // configuration block
 parameter integer COUNT_W = 38  // counter increments
+// verilator lint_on UNUSEDPARAM
 `else
 // verilator lint_off UNUSEDPARAM
 localparam integer N_CLUSTERS = 16;

@@ -54,7 +54,12 @@ module evclust_regs #(
     endgenerate
 
     localparam [ADDR_W-1:0] A_ID = 'h000, A_VERSION = 'h004, A_CTRL = 'h008, A_STATUS = 'h00c, A_IRQ_ENABLE = 'h010, A_BUILD = 'h014;
-    localparam integer COUNTERS_BASE = 'h040, CONFIG_BASE = 'h100;
+    // Word addresses (byte address / 4) of the counters and the configuration block.
+    localparam integer WORD_W = ADDR_W - 2;
+    localparam [WORD_W-1:0] COUNTERS_WORD = 'h040 >> 2, CONFIG_WORD = 'h100 >> 2;
+    localparam integer COUNTER_INDEX_W = N_COUNTERS > 1 ? $clog2(N_COUNTERS) : 1;
+    localparam integer CFG_INDEX_W = CFG_WORDS > 1 ? $clog2(CFG_WORDS) : 1;
+    localparam [WORD_W-1:0] N_COUNTER_WORDS = N_COUNTERS[WORD_W-1:0], N_CFG_WORDS = CFG_WORDS[WORD_W-1:0];
     localparam [31:0] BUILD_VALUE = {PALETTE_SIZE[15:0], N_CLUSTERS[15:0]};
 
     reg [31:0] config_words [0:CFG_WORDS-1];
@@ -90,9 +95,10 @@ module evclust_regs #(
     reg [31:0]       w_data;
     reg [3:0]        w_strb;
     wire             do_write = aw_held && w_held && !s_axil_bvalid;
-    wire [ADDR_W-1:0] cfg_offset = aw_addr - CONFIG_BASE[ADDR_W-1:0];
-    wire             cfg_hit = aw_addr >= CONFIG_BASE[ADDR_W-1:0] && cfg_offset[ADDR_W-1:2] < CFG_WORDS;
-    wire [ADDR_W-3:0] cfg_index = cfg_offset[ADDR_W-1:2];
+    wire [WORD_W-1:0] aw_word = aw_addr[ADDR_W-1:2];
+    wire [WORD_W-1:0] cfg_offset = aw_word - CONFIG_WORD;
+    wire             cfg_hit = aw_word >= CONFIG_WORD && cfg_offset < N_CFG_WORDS;
+    wire [CFG_INDEX_W-1:0] cfg_index = cfg_offset[CFG_INDEX_W-1:0];
     wire             write_ctrl = do_write && aw_addr == A_CTRL && w_strb[0];
     wire             write_status = do_write && aw_addr == A_STATUS && w_strb[0];
     wire             clear_counters = write_ctrl && w_data[1];
@@ -177,10 +183,12 @@ module evclust_regs #(
 
     function automatic [31:0] read_word;
         input [ADDR_W-1:0] addr;
-        reg [ADDR_W-1:0] offset;
+        reg [WORD_W-1:0] word, counter, offset;
         begin
             read_word = 32'd0;
-            offset = addr - CONFIG_BASE[ADDR_W-1:0];
+            word = addr[ADDR_W-1:2];
+            counter = word - COUNTERS_WORD;
+            offset = word - CONFIG_WORD;
             if (addr == A_ID)
                 read_word = REG_ID_VALUE;
             else if (addr == A_VERSION)
@@ -191,13 +199,13 @@ module evclust_regs #(
                 read_word = {29'd0, irq_enable};
             else if (addr == A_BUILD)
                 read_word = BUILD_VALUE;
-            else if (addr >= COUNTERS_BASE[ADDR_W-1:0] && addr < COUNTERS_BASE[ADDR_W-1:0] + 4 * N_COUNTERS)
-                read_word = counters[(addr - COUNTERS_BASE[ADDR_W-1:0]) >> 2];
-            else if (addr >= CONFIG_BASE[ADDR_W-1:0] && offset[ADDR_W-1:2] < CFG_WORDS)
-                read_word = config_words[offset[ADDR_W-1:2]];
+            else if (word >= COUNTERS_WORD && counter < N_COUNTER_WORDS)
+                read_word = counters[counter[COUNTER_INDEX_W-1:0]];
+            else if (word >= CONFIG_WORD && offset < N_CFG_WORDS)
+                read_word = config_words[offset[CFG_INDEX_W-1:0]];
         end
     endfunction
 
-    wire unused = &{1'b0, s_axil_awprot, s_axil_arprot, aw_addr[1:0], 1'b0};
+    wire [7:0] unused_bus_bits = {s_axil_awprot, s_axil_arprot, aw_addr[1:0]};  // protection and byte offsets
 endmodule
 `default_nettype wire

@@ -14,8 +14,9 @@ from cosim import RTL, use_simulator
 from evclust.rtl.sources import RTL_INCLUDES, RTL_SOURCES
 
 
-def lint(header: str | None = None) -> str:
-    """Verilator's complaints ('' when clean)."""
+def lint(header: str | None = None, top: str = "evclust_axis") -> str:
+    """Verilator's complaints ('' when clean) on `top` and everything below it (the integration
+    top by default: the register file and the core)."""
     use_simulator("verilator")
     with tempfile.TemporaryDirectory() as tmp:
         src = Path(tmp)
@@ -24,7 +25,7 @@ def lint(header: str | None = None) -> str:
         if header is not None:
             (src / "evclust_params.vh").write_text(header)
         done = subprocess.run(
-            ["verilator", "--lint-only", "-Wall", f"-I{src}", "--top-module", "evclust_core", "evclust_lint.vlt", *RTL_SOURCES],
+            ["verilator", "--lint-only", "-Wall", f"-I{src}", "--top-module", top, "evclust_lint.vlt", *RTL_SOURCES],
             cwd=src, capture_output=True, text=True,
         )  # fmt: skip
         return (done.stdout + done.stderr).strip() if done.returncode or done.stderr.strip() else ""

@@ -16,8 +16,9 @@ from evclust.vectors.read import load_case  # noqa: E402
 VECTORS = Path(__file__).resolve().parents[1] / "vectors"
 
 
-def test_the_reference_rtl_is_lint_clean():
-    assert lint() == ""
+@pytest.mark.parametrize("top", ["evclust_axis", "evclust_core"])
+def test_the_reference_rtl_is_lint_clean(top):
+    assert lint(top=top) == ""
 
 
 @pytest.mark.parametrize("case", ["table_full", "palette_tie", "pedestrian_clip", "suite_clip", "creation_support", "merge_edges"])
@@ -34,7 +35,8 @@ def test_lint_reports_a_real_problem(tmp_path):
     assert lint(header.replace("localparam integer FILTER_EVERY = 64;", "localparam integer FILTER_EVERY = 64;\nwire spare;")) != ""
 
 
-def test_the_fusesoc_core_file_lints_through_edalize(tmp_path):
+@pytest.mark.parametrize("target", ["lint", "axis_lint"])
+def test_the_fusesoc_core_file_lints_through_edalize(tmp_path, target):
     import os
     import shutil
     import subprocess
@@ -44,7 +46,7 @@ def test_the_fusesoc_core_file_lints_through_edalize(tmp_path):
     use_simulator("verilator")
     fusesoc = shutil.which("fusesoc", path=str(Path(sys.executable).parent)) or "fusesoc"
     root = Path(__file__).resolve().parents[1]
-    done = subprocess.run([fusesoc, "--cores-root", str(root), "run", "--target", "lint", "evclust:evclust:core"],
+    done = subprocess.run([fusesoc, "--cores-root", str(root), "run", "--target", target, "evclust:evclust:core"],
                           cwd=tmp_path, capture_output=True, text=True, env=os.environ)  # fmt: skip
     assert done.returncode == 0, done.stdout[-2000:] + done.stderr[-2000:]
     assert "%Warning" not in done.stdout + done.stderr

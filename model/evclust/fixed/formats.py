@@ -480,11 +480,13 @@ def _port_parameter_lines(table: FormatTable) -> list[str]:
     widths = {prefix: sum(f[1] for f in fields) for prefix, fields in _layouts(table)}
     return [
         "`ifdef EVCLUST_PORT_PARAMETERS",
+        "// verilator lint_off UNUSEDPARAM",
         f"parameter integer N = {table.n_clusters},  // clusters",
         f"parameter integer EV_W = {widths['IN']},  // event word",
         f"parameter integer REC_W = {widths['REC']},  // record word",
         f"parameter integer TRACE_W = {widths['TRACE']},  // trace word",
         f"parameter integer CFG_W = {32 * registers.config_words(table)},  // configuration block",
         f"parameter integer COUNT_W = {len(registers.COUNTERS) * registers.COUNTER_INC_BITS}  // counter increments",
+        "// verilator lint_on UNUSEDPARAM",
         "`else",
     ]

@@ -17,9 +17,17 @@ from evclust.choices import SIMULATORS
 from evclust.errors import EvclustError
 from evclust.rtl.sources import BUILD, RTL_DIR, RTL_INCLUDES, RTL_SOURCES, TB_DIR, require_repository
 
-SOURCES = (*(RTL_DIR / name for name in RTL_SOURCES), TB_DIR / "evclust_tb.v")
 INCLUDES = tuple(RTL_DIR / name for name in RTL_INCLUDES)
 TOPLEVEL = "evclust_tb"
+# The testbenches: toplevel -> (its Verilog beyond rtl/, its folder and cocotb module under tb/).
+BENCHES = {
+    "evclust_tb": ((TB_DIR / "evclust_tb.v",), TB_DIR, "test_evclust_core"),
+    "evclust_axis": ((), TB_DIR.parent / "evclust_axis", "test_evclust_axis"),
+}
+
+
+def _sources(toplevel: str) -> tuple[Path, ...]:
+    return (*(RTL_DIR / name for name in RTL_SOURCES), *BENCHES[toplevel][0])
 
 
 def verilator_bin() -> Path:
@@ -42,8 +50,8 @@ def use_simulator(sim: str) -> None:
         raise EvclustError("iverilog not found: install Icarus Verilog (Debian: apt install iverilog)")
 
 
-def build(sim: str, header: str):
-    """(runner, build directory) for this header. The sources are copied once per header, so
+def build(sim: str, header: str, toplevel: str = TOPLEVEL):
+    """(runner, build directory) for this header and testbench toplevel. The sources are copied once per header, so
     their times stay put and a second build is a no-op (Icarus checks times, Verilator skips
     identical inputs)."""
     require_repository()
@@ -55,20 +63,21 @@ def build(sim: str, header: str):
     # Verilator: random initial values (--x-initial unique, seeded per run by the plusarg below),
     # so a register read before it is reset or written shows up as a mismatch.
     args = ["-Wno-fatal", "-O3", "--x-assign", "unique", "--x-initial", "unique"] if sim == "verilator" else []
-    digest = hashlib.sha256(header.encode() + " ".join(args).encode())
-    for path in (*SOURCES, *INCLUDES):
+    sources = _sources(toplevel)
+    digest = hashlib.sha256(header.encode() + " ".join(args).encode() + toplevel.encode())
+    for path in (*sources, *INCLUDES):
         digest.update(path.read_bytes())
     build_dir = BUILD / "cosim" / sim / digest.hexdigest()[:16]
     src = build_dir / "src"
     if not (src / "evclust_params.vh").exists():
         src.mkdir(parents=True, exist_ok=True)
-        for path in (*SOURCES, *INCLUDES):
+        for path in (*sources, *INCLUDES):
             shutil.copy(path, src / path.name)
         (src / "evclust_params.vh").write_text(header)  # beside the sources, so it is the one included
     runner = get_runner(sim)
     with _pch_include():
         runner.build(
-            sources=[src / p.name for p in SOURCES], includes=[src], hdl_toplevel=TOPLEVEL,
+            sources=[src / p.name for p in sources], includes=[src], hdl_toplevel=toplevel,
             build_dir=build_dir, build_args=args, timescale=("1ns", "1ps"), log_file=build_dir / "build.log",
         )  # fmt: skip
     return runner, build_dir
@@ -91,18 +100,19 @@ def _pch_include():
             os.environ["MAKEFLAGS"] = before
 
 
-def run(sim: str, header: str, testcase: str, config: dict) -> dict:
-    """Run one cocotb test of tb/evclust_core/test_evclust_core.py; its measurements back as a
-    dict. A failing test raises AssertionError with the testbench's message."""
-    runner, build_dir = build(sim, header)
+def run(sim: str, header: str, testcase: str, config: dict, toplevel: str = TOPLEVEL) -> dict:
+    """Run one cocotb test of a testbench (default tb/evclust_core/test_evclust_core.py); its
+    measurements back as a dict. A failing test raises AssertionError with the testbench's message."""
+    runner, build_dir = build(sim, header, toplevel)
+    _, test_dir, test_module = BENCHES[toplevel]
     key = hashlib.sha256(json.dumps(config, sort_keys=True).encode()).hexdigest()[:12]
     out = build_dir / f"{testcase}-{key}.json"
     out.unlink(missing_ok=True)
     env = {"EVCLUST_TB": json.dumps(config | {"out": str(out), "header": str(build_dir / "src" / "evclust_params.vh")})}
     try:
         runner.test(
-            test_module="test_evclust_core", hdl_toplevel=TOPLEVEL, testcase=testcase, build_dir=build_dir,
-            test_dir=TB_DIR, extra_env=env, log_file=build_dir / f"{testcase}-{key}.log", timescale=("1ns", "1ps"),
+            test_module=test_module, hdl_toplevel=toplevel, testcase=testcase, build_dir=build_dir,
+            test_dir=test_dir, extra_env=env, log_file=build_dir / f"{testcase}-{key}.log", timescale=("1ns", "1ps"),
             results_xml=str(build_dir / f"{testcase}-{key}.xml"),
             plusargs=["+verilator+rand+reset+2", f"+verilator+seed+{int(key[:6], 16) + 1}"] if sim == "verilator" else [],
         )  # fmt: skip

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from evclust.vectors.pack import TRACE_FIELDS, unpack
 
-ACTIONS = ("update", "create", "evict", "drop")
+ACTIONS = ("update", "create", "evict", "drop", "unsupported")  # fixed_model.TRACE_*
 
 
 def describe_trace(word: int) -> str:
