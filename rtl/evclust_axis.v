@@ -13,7 +13,8 @@ module evclust_axis #(
 `undef EVCLUST_PORT_PARAMETERS
 ,
     parameter integer EV_BYTES = (EV_W + 7) / 8,
-    parameter integer REC_BYTES = (REC_W + 7) / 8
+    parameter integer REC_BYTES = (REC_W + 7) / 8,
+    parameter integer RUNTIME_CONFIG = 1  // 0: the build's parameter set only, in the smaller core
 ) (
     input  wire                   clk,
     input  wire                   rst,
@@ -64,7 +65,7 @@ module evclust_axis #(
     wire [REC_W-1:0]   record;
     wire               unused_filter_active;
 
-    evclust_regs #(.N(N), .EV_W(EV_W), .REC_W(REC_W), .TRACE_W(TRACE_W), .CFG_W(CFG_W), .COUNT_W(COUNT_W)) regs (
+    evclust_regs #(.N(N), .EV_W(EV_W), .REC_W(REC_W), .TRACE_W(TRACE_W), .CFG_W(CFG_W), .COUNT_W(COUNT_W), .RUNTIME_CONFIG(RUNTIME_CONFIG)) regs (
         .clk(clk), .rst(rst),
         .s_axil_awaddr(s_axil_awaddr), .s_axil_awprot(s_axil_awprot), .s_axil_awvalid(s_axil_awvalid), .s_axil_awready(s_axil_awready),
         .s_axil_wdata(s_axil_wdata), .s_axil_wstrb(s_axil_wstrb), .s_axil_wvalid(s_axil_wvalid), .s_axil_wready(s_axil_wready),
@@ -74,7 +75,7 @@ module evclust_axis #(
         .cfg(cfg), .clear(clear), .idle(idle), .count_inc(count_inc), .irq(irq)
     );
 
-    evclust_core #(.N(N), .EV_W(EV_W), .REC_W(REC_W), .TRACE_W(TRACE_W), .CFG_W(CFG_W), .COUNT_W(COUNT_W)) core (
+    evclust_core #(.N(N), .EV_W(EV_W), .REC_W(REC_W), .TRACE_W(TRACE_W), .CFG_W(CFG_W), .COUNT_W(COUNT_W), .RUNTIME_CONFIG(RUNTIME_CONFIG)) core (
         .clk(clk), .rst(rst), .clear(clear), .cfg(cfg),
         .ev_valid(s_axis_event_tvalid), .ev_ready(s_axis_event_tready), .ev_data(s_axis_event_tdata[EV_W-1:0]),
         .rec_valid(m_axis_record_tvalid), .rec_ready(m_axis_record_tready), .rec_data(record),

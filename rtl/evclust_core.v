@@ -24,6 +24,10 @@ module evclust_core #(
 `define EVCLUST_PORT_PARAMETERS
 `include "evclust_params.vh"
 `undef EVCLUST_PORT_PARAMETERS
+,
+    // 1: the constants come from `cfg` (the register file); 0: from the header (CFG_RESET),
+    // `cfg` unread, so synthesis folds them into the datapath: the smaller core, one parameter set.
+    parameter integer RUNTIME_CONFIG = 1
 ) (
     input  wire               clk,
     input  wire               rst,
@@ -64,6 +68,9 @@ module evclust_core #(
     localparam integer EVERY_W = $clog2(FILTER_EVERY + 1);
 
 
+    // The configuration block the datapath reads (CFG_* word indices).
+    wire [CFG_W-1:0] cfg_used = RUNTIME_CONFIG != 0 ? cfg : CFG_RESET;
+
     // ---------------------------------------------------------------- formats and constants
     localparam integer FP = CENTRE_FRAC, FR = HALF_SIZE_FRAC, FA = ACTIVITY_FRAC, FV = V_MCM_FRAC;
     localparam integer FW = MCM_NORM_FRAC, FI = V_INT_FRAC, FC = COLOUR_FRAC, FB = BACKGROUND_FRAC;
@@ -79,20 +86,20 @@ module evclust_core #(
     localparam signed [63:0] MAX_VI = (64'sd1 <<< (V_INT_W - 1)) - 1, MIN_VI = -(64'sd1 <<< (V_INT_W - 1));
     localparam signed [63:0] MAX_STEP = (64'sd1 <<< (CENTRE_STEP_W - 1)) - 1, MIN_STEP = -(64'sd1 <<< (CENTRE_STEP_W - 1));
     localparam signed [63:0] H_MAX = (64'sd1 <<< HIST_W) - 1;
-    wire signed [63:0] K_B_POS = $signed({{(64 - BETA_POS_W){1'b0}}, cfg[32 * CFG_BETA_POS +: BETA_POS_W]}), K_B_SIZE = $signed({{(64 - BETA_SIZE_W){1'b0}}, cfg[32 * CFG_BETA_SIZE +: BETA_SIZE_W]});
-    wire signed [63:0] K_B_VM = $signed({{(64 - BETA_VEL_MCM_W){1'b0}}, cfg[32 * CFG_BETA_VEL_MCM +: BETA_VEL_MCM_W]}), K_B_VI = $signed({{(64 - BETA_VEL_INT_W){1'b0}}, cfg[32 * CFG_BETA_VEL_INT +: BETA_VEL_INT_W]});
-    wire signed [63:0] K_B_LUM = $signed({{(64 - BETA_LUM_W){1'b0}}, cfg[32 * CFG_BETA_LUM +: BETA_LUM_W]}), K_B_CHRO = $signed({{(64 - BETA_CHRO_W){1'b0}}, cfg[32 * CFG_BETA_CHRO +: BETA_CHRO_W]});
-    wire signed [63:0] K_B_BG = $signed({{(64 - BETA_BG_W){1'b0}}, cfg[32 * CFG_BETA_BG +: BETA_BG_W]}), K_GAIN = $signed({{(64 - SIZE_GAIN_W){1'b0}}, cfg[32 * CFG_SIZE_GAIN +: SIZE_GAIN_W]});
-    wire signed [63:0] K_GAMMA_GLOBAL = $signed({{(64 - GAMMA_GLOBAL_W){1'b0}}, cfg[32 * CFG_GAMMA_GLOBAL +: GAMMA_GLOBAL_W]}), K_GPA = $signed({{(64 - GAMMA_PER_ACTIVITY_W){1'b0}}, cfg[32 * CFG_GAMMA_PER_ACTIVITY +: GAMMA_PER_ACTIVITY_W]});
-    wire signed [63:0] K_INV_P = $signed({{(64 - INV_P_W){1'b0}}, cfg[32 * CFG_INV_P +: INV_P_W]});
-    wire signed [63:0] K_R_MIN = $signed({{(64 - R_MIN_W){1'b0}}, cfg[32 * CFG_R_MIN +: R_MIN_W]});
-    wire signed [63:0] K_R_MAX = $signed({{(64 - R_MAX_W){1'b0}}, cfg[32 * CFG_R_MAX +: R_MAX_W]}), K_SEEK = $signed({{(64 - SEEK_MARGIN_W){1'b0}}, cfg[32 * CFG_SEEK_MARGIN +: SEEK_MARGIN_W]});
-    wire signed [63:0] K_EXIT_M = $signed({{(64 - EXIT_MARGIN_W){1'b0}}, cfg[32 * CFG_EXIT_MARGIN +: EXIT_MARGIN_W]}), K_A_MIN = $signed({{(64 - A_MIN_W){1'b0}}, cfg[32 * CFG_A_MIN +: A_MIN_W]});
-    wire signed [63:0] K_A_VALID = $signed({{(64 - A_VALID_W){1'b0}}, cfg[32 * CFG_A_VALID +: A_VALID_W]}), K_V_MIN_SQ = $signed({{(64 - V_MIN_SQ_W){1'b0}}, cfg[32 * CFG_V_MIN_SQ +: V_MIN_SQ_W]});
-    wire signed [63:0] K_V_EXIT_SQ = $signed({{(64 - V_EXIT_SQ_W){1'b0}}, cfg[32 * CFG_V_EXIT_SQ +: V_EXIT_SQ_W]}), K_COS_SQ = $signed({{(64 - COS_SQ_EXIT_W){1'b0}}, cfg[32 * CFG_COS_SQ_EXIT +: COS_SQ_EXIT_W]});
+    wire signed [63:0] K_B_POS = $signed({{(64 - BETA_POS_W){1'b0}}, cfg_used[32 * CFG_BETA_POS +: BETA_POS_W]}), K_B_SIZE = $signed({{(64 - BETA_SIZE_W){1'b0}}, cfg_used[32 * CFG_BETA_SIZE +: BETA_SIZE_W]});
+    wire signed [63:0] K_B_VM = $signed({{(64 - BETA_VEL_MCM_W){1'b0}}, cfg_used[32 * CFG_BETA_VEL_MCM +: BETA_VEL_MCM_W]}), K_B_VI = $signed({{(64 - BETA_VEL_INT_W){1'b0}}, cfg_used[32 * CFG_BETA_VEL_INT +: BETA_VEL_INT_W]});
+    wire signed [63:0] K_B_LUM = $signed({{(64 - BETA_LUM_W){1'b0}}, cfg_used[32 * CFG_BETA_LUM +: BETA_LUM_W]}), K_B_CHRO = $signed({{(64 - BETA_CHRO_W){1'b0}}, cfg_used[32 * CFG_BETA_CHRO +: BETA_CHRO_W]});
+    wire signed [63:0] K_B_BG = $signed({{(64 - BETA_BG_W){1'b0}}, cfg_used[32 * CFG_BETA_BG +: BETA_BG_W]}), K_GAIN = $signed({{(64 - SIZE_GAIN_W){1'b0}}, cfg_used[32 * CFG_SIZE_GAIN +: SIZE_GAIN_W]});
+    wire signed [63:0] K_GAMMA_GLOBAL = $signed({{(64 - GAMMA_GLOBAL_W){1'b0}}, cfg_used[32 * CFG_GAMMA_GLOBAL +: GAMMA_GLOBAL_W]}), K_GPA = $signed({{(64 - GAMMA_PER_ACTIVITY_W){1'b0}}, cfg_used[32 * CFG_GAMMA_PER_ACTIVITY +: GAMMA_PER_ACTIVITY_W]});
+    wire signed [63:0] K_INV_P = $signed({{(64 - INV_P_W){1'b0}}, cfg_used[32 * CFG_INV_P +: INV_P_W]});
+    wire signed [63:0] K_R_MIN = $signed({{(64 - R_MIN_W){1'b0}}, cfg_used[32 * CFG_R_MIN +: R_MIN_W]});
+    wire signed [63:0] K_R_MAX = $signed({{(64 - R_MAX_W){1'b0}}, cfg_used[32 * CFG_R_MAX +: R_MAX_W]}), K_SEEK = $signed({{(64 - SEEK_MARGIN_W){1'b0}}, cfg_used[32 * CFG_SEEK_MARGIN +: SEEK_MARGIN_W]});
+    wire signed [63:0] K_EXIT_M = $signed({{(64 - EXIT_MARGIN_W){1'b0}}, cfg_used[32 * CFG_EXIT_MARGIN +: EXIT_MARGIN_W]}), K_A_MIN = $signed({{(64 - A_MIN_W){1'b0}}, cfg_used[32 * CFG_A_MIN +: A_MIN_W]});
+    wire signed [63:0] K_A_VALID = $signed({{(64 - A_VALID_W){1'b0}}, cfg_used[32 * CFG_A_VALID +: A_VALID_W]}), K_V_MIN_SQ = $signed({{(64 - V_MIN_SQ_W){1'b0}}, cfg_used[32 * CFG_V_MIN_SQ +: V_MIN_SQ_W]});
+    wire signed [63:0] K_V_EXIT_SQ = $signed({{(64 - V_EXIT_SQ_W){1'b0}}, cfg_used[32 * CFG_V_EXIT_SQ +: V_EXIT_SQ_W]}), K_COS_SQ = $signed({{(64 - COS_SQ_EXIT_W){1'b0}}, cfg_used[32 * CFG_COS_SQ_EXIT +: COS_SQ_EXIT_W]});
     wire signed [63:0] HI_X = (($signed({32'd0, SENSOR_WIDTH[31:0]}) - 64'sd1) <<< FP) - K_EXIT_M;
     wire signed [63:0] HI_Y = (($signed({32'd0, SENSOR_HEIGHT[31:0]}) - 64'sd1) <<< FP) - K_EXIT_M;
-    wire [63:0] TAU = {{(64 - TAU_PHASE_W){1'b0}}, cfg[32 * CFG_TAU_US +: TAU_PHASE_W]};
+    wire [63:0] TAU = {{(64 - TAU_PHASE_W){1'b0}}, cfg_used[32 * CFG_TAU_US +: TAU_PHASE_W]};
     localparam integer LAST_SLOT_I = N - 1, LAST_SWEEP_I = SWEEP_LEN + TAIL - 1;
     localparam [SWEEP_W-1:0] LAST_SLOT = LAST_SLOT_I[SWEEP_W-1:0];
     localparam [SWEEP_W-1:0] LAST_SWEEP = LAST_SWEEP_I[SWEEP_W-1:0];
@@ -101,37 +108,37 @@ module evclust_core #(
     localparam [SWEEP_W-1:0] N_SLOTS = N[SWEEP_W-1:0], N_ENTRIES = P[SWEEP_W-1:0];
     localparam integer COS_SQ_F = COS_SQ_EXIT_FRAC;
     // One cluster per object (beyond the paper): scaled seek, merging, noise gate, creation support.
-    wire signed [63:0] K_SEEK_SCALE = $signed({{(64 - SEEK_SCALE_W){1'b0}}, cfg[32 * CFG_SEEK_SCALE +: SEEK_SCALE_W]});
-    wire signed [63:0] K_MERGE_SCALE = $signed({{(64 - MERGE_SCALE_W){1'b0}}, cfg[32 * CFG_MERGE_SCALE +: MERGE_SCALE_W]});
-    wire signed [63:0] K_MERGE_V_TOL = $signed({{(64 - MERGE_V_TOL_W){1'b0}}, cfg[32 * CFG_MERGE_V_TOL +: MERGE_V_TOL_W]});
-    wire signed [63:0] K_MERGE_V_REL = $signed({{(64 - MERGE_V_REL_W){1'b0}}, cfg[32 * CFG_MERGE_V_REL +: MERGE_V_REL_W]});
-    wire signed [63:0] K_NOISE_GATE = $signed({{(64 - NOISE_GATE_W){1'b0}}, cfg[32 * CFG_NOISE_GATE +: NOISE_GATE_W]});
-    wire [31:0] K_SUPPORT_WINDOW = {{(32 - SUPPORT_WINDOW_W){1'b0}}, cfg[32 * CFG_SUPPORT_WINDOW +: SUPPORT_WINDOW_W]};
+    wire signed [63:0] K_SEEK_SCALE = $signed({{(64 - SEEK_SCALE_W){1'b0}}, cfg_used[32 * CFG_SEEK_SCALE +: SEEK_SCALE_W]});
+    wire signed [63:0] K_MERGE_SCALE = $signed({{(64 - MERGE_SCALE_W){1'b0}}, cfg_used[32 * CFG_MERGE_SCALE +: MERGE_SCALE_W]});
+    wire signed [63:0] K_MERGE_V_TOL = $signed({{(64 - MERGE_V_TOL_W){1'b0}}, cfg_used[32 * CFG_MERGE_V_TOL +: MERGE_V_TOL_W]});
+    wire signed [63:0] K_MERGE_V_REL = $signed({{(64 - MERGE_V_REL_W){1'b0}}, cfg_used[32 * CFG_MERGE_V_REL +: MERGE_V_REL_W]});
+    wire signed [63:0] K_NOISE_GATE = $signed({{(64 - NOISE_GATE_W){1'b0}}, cfg_used[32 * CFG_NOISE_GATE +: NOISE_GATE_W]});
+    wire [31:0] K_SUPPORT_WINDOW = {{(32 - SUPPORT_WINDOW_W){1'b0}}, cfg_used[32 * CFG_SUPPORT_WINDOW +: SUPPORT_WINDOW_W]};
     // Run-time values and switches (registers, docs/REGISTERS.md); their widths are the build's.
-    wire [INV_T_HALF_W-1:0]    K_INV_T_HALF = cfg[32 * CFG_INV_T_HALF +: INV_T_HALF_W];
-    wire [LUMA_WEIGHT_W-1:0]   K_LUMA_WEIGHT = cfg[32 * CFG_LUMA_WEIGHT +: LUMA_WEIGHT_W];
-    wire [MIXING_TOLERANCE_W-1:0] K_MIXING_TOLERANCE = cfg[32 * CFG_MIXING_TOLERANCE +: MIXING_TOLERANCE_W];
-    wire [HALF_SIZE_W-1:0]     K_R_INIT = cfg[32 * CFG_R_INIT +: HALF_SIZE_W];
-    wire [FRAME_PER_TAU_W-1:0] K_FRAME_PER_TAU = cfg[32 * CFG_FRAME_PER_TAU +: FRAME_PER_TAU_W];
-    wire [EVERY_W-1:0]         K_FILTER_EVERY = cfg[32 * CFG_FILTER_EVERY +: EVERY_W];
-    wire [1:0]                 gamma_mode = cfg[32 * CFG_GAMMA_MODE +: 2];
-    wire                       warm_start = cfg[32 * CFG_WARM_START];
-    wire                       mcm_correct = cfg[32 * CFG_MCM_CORRECT];
-    wire                       vote_contrast = cfg[32 * CFG_VOTE_CONTRAST];
-    wire                       mixing = cfg[32 * CFG_MIXING];
-    wire                       bg_fixed = cfg[32 * CFG_BG_FIXED];
-    wire [P-1:0]               background_mask = cfg[32 * CFG_BACKGROUND_MASK +: P];
-    wire [BACKGROUND_W-1:0]    bg_init_y = cfg[32 * CFG_BG_INIT_Y +: BACKGROUND_W];
-    wire [BACKGROUND_W-1:0]    bg_init_cb = cfg[32 * CFG_BG_INIT_CB +: BACKGROUND_W];
-    wire [BACKGROUND_W-1:0]    bg_init_cr = cfg[32 * CFG_BG_INIT_CR +: BACKGROUND_W];
+    wire [INV_T_HALF_W-1:0]    K_INV_T_HALF = cfg_used[32 * CFG_INV_T_HALF +: INV_T_HALF_W];
+    wire [LUMA_WEIGHT_W-1:0]   K_LUMA_WEIGHT = cfg_used[32 * CFG_LUMA_WEIGHT +: LUMA_WEIGHT_W];
+    wire [MIXING_TOLERANCE_W-1:0] K_MIXING_TOLERANCE = cfg_used[32 * CFG_MIXING_TOLERANCE +: MIXING_TOLERANCE_W];
+    wire [HALF_SIZE_W-1:0]     K_R_INIT = cfg_used[32 * CFG_R_INIT +: HALF_SIZE_W];
+    wire [FRAME_PER_TAU_W-1:0] K_FRAME_PER_TAU = cfg_used[32 * CFG_FRAME_PER_TAU +: FRAME_PER_TAU_W];
+    wire [EVERY_W-1:0]         K_FILTER_EVERY = cfg_used[32 * CFG_FILTER_EVERY +: EVERY_W];
+    wire [1:0]                 gamma_mode = cfg_used[32 * CFG_GAMMA_MODE +: 2];
+    wire                       warm_start = cfg_used[32 * CFG_WARM_START];
+    wire                       mcm_correct = cfg_used[32 * CFG_MCM_CORRECT];
+    wire                       vote_contrast = cfg_used[32 * CFG_VOTE_CONTRAST];
+    wire                       mixing = cfg_used[32 * CFG_MIXING];
+    wire                       bg_fixed = cfg_used[32 * CFG_BG_FIXED];
+    wire [P-1:0]               background_mask = cfg_used[32 * CFG_BACKGROUND_MASK +: P];
+    wire [BACKGROUND_W-1:0]    bg_init_y = cfg_used[32 * CFG_BG_INIT_Y +: BACKGROUND_W];
+    wire [BACKGROUND_W-1:0]    bg_init_cb = cfg_used[32 * CFG_BG_INIT_CB +: BACKGROUND_W];
+    wire [BACKGROUND_W-1:0]    bg_init_cr = cfg_used[32 * CFG_BG_INIT_CR +: BACKGROUND_W];
     // The palette, entry j in bits [8j +: 8] (its registers are Y, Cb, Cr for each entry in turn).
     wire [8*P-1:0]             palette_y, palette_cb, palette_cr;
     genvar pj;
     generate
         for (pj = 0; pj < P; pj = pj + 1) begin : palette_entry
-            assign palette_y[8*pj +: 8] = cfg[32 * (CFG_PALETTE_0_Y + 3 * pj) +: 8];
-            assign palette_cb[8*pj +: 8] = cfg[32 * (CFG_PALETTE_0_CB + 3 * pj) +: 8];
-            assign palette_cr[8*pj +: 8] = cfg[32 * (CFG_PALETTE_0_CR + 3 * pj) +: 8];
+            assign palette_y[8*pj +: 8] = cfg_used[32 * (CFG_PALETTE_0_Y + 3 * pj) +: 8];
+            assign palette_cb[8*pj +: 8] = cfg_used[32 * (CFG_PALETTE_0_CB + 3 * pj) +: 8];
+            assign palette_cr[8*pj +: 8] = cfg_used[32 * (CFG_PALETTE_0_CR + 3 * pj) +: 8];
         end
     endgenerate
     localparam signed [63:0] LAST_X = ($signed({32'd0, SENSOR_WIDTH[31:0]}) - 64'sd1) <<< FP;  // the last column, in P's format

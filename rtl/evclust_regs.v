@@ -14,7 +14,8 @@ module evclust_regs #(
 `include "evclust_params.vh"
 `undef EVCLUST_PORT_PARAMETERS
 ,
-    parameter integer ADDR_W = 12
+    parameter integer ADDR_W = 12,
+    parameter integer RUNTIME_CONFIG = 1  // 0: the configuration words are the build's, read-only
 ) (
     input  wire               clk,
     input  wire               rst,
@@ -146,7 +147,7 @@ module evclust_regs #(
                 aw_held <= 1'b0;
                 w_held <= 1'b0;
                 s_axil_bvalid <= 1'b1;
-                if (cfg_hit)
+                if (cfg_hit && RUNTIME_CONFIG != 0)
                     config_words[cfg_index] <= strobed(config_words[cfg_index], w_data, w_strb);
                 if (aw_addr == A_IRQ_ENABLE && w_strb[0])
                     irq_enable <= w_data[2:0];

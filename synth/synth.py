@@ -118,6 +118,7 @@ def main():
     parser.add_argument("--defaults", action="store_true", help="the default parameters instead of the traffic preset")
     parser.add_argument("--top", default="evclust_core", choices=["evclust_core", "evclust_axis"],
                         help="evclust_core (configuration as free inputs) or evclust_axis (with its register file); default: %(default)s")
+    parser.add_argument("--static", action="store_true", help="the header's constants built in (RUNTIME_CONFIG = 0)")
     args = parser.parse_args()
     # One snapshot of the RTL for every N: others may be editing rtl/ meanwhile.
     snapshot = rtl_snapshot()
@@ -127,8 +128,8 @@ def main():
             print(f"synth: N={n} ...", file=sys.stderr)
             beat = lambda s, step, n=n: print(f"  N={n}: {s:5.0f} s, {step}", file=sys.stderr)  # noqa: E731
             header = defaults_header(n) if args.defaults else params_header(n)
-            label = f"{'defaults-' if args.defaults else ''}{'axis-' if args.top != 'evclust_core' else ''}n{n}{'-hier' if args.hier else ''}"
-            figures = synthesise(header, label, args.hier, beat, snapshot, top=args.top)
+            label = f"{'defaults-' if args.defaults else ''}{'axis-' if args.top != 'evclust_core' else ''}n{n}{'-static' if args.static else ''}{'-hier' if args.hier else ''}"
+            figures = synthesise(header, label, args.hier, beat, snapshot, top=args.top, static=args.static)
             rows.append(figures | {"n_clusters": n})
             print(f"synth: N={n} done in {figures['wall_s'] / 60:.1f} min{' (cached)' if figures['cached'] else ''}", file=sys.stderr)
     except EvclustError as e:

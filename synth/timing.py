@@ -79,6 +79,7 @@ def main():
     parser.add_argument("--no-route", action="store_true", help="stop after placement (nextpnr's estimate)")
     parser.add_argument("--json", type=Path, default=BUILD / "timing" / "results.json", help="raw figures (default: %(default)s)")
     parser.add_argument("--write", type=Path, metavar="BENCHMARKS.md", help="rewrite this file's timing section")
+    parser.add_argument("--static", action="store_true", help="the core with the build's constants built in (RUNTIME_CONFIG = 0)")
     args = parser.parse_args()
     snapshot = rtl_snapshot()  # one snapshot of rtl/ for every N
     rows = []
@@ -86,7 +87,8 @@ def main():
         for n in args.n:
             print(f"timing: N={n} ...", file=sys.stderr)
             beat = lambda step, s, detail, n=n: print(f"  N={n}: {step} {s:5.0f} s {detail}", file=sys.stderr)  # noqa: E731
-            figures = place_and_route(params_header(n), f"traffic-n{n}", not args.no_route, beat, snapshot)
+            label = f"traffic-n{n}{'-static' if args.static else ''}"
+            figures = place_and_route(params_header(n), label, not args.no_route, beat, snapshot, static=args.static)
             rows.append(figures | {"n_clusters": n})
             fmax = f"{figures['fmax_mhz']:.1f} MHz" if figures["fmax_mhz"] is not None else "does not fit the part"
             print(f"timing: N={n}: {fmax}{' (cached)' if figures['cached'] else ''}", file=sys.stderr)

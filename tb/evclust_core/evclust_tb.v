@@ -8,7 +8,8 @@
 `default_nettype none
 module evclust_tb #(
     parameter integer DEPTH = 4096,      // events per batch
-    parameter integer REC_DEPTH = 16384  // records per batch
+    parameter integer REC_DEPTH = 16384, // records per batch
+    parameter integer RUNTIME_CONFIG = 1 // the core's: 0 folds the build's constants in
 ) (
     input  wire        clk,
     input  wire        rst,
@@ -77,7 +78,7 @@ module evclust_tb #(
     wire [31:0]      xs2 = xs1 ^ (xs1 >> 17);
     wire [31:0]      next_random = xs2 ^ (xs2 << 5);
 
-    evclust_regs regs (
+    evclust_regs #(.RUNTIME_CONFIG(RUNTIME_CONFIG)) regs (
         .clk(clk), .rst(rst),
         .s_axil_awaddr(s_axil_awaddr), .s_axil_awprot(s_axil_awprot), .s_axil_awvalid(s_axil_awvalid), .s_axil_awready(s_axil_awready),
         .s_axil_wdata(s_axil_wdata), .s_axil_wstrb(s_axil_wstrb), .s_axil_wvalid(s_axil_wvalid), .s_axil_wready(s_axil_wready),
@@ -87,7 +88,7 @@ module evclust_tb #(
         .cfg(cfg), .clear(clear), .idle(idle), .count_inc(count_inc), .irq(irq)
     );
 
-    evclust_core core (
+    evclust_core #(.RUNTIME_CONFIG(RUNTIME_CONFIG)) core (
         .clk(clk),
         .rst(rst),
         .clear(clear),

@@ -157,7 +157,7 @@ if cocotb is not None:
         from evclust.vectors.read import load_case
 
         config = _config()
-        result = {"cases": {}}
+        result = {"cases": {}, "runtime_config": int(dut.RUNTIME_CONFIG.value)}
         cocotb.start_soon(Clock(dut.clk, CLOCK_NS, unit="ns").start())
         Registers(dut)  # the register bus idles (the build's parameters, from reset)
         header = Path(config["header"]).read_text()
@@ -335,6 +335,16 @@ def _case_header(name: str) -> str:
 def test_vector_case_replays_bit_exact(sim, case):
     result = run(sim, _case_header(case), "replay_vectors", {"cases": [str(VECTORS / case)], "seed": 1, "gap": GAP, "stall": STALL})
     assert case in result["cases"]
+    assert result["cases"][case]["records"] == json.loads((VECTORS / case / "manifest.json").read_text())["counts"]["records"]
+
+
+@pytest.mark.parametrize("case", ["traffic_clip", "table_full", "merge_edges"])
+@pytest.mark.parametrize("sim", SIMS)
+def test_the_core_with_its_constants_built_in_replays_bit_exact(sim, case):
+    # RUNTIME_CONFIG = 0: the header's constants folded into the datapath, the cfg port unread.
+    config = {"cases": [str(VECTORS / case)], "seed": 2, "gap": GAP, "stall": STALL}
+    result = run(sim, _case_header(case), "replay_vectors", config, parameters={"RUNTIME_CONFIG": 0})
+    assert result["runtime_config"] == 0
     assert result["cases"][case]["records"] == json.loads((VECTORS / case / "manifest.json").read_text())["counts"]["records"]
 
 

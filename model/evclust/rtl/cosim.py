@@ -50,7 +50,7 @@ def use_simulator(sim: str) -> None:
         raise EvclustError("iverilog not found: install Icarus Verilog (Debian: apt install iverilog)")
 
 
-def build(sim: str, header: str, toplevel: str = TOPLEVEL):
+def build(sim: str, header: str, toplevel: str = TOPLEVEL, parameters: dict | None = None):
     """(runner, build directory) for this header and testbench toplevel. The sources are copied once per header, so
     their times stay put and a second build is a no-op (Icarus checks times, Verilator skips
     identical inputs)."""
@@ -64,7 +64,8 @@ def build(sim: str, header: str, toplevel: str = TOPLEVEL):
     # so a register read before it is reset or written shows up as a mismatch.
     args = ["-Wno-fatal", "-O3", "--x-assign", "unique", "--x-initial", "unique"] if sim == "verilator" else []
     sources = _sources(toplevel)
-    digest = hashlib.sha256(header.encode() + " ".join(args).encode() + toplevel.encode())
+    parameters = parameters or {}
+    digest = hashlib.sha256(header.encode() + " ".join(args).encode() + toplevel.encode() + repr(sorted(parameters.items())).encode())
     for path in (*sources, *INCLUDES):
         digest.update(path.read_bytes())
     build_dir = BUILD / "cosim" / sim / digest.hexdigest()[:16]
@@ -78,7 +79,7 @@ def build(sim: str, header: str, toplevel: str = TOPLEVEL):
     with _pch_include():
         runner.build(
             sources=[src / p.name for p in sources], includes=[src], hdl_toplevel=toplevel,
-            build_dir=build_dir, build_args=args, timescale=("1ns", "1ps"), log_file=build_dir / "build.log",
+            build_dir=build_dir, build_args=args, timescale=("1ns", "1ps"), log_file=build_dir / "build.log", parameters=parameters,
         )  # fmt: skip
     return runner, build_dir
 
@@ -100,10 +101,10 @@ def _pch_include():
             os.environ["MAKEFLAGS"] = before
 
 
-def run(sim: str, header: str, testcase: str, config: dict, toplevel: str = TOPLEVEL) -> dict:
+def run(sim: str, header: str, testcase: str, config: dict, toplevel: str = TOPLEVEL, parameters: dict | None = None) -> dict:
     """Run one cocotb test of a testbench (default tb/evclust_core/test_evclust_core.py); its
     measurements back as a dict. A failing test raises AssertionError with the testbench's message."""
-    runner, build_dir = build(sim, header, toplevel)
+    runner, build_dir = build(sim, header, toplevel, parameters)
     _, test_dir, test_module = BENCHES[toplevel]
     key = hashlib.sha256(json.dumps(config, sort_keys=True).encode()).hexdigest()[:12]
     out = build_dir / f"{testcase}-{key}.json"

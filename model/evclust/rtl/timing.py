@@ -50,11 +50,13 @@ def tool_identity() -> str:
         raise EvclustError(f"{exc.name} is not installed: pip install -e '.[synth]'") from None
 
 
-def yosys_script(src: Path, out: Path) -> str:
+def yosys_script(src: Path, out: Path, static: bool = False) -> str:
+    """`static`: the core with the header's constants built in (RUNTIME_CONFIG = 0), not read from its cfg port."""
     reads = " ".join(str(src / f) for f in RTL_SOURCES)
     # ABC9's &mfs and &verify off, as for synth_xilinx (evclust.rtl.synth: &mfs runs for tens of minutes here).
     return "\n".join(ABC9_KNOBS + [
         f"read_verilog -I{src} {reads}",
+        *([f"chparam -set RUNTIME_CONFIG 0 {TOP}"] if static else []),
         f"synth_ecp5 -top {TOP} -json {out / 'netlist.json'}",
         f"tee -o {out / 'stat.txt'} stat",
     ]) + "\n"  # fmt: skip
@@ -68,8 +70,8 @@ def nextpnr_args(out: Path, route: bool) -> list[str]:
     ] + ([] if route else ["--no-route"])  # fmt: skip
 
 
-def cache_key(header: str, sources: dict[str, str], route: bool, identity: str) -> str:
-    key = f"{FLOW_VERSION}\n{identity}\n{yosys_script(Path('SRC'), Path('OUT'))}\n{nextpnr_args(Path('OUT'), route)}\n{header}"
+def cache_key(header: str, sources: dict[str, str], route: bool, identity: str, static: bool = False) -> str:
+    key = f"{FLOW_VERSION}\n{identity}\n{yosys_script(Path('SRC'), Path('OUT'), static)}\n{nextpnr_args(Path('OUT'), route)}\n{header}"
     digest = hashlib.sha256(key.encode())
     for name in sorted(sources):
         digest.update(f"\n{name}\n{sources[name]}".encode())
@@ -134,19 +136,19 @@ def _run(tool: str, args: list[str], out: Path, log: Path, heartbeat) -> float:
     return seconds
 
 
-def place_and_route(header: str, label: str, route: bool = True, heartbeat=None, snapshot=None) -> dict:
+def place_and_route(header: str, label: str, route: bool = True, heartbeat=None, snapshot=None, static: bool = False) -> dict:
     """Fmax, critical path and resources of the RTL built with `header` on the LFE5U-85F.
     `heartbeat(step, seconds, detail)` is called every minute; the result has "cached": True
     when an identical earlier run was reused."""
     require_repository()
     sources, rtl = snapshot or rtl_snapshot()
     identity = tool_identity()
-    out = BUILD / "timing" / f"{label}-{cache_key(header, sources, route, identity)}"
+    out = BUILD / "timing" / f"{label}-{cache_key(header, sources, route, identity, static)}"
     done = out / "figures.json"
     if done.exists():
         return json.loads(done.read_text()) | {"cached": True}
     src = stage_sources(out, sources, header)
-    (out / "synth.ys").write_text(yosys_script(src, out))
+    (out / "synth.ys").write_text(yosys_script(src, out, static))
     synth_s = _run("yosys", ["-q", "-l", str(out / "yosys.log"), str(out / "synth.ys")], out, out / "yosys.log", heartbeat)
     try:
         pnr_s = _run("nextpnr-ecp5", nextpnr_args(out, route), out, out / "nextpnr.log", heartbeat)
