@@ -305,7 +305,7 @@ module evclust_core #(
 
     // ---------------------------------------------------------------- control
     localparam [2:0] ST_INIT = 3'd0, ST_IDLE = 3'd1, ST_EXEC = 3'd2, ST_SCAN = 3'd3, ST_EVICT = 3'd4, ST_SWEEP = 3'd5, ST_MERGE = 3'd6, ST_PHASE = 3'd7;
-    reg [2:0]              state;
+    reg [2:0]              state, state_next;  // the FSM: state_next below, one register
     reg [SWEEP_W-1:0]      index;        // INIT: palette entry; SCAN: slot; SWEEP: slot and palette entry
     reg [EV_T_W-1:0]       e_t;
     reg [EV_XY_W-1:0]      e_x, e_y;
@@ -828,6 +828,7 @@ module evclust_core #(
         .done(by_tau_done), .quotient(by_tau_q), .remainder_out(by_tau_left)
     );
     wire        many_boundaries = by_tau_q >= (33'd1 << FRAME_PER_TAU_W);
+    wire        no_boundary = phase_q < {1'b0, TAU[31:0]};
     wire        frame_start = state == ST_PHASE && phase_step == PHASE_BY_TAU && by_tau_done && !many_boundaries;
     wire [FRAME_PER_TAU_W-1:0] frame_q;
     wire [FRAME_PER_TAU_W-1:0] unused_frame_left;
@@ -863,6 +864,7 @@ module evclust_core #(
     // EXEC: update the slot found, or create in a free one; SCAN finds the weakest; EVICT
     // creates there if it is weak enough, else drops the event.
     wire scan_last = index == LAST_SLOT;
+    wire init_done = index >= LAST_INIT && (CREATE_SUPPORT == 0 || init_cell == LAST_CELL);
     wire scan_weaker = dec_a < weakest_a || index == {SWEEP_W{1'b0}};
     wire evict = u64({{(63 - ACTIVITY_W){1'b0}}, weakest_a}) < K_A_VALID;
     reg              do_update, do_create, finish;
@@ -921,6 +923,36 @@ module evclust_core #(
     wire [SLOT_W-1:0] written_slot = do_update ? e_slot : create_slot;
     assign ev_ready = !dp_rst && (!a_valid || a_advance);  // no handshake during a reset or clear
 
+    // ---------------------------------------------------------------- the FSM's next state
+    // INIT -> IDLE; IDLE -> EXEC as stage A hands over; EXEC -> SCAN when no slot takes the
+    // event; SCAN -> EVICT at the last slot; an event that finishes goes to PHASE when a filter
+    // step is due (PHASE -> SWEEP <-> MERGE -> IDLE), else to IDLE, or straight to EXEC when A
+    // hands over the next one in the same cycle.
+    always @* begin
+        state_next = state;
+        case (state)
+            ST_INIT: if (init_done) state_next = ST_IDLE;
+            ST_EXEC: if (!finish) state_next = ST_SCAN;
+            ST_SCAN: if (scan_last) state_next = ST_EVICT;
+            ST_SWEEP: if (sweep_merge) state_next = ST_MERGE;
+                      else if (sweep_advance && index == LAST_SWEEP) state_next = ST_IDLE;
+            ST_PHASE: case (phase_step)
+                PHASE_DECIDE: if (no_boundary || !phase_start) state_next = ST_SWEEP;
+                PHASE_BY_TAU: if (by_tau_done && many_boundaries) state_next = ST_SWEEP;
+                default: if (frame_done) state_next = ST_SWEEP;
+            endcase
+            ST_MERGE: if (m_write) state_next = ST_SWEEP;
+            default: ;
+        endcase
+        if (finish)
+            state_next = sweep_due ? ST_PHASE : ST_IDLE;
+        if (a_advance)
+            state_next = ST_EXEC;
+    end
+
+    always @(posedge clk)
+        state <= dp_rst ? ST_INIT : state_next;
+
     // ---------------------------------------------------------------- status counters
     // What this cycle adds to each counter of evclust_regs, registered into count_inc. The
     // saturations are the model's `_store` sites (fixed_model.py), each counted where it applies.
@@ -971,7 +1003,6 @@ module evclust_core #(
         if (rec_valid && rec_ready)
             rec_valid <= 1'b0;
         if (dp_rst) begin
-            state <= ST_INIT;
             index <= {SWEEP_W{1'b0}};
             rec_valid <= 1'b0;
             rec_data <= {REC_W{1'b0}};
@@ -1011,46 +1042,36 @@ module evclust_core #(
                         if (init_cell != LAST_CELL)  // a small map waits here for the mixing table
                             init_cell <= init_cell + 1'b1;
                     end
-                    if (index >= LAST_INIT && (CREATE_SUPPORT == 0 || init_cell == LAST_CELL)) begin
+                    if (init_done)
                         index <= {SWEEP_W{1'b0}};
-                        state <= ST_IDLE;
-                    end
                 end
-                ST_EXEC: if (!finish) begin
+                ST_EXEC: if (!finish)
                     index <= {SWEEP_W{1'b0}};
-                    state <= ST_SCAN;
-                end
                 ST_SCAN: begin
                     if (scan_weaker) begin
                         weakest <= k;
                         weakest_a <= dec_a;
                     end
                     index <= index + 1'b1;
-                    if (scan_last)
-                        state <= ST_EVICT;
                 end
                 ST_SWEEP: if (sweep_merge) begin
                     m_j <= merge_j;
-                    state <= ST_MERGE;
                 end else if (sweep_advance) begin
                     index <= index + 1'b1;
                     if (index == LAST_SWEEP) begin
                         step <= step + 32'd1;
                         t_filter <= e_t;
-                        state <= ST_IDLE;
                     end
                 end
                 ST_PHASE: case (phase_step)  // tau boundaries since the last step and T_frame / (n tau)
-                    PHASE_DECIDE: if (phase_q < {1'b0, TAU[31:0]}) begin
+                    PHASE_DECIDE: if (no_boundary) begin
                         boundaries <= 33'd0;
                         tau_phase <= phase_q[TAU_PHASE_W-1:0];
                         per_frame <= K_FRAME_PER_TAU;  // T_frame / tau: n counts as 1
-                        state <= ST_SWEEP;
                     end else if (!phase_start) begin  // one boundary
                         boundaries <= 33'd1;
                         tau_phase <= phase_q[TAU_PHASE_W-1:0] - TAU[TAU_PHASE_W-1:0];
                         per_frame <= K_FRAME_PER_TAU;
-                        state <= ST_SWEEP;
                     end else begin
                         phase_step <= PHASE_BY_TAU;
                     end
@@ -1059,21 +1080,18 @@ module evclust_core #(
                         tau_phase <= by_tau_left[TAU_PHASE_W-1:0];
                         if (many_boundaries) begin  // T_frame / (n tau) leaves nothing
                             per_frame <= {FRAME_PER_TAU_W{1'b0}};
-                            state <= ST_SWEEP;
                         end else begin
                             phase_step <= PHASE_FRAME;
                         end
                     end
                     default: if (frame_done) begin
                         per_frame <= frame_q;
-                        state <= ST_SWEEP;
                     end
                 endcase
                 ST_MERGE: begin  // the dividers started in the first cycle; the slot written in the last
                     m_started <= 1'b1;
                     if (m_write) begin
-                        m_started <= 1'b0;
-                        state <= ST_SWEEP;  // the same slot again: it may absorb another
+                        m_started <= 1'b0;  // SWEEP then takes the same slot again: it may absorb another
                     end
                 end
                 default: ;
@@ -1110,10 +1128,8 @@ module evclust_core #(
                     phase_q <= phase;
                     phase_step <= PHASE_DECIDE;
                     index <= {SWEEP_W{1'b0}};
-                    state <= ST_PHASE;
                 end else begin
                     since_filter <= since_filter + 1'b1;
-                    state <= ST_IDLE;
                 end
             end
 
@@ -1131,7 +1147,6 @@ module evclust_core #(
                 e_free_second <= free_second;
                 if (state != ST_IDLE)
                     seek_w <= written_slot;
-                state <= ST_EXEC;
             end
             if (ev_valid && ev_ready) begin
                 a_t <= in_t;
