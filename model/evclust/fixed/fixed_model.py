@@ -238,6 +238,15 @@ def _mixing_palette(ey, ecb, ecr, bg, palette, inv_ww, background_mask, k):
 
 
 @numba.njit(cache=True, nogil=True)
+def palette_vote(lum, cb, cr, G, k):
+    """The event's vote: 1, or with contrast votes |e - BG|₁ from the exact background, rounded half up."""
+    if k[C_VOTE_CONTRAST] == 0:
+        return np.int64(1)
+    fb = k[C_FB]
+    return (abs((lum << fb) - G[BG_Y]) + abs((cb << fb) - G[BG_CB]) + abs((cr << fb) - G[BG_CR]) + (np.int64(1) << (fb - 1))) >> fb
+
+
+@numba.njit(cache=True, nogil=True)
 def refresh_mixing(G, palette, inv_ww, k):
     """1/|palette_j - BG|² in Q0.32 (integer colours): a division per entry, at filter steps only."""
     fb = k[C_FB]
@@ -308,9 +317,7 @@ def _update(S, H, G, s, t, ex, ey, lum, cb, cr, k, table, palette, inv_ww, backg
             c = _mixing_palette(lum, cb, cr, bg, palette, inv_ww, background_mask, k)
         else:
             c = _nearest_palette(lum, cb, cr, palette, k)
-        vote = np.int64(1)
-        if k[C_VOTE_CONTRAST] != 0:  # |e - BG|₁ from the exact background, rounded half up
-            vote = (abs((lum << fb) - G[BG_Y]) + abs((cb << fb) - G[BG_CB]) + abs((cr << fb) - G[BG_CR]) + (np.int64(1) << (fb - 1))) >> fb
+        vote = palette_vote(lum, cb, cr, G, k)
         # Saturating by design (SPEC §4): reaching the top halves every counter, so not an overflow.
         H[s, c] = min(_seen(H[s, c] + vote, S_HIST, ranges), k[C_H_MAX])
         if H[s, c] >= k[C_H_MAX]:

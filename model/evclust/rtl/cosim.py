@@ -23,6 +23,8 @@ TOPLEVEL = "evclust_tb"
 BENCHES = {
     "evclust_tb": ((TB_DIR / "evclust_tb.v",), TB_DIR, "test_evclust_core"),
     "evclust_axis": ((), TB_DIR.parent / "evclust_axis", "test_evclust_axis"),
+    "evclust_decay": ((), TB_DIR.parent / "evclust_decay", "test_evclust_decay"),
+    "evclust_palette": ((), TB_DIR.parent / "evclust_palette", "test_evclust_palette"),
 }
 
 

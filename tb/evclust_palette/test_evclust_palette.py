@@ -1,0 +1,187 @@
+"""evclust_palette, one event's palette class and vote, against the fixed model's functions
+(`_nearest_palette`, `_mixing_palette`, `palette_vote`) under Icarus and Verilator.
+
+The inputs are the run-time registers (palette colours, w_Y, the mixing tolerance, the background
+entries, the switches), the background and the mixing table 1/|w|^2, which the core refreshes
+with the model's `refresh_mixing` rule; each case draws them at random. Exhaustive where the
+space is small: every value 0..255 of each colour channel of the event (the other two held),
+under each of the four switch settings; random elsewhere: whole random events and registers,
+and events placed on or near a background-to-entry segment, where the mixing rule decides.
+
+The cocotb test runs inside the simulator (configured by EVCLUST_TB); the pytest function builds
+and launches it through `cocotb_tools.runner`, as tb/evclust_core/test_evclust_core.py.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import random
+import sys
+from pathlib import Path
+
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+try:
+    import cocotb
+    from cocotb.triggers import Timer
+except ImportError:  # collected by pytest without cocotb: the pytest half still reports why
+    cocotb = None
+
+SETTINGS = 24  # random register settings; each runs the channel sweeps and the random events
+RANDOM_EVENTS = 64
+SWITCHES = ((0, 0), (0, 1), (1, 0), (1, 1))  # (mixing, vote_contrast)
+
+
+class Palette:
+    """One random register setting and the model's view of it (k, G, palette, inv_ww, mask)."""
+
+    def __init__(self, config: dict, rng: random.Random):
+        import numpy as np
+
+        from evclust.clusterer.layout import BG_CB, BG_CR, BG_Y
+        from evclust.fixed import fixed_model as fm
+
+        w = config["widths"]
+        self.size = w["P"]
+        self.k = np.array(config["k"], np.int64)
+        self.k[fm.C_LUMA_W] = rng.randrange(1 << w["LUMA_BITS"])
+        self.k[fm.C_MIX_TOL] = rng.choice((0, rng.randrange(1 << w["TOL_BITS"]), (1 << w["TOL_BITS"]) - 1))
+        self.palette = np.array([[rng.randrange(256) for _ in range(3)] for _ in range(self.size)], np.int64)
+        if rng.random() < 0.3:  # equal entries: ties go to the lower index
+            self.palette[rng.randrange(self.size)] = self.palette[rng.randrange(self.size)]
+        self.mask = np.array([rng.random() < 0.25 for _ in range(self.size)], np.bool_)
+        self.G = np.zeros(fm.N_GLOBALS, np.int64)
+        bg_max = (255 << self.k[fm.C_FB]) | ((1 << self.k[fm.C_FB]) - 1)
+        for column in (BG_Y, BG_CB, BG_CR):
+            self.G[column] = rng.randrange(bg_max + 1)
+        if rng.random() < 0.2:  # the background on an entry: |w|^2 = 0, whose 1/|w|^2 is 0
+            j = rng.randrange(self.size)
+            for column, channel in ((BG_Y, 0), (BG_CB, 1), (BG_CR, 2)):
+                self.G[column] = int(self.palette[j, channel]) << self.k[fm.C_FB]
+        self.inv_ww = np.zeros(self.size, np.int64)
+        fm.refresh_mixing(self.G, self.palette, self.inv_ww, self.k)
+        self.bg = tuple(int(self.G[c]) for c in (BG_Y, BG_CB, BG_CR))
+
+    def expect(self, lum: int, cb: int, cr: int, mixing: int, vote_contrast: int) -> tuple[int, int]:
+        from evclust.fixed import fixed_model as fm
+
+        fb = int(self.k[fm.C_FB])
+        if mixing:
+            bg = tuple(v >> fb for v in self.bg)
+            c = fm._mixing_palette(lum, cb, cr, bg, self.palette, self.inv_ww, self.mask, self.k)
+        else:
+            c = fm._nearest_palette(lum, cb, cr, self.palette, self.k)
+        self.k[fm.C_VOTE_CONTRAST] = vote_contrast
+        return int(c), int(fm.palette_vote(lum, cb, cr, self.G, self.k))
+
+    def events(self, rng: random.Random):
+        """Each channel swept over 0..255 with the others held, random events, events on segments."""
+        held = [rng.randrange(256) for _ in range(3)]
+        for channel in range(3):
+            for value in range(256):
+                colour = list(held)
+                colour[channel] = value
+                yield tuple(colour)
+        for _ in range(RANDOM_EVENTS):
+            yield tuple(rng.randrange(256) for _ in range(3))
+        from evclust.fixed.fixed_model import C_FB
+
+        bg = [v >> int(self.k[C_FB]) for v in self.bg]
+        for _ in range(RANDOM_EVENTS):  # on a segment background -> entry, nudged
+            j, q = rng.randrange(self.size), rng.random()
+            yield tuple(min(255, max(0, round(b + q * (int(p) - b)) + rng.randint(-2, 2))) for b, p in zip(bg, self.palette[j]))
+
+
+if cocotb is not None:
+
+    @cocotb.test()
+    async def palette_vectors(dut):
+        """Every case through the combinational module; the first difference from the model fails."""
+        config = json.loads(os.environ["EVCLUST_TB"])
+        try:
+            result = await _palette_vectors(dut, config)
+        except Exception as exc:
+            result = {"checked": 0, "classes": [], "error": f"{type(exc).__name__}: {exc}"}
+        Path(config["out"]).write_text(json.dumps(result))
+        assert result["error"] is None, result["error"]
+
+    async def _palette_vectors(dut, config):
+        rng = random.Random(config["seed"])
+        error, checked, classes = None, 0, set()
+        inv_bits = config["widths"]["INV_BITS"]
+        for _ in range(SETTINGS):
+            pal = Palette(config, rng)
+            for port, channel in (("palette_y", 0), ("palette_cb", 1), ("palette_cr", 2)):
+                getattr(dut, port).value = sum(int(pal.palette[j, channel]) << (8 * j) for j in range(pal.size))
+            dut.inv_ww.value = sum(int(pal.inv_ww[j]) << (inv_bits * j) for j in range(pal.size))
+            dut.background_mask.value = sum(int(pal.mask[j]) << j for j in range(pal.size))
+            dut.bg_y.value, dut.bg_cb.value, dut.bg_cr.value = pal.bg
+            from evclust.fixed.fixed_model import C_LUMA_W, C_MIX_TOL
+
+            dut.luma_weight.value = int(pal.k[C_LUMA_W])
+            dut.mixing_tolerance.value = int(pal.k[C_MIX_TOL])
+            for lum, cb, cr in pal.events(rng):
+                dut.lum.value, dut.cb.value, dut.cr.value = lum, cb, cr
+                for mixing, vote_contrast in SWITCHES:
+                    dut.mixing.value, dut.vote_contrast.value = mixing, vote_contrast
+                    await Timer(1, unit="ns")
+                    got = (int(dut.class_index.value), int(dut.vote.value))
+                    want = pal.expect(lum, cb, cr, mixing, vote_contrast)
+                    checked += 1
+                    classes.add((mixing, got[0]))
+                    if got != want:
+                        error = (f"event ({lum}, {cb}, {cr}), mixing={mixing}, vote_contrast={vote_contrast}, palette "
+                                 f"{pal.palette.tolist()}, background {pal.bg}, mask {pal.mask.tolist()}, w_Y {pal.k[C_LUMA_W]}, "
+                                 f"tolerance {pal.k[C_MIX_TOL]}: RTL (class, vote) {got}, model {want}")  # fmt: skip
+                        break
+                if error:
+                    break
+            if error:
+                break
+        return {"checked": checked, "classes": sorted(classes), "error": error}
+
+
+# ------------------------------------------------------------------------------------------
+# pytest: build, launch, check.
+
+from cosim import configuration_params, run, selected_simulators  # noqa: E402
+
+# Builds whose palette widths differ: the traffic preset (8 entries), and the defaults (every
+# addition on, the mixing rule's formats) on a suite-sized sensor.
+BUILDS = {"traffic": (480, 270, 50000.0), "defaults": (160, 120, 16666.0)}
+
+
+def _width(constants: dict, name: str) -> int:
+    """A constant's register width; 1 for one the parameter set leaves out (the header's rule)."""
+    return constants[name].fmt.word_bits if name in constants else 1
+
+
+def palette_build(name: str) -> tuple[str, dict, dict]:
+    """(header, module parameters, cocotb configuration) of a build."""
+    from evclust.fixed.formats import verilog_header
+    from evclust.fixed.model import FixedClusterer
+
+    width, height, t_frame = BUILDS[name]
+    model = FixedClusterer(configuration_params(name, 16), width, height, t_frame)
+    table = model.table
+    size = table.palette_size
+    c = table.constants
+    widths = {"P": size, "CLASS_W": max(1, (size - 1).bit_length()), "BG_BITS": table["background"].word_bits,
+              "INV_BITS": table["inv_ww"].word_bits, "VOTE_BITS": table["vote"].word_bits,
+              "LUMA_BITS": _width(c, "luma_weight"), "TOL_BITS": _width(c, "mixing_tolerance")}  # fmt: skip
+    return verilog_header(table), widths, {"widths": widths, "k": [int(v) for v in model.k]}
+
+
+@pytest.mark.parametrize("build", sorted(BUILDS))
+@pytest.mark.parametrize("sim", selected_simulators())
+def test_the_palette_class_and_vote_match_the_models_functions(sim, build):
+    header, parameters, config = palette_build(build)
+    result = run(sim, header, "palette_vectors", config | {"seed": 11}, toplevel="evclust_palette", parameters=parameters)
+    assert result["checked"] == SETTINGS * (3 * 256 + 2 * RANDOM_EVENTS) * len(SWITCHES)
+    size = parameters["P"]
+    # Both rules chose every entry somewhere, so no class index went untested.
+    assert {c for m, c in result["classes"] if m == 0} == set(range(size))
+    assert {c for m, c in result["classes"] if m == 1} == set(range(size))
