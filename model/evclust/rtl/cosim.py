@@ -13,6 +13,8 @@ import shutil
 import sysconfig
 from pathlib import Path
 
+from filelock import FileLock
+
 from evclust.choices import SIMULATORS
 from evclust.errors import EvclustError
 from evclust.rtl.sources import BUILD, RTL_DIR, RTL_INCLUDES, RTL_SOURCES, TB_DIR, require_repository
@@ -72,13 +74,15 @@ def build(sim: str, header: str, toplevel: str = TOPLEVEL, parameters: dict | No
         digest.update(path.read_bytes())
     build_dir = BUILD / "cosim" / sim / digest.hexdigest()[:16]
     src = build_dir / "src"
-    if not (src / "evclust_params.vh").exists():
-        src.mkdir(parents=True, exist_ok=True)
-        for path in (*sources, *INCLUDES):
-            shutil.copy(path, src / path.name)
-        (src / "evclust_params.vh").write_text(header)  # beside the sources, so it is the one included
     runner = get_runner(sim)
-    with _pch_include():
+    build_dir.parent.mkdir(parents=True, exist_ok=True)
+    # One build at a time per directory: pytest-xdist workers share the cache.
+    with FileLock(build_dir.with_suffix(".lock")), _pch_include():
+        if not (src / "evclust_params.vh").exists():
+            src.mkdir(parents=True, exist_ok=True)
+            for path in (*sources, *INCLUDES):
+                shutil.copy(path, src / path.name)
+            (src / "evclust_params.vh").write_text(header)  # beside the sources, so it is the one included
         runner.build(
             sources=[src / p.name for p in sources], includes=[src], hdl_toplevel=toplevel,
             build_dir=build_dir, build_args=args, timescale=("1ns", "1ps"), log_file=build_dir / "build.log", parameters=parameters,
