@@ -1287,5 +1287,9 @@ module evclust_core #(
             end
         end
     end
+
+`ifdef FORMAL
+`include "evclust_core_props.vh"  // formal/evclust_core/: the stream properties, for SymbiYosys only
+`endif
 endmodule
 `default_nettype wire
