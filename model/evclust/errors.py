@@ -21,6 +21,14 @@ def validation_message(exc, prefix: str = "") -> str:
     return f"{where}: {err['msg']}{more}" if where else f"{err['msg']}{more}"
 
 
+def read_text(path: str | os.PathLike) -> str:
+    """A text input (scene, parameters) as UTF-8, or one line saying why it cannot be read."""
+    try:
+        return Path(path).read_bytes().decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise EvclustError(f"{path}: not UTF-8 text (byte {exc.start}); save it as UTF-8") from None
+
+
 @contextlib.contextmanager
 def atomic_output(path: str | os.PathLike, suffix: str | None = None):
     """Yield a temporary path beside `path`; move it into place only if the block succeeds.
@@ -28,6 +36,16 @@ def atomic_output(path: str | os.PathLike, suffix: str | None = None):
     A failed run therefore never leaves a partial output file behind.
     """
     path = Path(path)
+    if path.is_dir():
+        raise EvclustError(f"{path}: is a folder; give a file name")
+    if path.exists() and not path.is_file():  # a device or FIFO (/dev/null, /dev/full): written in place, never replaced
+        try:
+            yield path
+        except OSError as exc:
+            if exc.filename:
+                raise
+            raise EvclustError(f"{path}: {exc.strerror or exc}") from None  # /dev/full: name the file
+        return
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix or path.suffix, dir=path.parent)
     os.close(fd)

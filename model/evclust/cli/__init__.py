@@ -3,17 +3,30 @@
 from __future__ import annotations
 
 import argparse
+import signal
 import sys
+import threading
 
 from evclust import __version__
 from evclust.cli import formats, generalize, plot, reference, render, report, scenes, score, show, simulate, track, tune, vectors
+from evclust.cli.common import refuse_overwriting
 from evclust.errors import EvclustError
 
 VERBS = (simulate, track, score, reference, tune, formats, vectors, report, show, render, plot, scenes, generalize)
 
 
+class Parser(argparse.ArgumentParser):
+    """argparse with the CLI's promise: a usage error is one line ('evclust VERB --help' has the
+    rest) and exit code 2. Sub-parsers are made of the same class."""
+
+    def error(self, message: str):
+        verb = self.prog.removeprefix("evclust").strip()
+        print(f"evclust: error: {verb + ': ' if verb else ''}{message} (see '{self.prog} --help')", file=sys.stderr)
+        raise SystemExit(2)
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = Parser(
         prog="evclust",
         description=(
             "Colour event camera simulator and event-by-event clusterer. "
@@ -28,17 +41,37 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+class Terminated(KeyboardInterrupt):
+    """SIGTERM, handled as Ctrl-C is: the run unwinds, so no temporary or partial file is left."""
+
+
+def _terminate(signum, frame):
+    raise Terminated
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
-    args = parser.parse_args(argv)
     try:
+        args = parser.parse_args(argv)
+    except SystemExit as exc:  # --help, --version, or a usage error already reported in one line
+        return exc.code if isinstance(exc.code, int) else 2
+    main_thread = threading.current_thread() is threading.main_thread()  # signal handlers live there only
+    previous = signal.signal(signal.SIGTERM, _terminate) if main_thread else None
+    try:
+        refuse_overwriting(args)
         return args.run(args) or 0
     except EvclustError as exc:
         print(f"evclust: error: {exc}", file=sys.stderr)
         return 2
+    except Terminated:
+        print("evclust: terminated", file=sys.stderr)
+        return 128 + signal.SIGTERM
     except KeyboardInterrupt:
         print("evclust: interrupted", file=sys.stderr)
         return 130
     except OSError as exc:  # output folder not writable, disk full, ...
         print(f"evclust: error: {exc.filename or ''}: {exc.strerror or exc}", file=sys.stderr)
         return 2
+    finally:
+        if main_thread:
+            signal.signal(signal.SIGTERM, previous)

@@ -11,3 +11,59 @@ PACKAGE = Path(__file__).resolve().parents[1]
 def preset_list() -> str:
     """The clusterer presets' names, from the files (the same list `load_params` accepts)."""
     return ", ".join(sorted(p.stem for p in (PACKAGE / "clusterer" / "presets").glob("*.toml")))
+
+
+# Each verb's file arguments (argparse dests): those it reads and those it writes. An output that
+# is one of the inputs, or another of the outputs, is refused before anything runs: the run
+# would replace a file it reads, or one output would replace the other.
+FILE_ARGUMENTS = {
+    "simulate": (("scene",), ("output", "truth")),
+    "track": (("events", "params"), ("output",)),
+    "score": (("tracks", "truth"), ("json",)),
+    "reference": (("video", "params"), ("output",)),
+    "tune": (("scene", "params"), ("output",)),
+    "formats": (("params", "write_for"), ("verilog", "c_header", "registers")),
+    "show": (("events",), ("output",)),
+    "render": (("events", "tracks"), ("output",)),
+    "plot": (("tracks", "truth", "events"), ("output",)),
+    "generalize": ((), ("output",)),
+}
+POSITIONAL = ("scene", "events", "tracks", "video")
+
+
+def _label(dest: str) -> str:
+    if dest in POSITIONAL:
+        return dest.upper()
+    return "-o" if dest == "output" else "--" + dest.replace("_", "-")
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    """One file by inode when both exist (links and symlinks too), else by resolved path."""
+    import os
+
+    if a.exists() and b.exists():
+        return os.path.samefile(a, b)
+    return a.resolve() == b.resolve()
+
+
+def refuse_overwriting(args) -> None:
+    """EvclustError when an output of this run is one of its inputs or another output. Special
+    files (/dev/null, a FIFO) may take several outputs and are never replaced, so they pass."""
+    import stat
+
+    from evclust.errors import EvclustError
+
+    inputs, outputs = FILE_ARGUMENTS.get(getattr(args, "verb", ""), ((), ()))
+    taken = [(dest, Path(getattr(args, dest))) for dest in inputs if getattr(args, dest, None) and Path(getattr(args, dest)).is_file()]
+    for dest in outputs:
+        value = getattr(args, dest, None)
+        if not value:
+            continue
+        path = Path(value)
+        if path.exists() and not stat.S_ISREG(path.stat().st_mode):
+            continue
+        for other, other_path in taken:
+            if _same_file(path, other_path):
+                role = "an input" if other in inputs else "another output"
+                raise EvclustError(f"{_label(dest)} {value}: is {role} of this run ({_label(other)} {other_path}); write it elsewhere")
+        taken.append((dest, path))

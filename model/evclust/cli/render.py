@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 from evclust.errors import EvclustError
@@ -41,7 +42,7 @@ def run(args) -> int:
     suffix = out.suffix.lower()
     if suffix not in VIDEO_SUFFIXES + PNG_SUFFIXES:
         raise EvclustError(f"{out}: the output must be a video (.mp4) or a picture (.png), not '{out.suffix or '(none)'}'")
-    if args.window is not None and not args.window > 0:
+    if args.window is not None and not 0 < args.window < math.inf:
         raise EvclustError(f"--window {args.window:g}: must be a positive number of µs")
     if not 1 <= args.scale <= 16:
         raise EvclustError(f"--scale {args.scale}: must be an integer from 1 to 16")
@@ -49,8 +50,8 @@ def run(args) -> int:
         raise EvclustError(f"--arrow-frames {args.arrow_frames:g}: must not be negative")
     for name in ("t0", "t1"):
         value = getattr(args, name)
-        if value is not None and not value >= 0:
-            raise EvclustError(f"--{name} {value:g}: must be a time in µs, >= 0")
+        if value is not None and not 0 <= value < math.inf:
+            raise EvclustError(f"--{name} {value:g}: must be a finite time in µs, >= 0")
     source = open_events(args.events)
     events, ev_meta = source.read(), source.meta
     tracks, track_meta = read_tracks(args.tracks)

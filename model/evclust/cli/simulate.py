@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import shutil
 import sys
+from pathlib import Path
 
 from evclust.errors import EvclustError, atomic_output
 
@@ -29,11 +30,18 @@ def add_parser(sub) -> None:
     p.set_defaults(run=run)
 
 
+# Frame rates a simulation accepts: slower than one frame in 1000 s puts event times past what
+# the µs clock holds over a long video; faster than 10^6 frames/s leaves under 1 µs per frame.
+MIN_FPS, MAX_FPS = 1e-3, 1e6
+
+
 def run(args) -> int:
     if args.frames is not None and args.frames < 2:
         raise EvclustError(f"--frames {args.frames}: at least 2 frames are needed to see a change")
-    if args.fps is not None and args.fps <= 0:
-        raise EvclustError(f"--fps {args.fps}: the frame rate must be positive")
+    if args.fps is not None and not MIN_FPS <= args.fps <= MAX_FPS:  # NaN fails both
+        raise EvclustError(f"--fps {args.fps}: the frame rate must be between {MIN_FPS:g} and {MAX_FPS:g} frames/s")
+    if args.seed is not None and args.seed < 0:
+        raise EvclustError(f"--seed {args.seed}: a seed is a whole number >= 0")
     from evclust.events import event_writer
     from evclust.scenes import load_scene, write_truth
     from evclust.simulator import Simulation, stream_scene
@@ -42,20 +50,29 @@ def run(args) -> int:
     if args.truth and not scene.has_truth:
         raise EvclustError(f"{args.scene}: no ground truth for this scene (a video needs a CSV of the same name beside it)")
     stream = stream_scene(scene, seed=args.seed, progress=not args.quiet)
-    # Written as made, so memory does not grow with the video; a failure leaves no file.
-    with event_writer(args.output, stream.meta, evt_version=args.evt) as writer:
-        for chunk in stream:
-            writer.write(chunk)
-        result = Simulation(None, stream.meta, stream.samples, stream.sample_period_us, stream.wall_s, count=writer.count)
-        if result.frames < 2:
-            raise EvclustError(f"{args.scene}: only {result.frames} frame(s) could be read; at least 2 are needed")
-    if args.truth:
-        if scene.truth_path is not None:
-            with atomic_output(args.truth) as tmp:
-                shutil.copyfile(scene.truth_path, tmp)
-        else:
-            rows = scene.source.truth()
-            write_truth(args.truth, [r for r in rows if r["frame"] < result.frames])
+    # Written as made, so memory does not grow with the video; a failure leaves no file. The
+    # truth is written before the events are committed, and removed if they are not: both
+    # outputs or neither.
+    truth_written = False
+    try:
+        with event_writer(args.output, stream.meta, evt_version=args.evt) as writer:
+            for chunk in stream:
+                writer.write(chunk)
+            result = Simulation(None, stream.meta, stream.samples, stream.sample_period_us, stream.wall_s, count=writer.count)
+            if result.frames < 2:
+                raise EvclustError(f"{args.scene}: only {result.frames} frame(s) could be read; at least 2 are needed")
+            if args.truth:
+                if scene.truth_path is not None:
+                    with atomic_output(args.truth) as tmp:
+                        shutil.copyfile(scene.truth_path, tmp)
+                else:
+                    rows = scene.source.truth()
+                    write_truth(args.truth, [r for r in rows if r["frame"] < result.frames])
+                truth_written = True
+    except BaseException:
+        if truth_written:
+            Path(args.truth).unlink(missing_ok=True)
+        raise
     print(result.summary())
     sys.stdout.flush()
     return 0

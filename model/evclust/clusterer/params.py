@@ -16,7 +16,7 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 from evclust.colour import rgb_to_ycbcr
-from evclust.errors import EvclustError, validation_message
+from evclust.errors import EvclustError, read_text, validation_message
 
 Alpha = Annotated[float, Field(ge=0.0, lt=1.0)]
 Positive = Annotated[float, Field(gt=0.0)]
@@ -27,7 +27,7 @@ Byte = Annotated[float, Field(ge=0.0, le=255.0)]
 class PaletteEntry(BaseModel):
     """A colour class: a name (matched against ground-truth labels) and its RGB colour."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)  # NaN and inf: refused at the source
     name: Annotated[str, Field(min_length=1)]
     rgb: tuple[Byte, Byte, Byte]
 
@@ -46,7 +46,7 @@ DEFAULT_PALETTE = (
 
 
 class ClustererParams(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)  # NaN and inf: refused at the source
 
     # The cluster table and the seek region (§5.2).
     n_clusters: Annotated[int, Field(ge=1, le=1024)] = 16  # N slots
@@ -208,7 +208,7 @@ def load_params(ref: str | Path | None, source: str = "") -> tuple[ClustererPara
     if path.suffix.lower() == ".toml":
         if not path.is_file():
             raise EvclustError(f"{path}: no such parameter file")
-        return parse_params(path.read_text(), str(path)), str(path)
+        return parse_params(read_text(path), str(path)), str(path)
     if str(ref) in preset_names():
         text = (resources.files("evclust.clusterer") / "presets" / f"{ref}.toml").read_text()
         return parse_params(text, f"preset '{ref}'"), f"preset '{ref}'"

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import math
 
 import numpy as np
 
@@ -39,8 +40,54 @@ class EventMeta:
 
     @classmethod
     def from_dict(cls, d: dict) -> "EventMeta":
+        """From a file's metadata, checked: EvclustError names the first value out of place."""
         known = {f.name for f in dataclasses.fields(cls)}
-        return cls(**{k: v for k, v in d.items() if k in known})
+        meta = cls(**{k: v for k, v in d.items() if k in known})
+        meta.check()
+        return meta
+
+    def check(self) -> None:
+        """Types and ranges a stream can be run with; a sensor beyond the limit (the environment's
+        EVCLUST_MAX_SENSOR_PIXELS, default 2^25) is refused before anything is allocated."""
+        from evclust.errors import EvclustError
+
+        for key in ("width", "height"):
+            value = getattr(self, key)
+            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not 1 <= value <= MAX_SENSOR_SIDE:
+                raise EvclustError(f"metadata: sensor {key} {value!r}: expected a whole number of pixels from 1 to {MAX_SENSOR_SIDE}")
+        limit = max_sensor_pixels()
+        if int(self.width) * int(self.height) > limit:
+            raise EvclustError(f"metadata: a {self.width}x{self.height} sensor is over {limit:,} pixels (set EVCLUST_MAX_SENSOR_PIXELS to allow it)")
+        t = self.t_frame_us
+        if t is not None and (isinstance(t, bool) or not isinstance(t, (int, float, np.integer, np.floating)) or not 0 < t < math.inf):
+            raise EvclustError(f"metadata: t_frame_us {t!r}: expected a positive, finite frame period in µs")
+        if not isinstance(self.source, str):
+            raise EvclustError(f"metadata: source {self.source!r}: expected text")
+        if not isinstance(self.has_colour, (bool, np.bool_)):
+            raise EvclustError(f"metadata: has_colour {self.has_colour!r}: expected true or false")
+
+
+# x and y are 16-bit; a sensor's pixel count is bounded separately (max_sensor_pixels).
+MAX_SENSOR_SIDE = 65535
+DEFAULT_MAX_SENSOR_PIXELS = 1 << 25  # an 8K sensor, 7680 x 4320, fits
+
+
+def max_sensor_pixels() -> int:
+    """The largest sensor accepted: EVCLUST_MAX_SENSOR_PIXELS if set (a user's explicit raise)."""
+    import os
+
+    from evclust.errors import EvclustError
+
+    raw = os.environ.get("EVCLUST_MAX_SENSOR_PIXELS")
+    if raw is None:
+        return DEFAULT_MAX_SENSOR_PIXELS
+    try:
+        value = int(raw)
+    except ValueError:
+        raise EvclustError(f"EVCLUST_MAX_SENSOR_PIXELS={raw!r}: expected a whole number") from None
+    if value < 1:
+        raise EvclustError(f"EVCLUST_MAX_SENSOR_PIXELS={raw!r}: expected a positive number")
+    return value
 
 
 _RECORD = np.dtype((np.void, EVENT_DTYPE.itemsize))

@@ -72,7 +72,10 @@ class EventReader:
         for key in ("width", "height"):
             if key not in meta_dict:
                 raise EvclustError(f"{path}: metadata has no sensor {key}")
-        self.meta = EventMeta.from_dict(meta_dict)
+        try:
+            self.meta = EventMeta.from_dict(meta_dict)
+        except EvclustError as exc:
+            raise EvclustError(f"{path}: {exc}") from None
 
     def chunks(self, size: int = CHUNK) -> Iterator[np.ndarray]:
         """Validated EVENT_DTYPE chunks of about `size` events, in stream order."""
@@ -136,9 +139,11 @@ def _read_npz(path: Path) -> tuple[dict[str, np.ndarray], dict]:
                 raise EvclustError(f"{path}: no 'events' array (found: {', '.join(z.files) or 'nothing'})")
             events = z["events"]
             meta = json.loads(str(z["meta"])) if "meta" in z.files else {}
+            if not isinstance(meta, dict):
+                raise EvclustError(f"{path}: metadata is {type(meta).__name__}, expected a JSON object")
     except EvclustError:
         raise
-    except (OSError, ValueError, zipfile.BadZipFile, json.JSONDecodeError) as exc:
+    except (OSError, ValueError, EOFError, zipfile.BadZipFile, json.JSONDecodeError) as exc:
         raise EvclustError(f"{path}: not a readable event file ({exc.__class__.__name__}: {exc})") from None
     if events.dtype.names is None:
         raise EvclustError(f"{path}: 'events' is not a structured array with fields {', '.join(EVENT_DTYPE.names)}")
@@ -158,7 +163,7 @@ def _hdf5_header(path: Path) -> tuple[dict, int]:
             group = f["events"]
             _check_fields(path, group.keys())
             count = group["t"].shape[0] if group["t"].ndim == 1 else -1
-            meta = {k: (v.item() if hasattr(v, "item") else v) for k, v in f.attrs.items()}
+            meta = {k: (v.item() if getattr(v, "size", 0) == 1 else v) for k, v in f.attrs.items()}  # arrays stay, for check() to refuse
             meta["has_colour"] = COLOUR_FIELDS[0] in group
     except EvclustError:
         raise

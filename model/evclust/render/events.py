@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import matplotlib
@@ -11,7 +12,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from evclust.colour import ycbcr_to_rgb  # noqa: E402
-from evclust.errors import atomic_output  # noqa: E402
+from evclust.errors import EvclustError, atomic_output  # noqa: E402
 from evclust.events.format import EventMeta  # noqa: E402
 
 
@@ -28,6 +29,13 @@ def _window(ev: np.ndarray, meta: EventMeta, t0_us: float | None, span_us: float
 
 def draw_events(ev: np.ndarray, meta: EventMeta, path: str | Path, t0_us: float | None = None, span_us: float | None = None) -> None:
     """Three panels: ON/OFF events of a time window, the colour those events carry, events per frame."""
+    from evclust.render.plots import check_plot_path
+
+    check_plot_path(path)
+    if t0_us is not None and not math.isfinite(t0_us):
+        raise EvclustError(f"--t0 {t0_us}: a start time in µs must be a finite number")
+    if span_us is not None and not 0 < span_us < math.inf:
+        raise EvclustError(f"--span {span_us}: the window's length in µs must be positive and finite")
     win = _window(ev, meta, t0_us, span_us)
     polarity = np.full((meta.height, meta.width, 3), 0.5)
     colour = np.zeros((meta.height, meta.width, 3))

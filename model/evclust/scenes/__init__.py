@@ -9,7 +9,7 @@ from pathlib import Path
 
 from pydantic import ValidationError
 
-from evclust.errors import EvclustError, validation_message
+from evclust.errors import EvclustError, read_text, validation_message
 from evclust.scenes.schema import SceneSpec, SensorSpec
 from evclust.scenes.synthetic import TRUTH_COLUMNS, SyntheticSource
 from evclust.scenes.truth import write_truth
@@ -61,7 +61,7 @@ def load_scene(ref: str | Path, fps: float | None = None, max_frames: int | None
     if path.suffix.lower() == ".toml":
         if not path.is_file():
             raise EvclustError(f"{path}: no such scene file")
-        spec = parse_scene(path.read_text(), str(path))
+        spec = parse_scene(read_text(path), str(path))
         base = path.parent
         label = str(path)
     elif path.exists():  # a video or a folder of images

@@ -1,0 +1,319 @@
+"""Hostile and careless input to the command line. The promise, checked for every case: exit code
+2, one line on stderr, no traceback, no partial or replaced output, and every input unchanged.
+
+Classes here: an output that is an input (by path, by a second path to it, by a hard link or a
+symlink), two outputs that are one file, an output that is a folder, special files as outputs
+(written in place, never replaced; a full device is an error), and SIGTERM mid-run.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from evclust.cli import main
+
+SCENE = """
+width = 40
+height = 30
+fps = 30
+frames = 6
+[[objects]]
+id = 1
+label = "red"
+size = [8, 8]
+colour = [210, 40, 40]
+start = [10, 15]
+legs = [{ frames = 5, velocity = [2.0, 0.0] }]
+"""
+
+
+@pytest.fixture(scope="module")
+def files(tmp_path_factory):
+    """A scene, its events and truth, tracks, a score JSON and a parameter file, made once."""
+    root = tmp_path_factory.mktemp("hostile")
+    (root / "scene.toml").write_text(SCENE)
+    (root / "params.toml").write_text("[clusterer]\nn_clusters = 4\n")
+    assert main(["simulate", str(root / "scene.toml"), "-o", str(root / "ev.npz"), "--truth", str(root / "gt.csv"), "-q"]) == 0
+    assert main(["track", str(root / "ev.npz"), "-o", str(root / "tracks.csv"), "-q"]) == 0
+    return root
+
+
+def snapshot(folder: Path) -> dict:
+    """Every file under the folder and its content hash (links by what they point at)."""
+    return {str(p.relative_to(folder)): hashlib.sha256(p.read_bytes()).hexdigest() for p in sorted(folder.rglob("*")) if p.is_file()}
+
+
+def work_folder(files: Path, tmp_path: Path) -> Path:
+    """A copy of the inputs for one case, so a case that destroys one harms no other."""
+    for name in ("scene.toml", "params.toml", "ev.npz", "gt.csv", "tracks.csv"):
+        (tmp_path / name).write_bytes((files / name).read_bytes())
+    (tmp_path / "sub").mkdir()
+    os.link(tmp_path / "ev.npz", tmp_path / "ev_hardlink.npz")
+    os.symlink(tmp_path / "tracks.csv", tmp_path / "tracks_symlink.csv")
+    os.symlink(tmp_path / "gt.csv", tmp_path / "gt_symlink.csv")
+    return tmp_path
+
+
+def assert_refused(capsys, folder: Path, argv: list[str], *fragments: str) -> None:
+    before = snapshot(folder)
+    code = main(argv)
+    out, err = capsys.readouterr()
+    lines = err.strip().splitlines()
+    assert code == 2, (code, out, err)
+    assert len(lines) == 1 and lines[0].startswith("evclust: error: "), err
+    assert "Traceback" not in err
+    for fragment in fragments:
+        assert fragment in lines[0], lines[0]
+    assert snapshot(folder) == before, "an input changed or an output was left"
+
+
+# (argv with {d} for the folder, fragments the error line must hold). Every output here names a
+# file the same run reads or writes, directly or through a second path.
+OVERWRITES = {
+    "track -o = its events": (["track", "{d}/ev.npz", "-o", "{d}/ev.npz"], ["-o", "EVENTS"]),
+    "track -o = its events through ./": (["track", "{d}/ev.npz", "-o", "{d}/./ev.npz"], ["is an input"]),
+    "track -o = its events through sub/..": (["track", "{d}/ev.npz", "-o", "{d}/sub/../ev.npz"], ["is an input"]),
+    "track -o = a hard link to its events": (["track", "{d}/ev.npz", "-o", "{d}/ev_hardlink.npz"], ["is an input"]),
+    "track -o = its parameter file": (["track", "{d}/ev.npz", "-o", "{d}/params.toml", "--params", "{d}/params.toml"], ["--params"]),
+    "simulate -o = its scene": (["simulate", "{d}/scene.toml", "-o", "{d}/scene.toml"], ["SCENE"]),
+    "simulate --truth = its scene": (["simulate", "{d}/scene.toml", "-o", "{d}/new.npz", "--truth", "{d}/scene.toml"], ["--truth"]),
+    "simulate --truth = -o": (["simulate", "{d}/scene.toml", "-o", "{d}/new.csv", "--truth", "{d}/new.csv"], ["another output"]),
+    "simulate --truth = -o, an existing file": (["simulate", "{d}/scene.toml", "-o", "{d}/gt.csv", "--truth", "{d}/gt.csv"], ["another output"]),
+    "score --json = its tracks": (["score", "{d}/tracks.csv", "--truth", "{d}/gt.csv", "--json", "{d}/tracks.csv"], ["--json"]),
+    "score --json = its truth": (["score", "{d}/tracks.csv", "--truth", "{d}/gt.csv", "--json", "{d}/gt.csv"], ["--json"]),
+    "score --json = a symlink to its truth": (["score", "{d}/tracks.csv", "--truth", "{d}/gt.csv", "--json", "{d}/gt_symlink.csv"], ["--json"]),
+    "score --json = its tracks through a symlink given as tracks": (["score", "{d}/tracks_symlink.csv", "--truth", "{d}/gt.csv", "--json", "{d}/tracks.csv"], ["--json"]),
+    "show -o = its events": (["show", "{d}/ev.npz", "-o", "{d}/ev.npz"], ["EVENTS"]),
+    "render -o = its events": (["render", "{d}/ev.npz", "{d}/tracks.csv", "-o", "{d}/ev.npz"], ["EVENTS"]),
+    "render -o = its tracks": (["render", "{d}/ev.npz", "{d}/tracks.csv", "-o", "{d}/tracks.csv"], ["TRACKS"]),
+    "plot -o = its tracks": (["plot", "{d}/tracks.csv", "--truth", "{d}/gt.csv", "-o", "{d}/tracks.csv"], ["TRACKS"]),
+    "plot -o = its truth": (["plot", "{d}/tracks.csv", "--truth", "{d}/gt.csv", "-o", "{d}/gt.csv"], ["--truth"]),
+    "formats --registers = its parameters": (["formats", "--params", "{d}/params.toml", "--registers", "{d}/params.toml"], ["--params"]),
+    "formats --c-header = --verilog": (["formats", "--verilog", "{d}/x.vh", "--c-header", "{d}/x.vh"], ["another output"]),
+    "formats --verilog = --write-for's file": (["formats", "--write-for", "{d}/params.toml", "--verilog", "{d}/params.toml"], ["--write-for"]),
+    "tune -o = its parameters": (["tune", "{d}/scene.toml", "--params", "{d}/params.toml", "-o", "{d}/params.toml", "--trials", "1", "-q"], ["--params"]),
+    "tune -o = its scene": (["tune", "{d}/scene.toml", "-o", "{d}/scene.toml", "--trials", "1", "-q"], ["SCENE"]),
+}
+
+
+@pytest.mark.parametrize("case", sorted(OVERWRITES))
+def test_an_output_that_is_an_input_or_another_output_is_refused_before_anything_runs(case, files, tmp_path, capsys):
+    folder = work_folder(files, tmp_path)
+    argv, fragments = OVERWRITES[case]
+    assert_refused(capsys, folder, [a.replace("{d}", str(folder)) for a in argv], *fragments)
+
+
+@pytest.mark.parametrize("verb", ["track", "show", "simulate"])
+def test_a_folder_as_the_output_is_one_line(verb, files, tmp_path, capsys):
+    folder = work_folder(files, tmp_path)
+    source = {"track": "ev.npz", "show": "ev.npz", "simulate": "scene.toml"}[verb]
+    extra = ["-q"] if verb != "show" else []
+    assert_refused(capsys, folder, [verb, str(folder / source), "-o", str(folder / "sub"), *extra], "sub")
+
+
+@pytest.mark.parametrize("argv", [
+    ["formats", "--registers", "/dev/null", "--c-header", "/dev/null"],
+    ["simulate", "{d}/scene.toml", "-o", "{d}/new.npz", "--truth", "/dev/null", "-q"],
+    ["score", "{d}/tracks.csv", "--truth", "{d}/gt.csv", "--json", "/dev/null"],
+], ids=["formats, two outputs", "simulate --truth", "score --json"])  # fmt: skip
+def test_dev_null_as_an_output_is_written_in_place_and_not_replaced(argv, files, tmp_path, capsys):
+    folder = work_folder(files, tmp_path)
+    before = os.stat("/dev/null")
+    assert main([a.replace("{d}", str(folder)) for a in argv]) == 0
+    after = os.stat("/dev/null")
+    assert (after.st_ino, after.st_rdev) == (before.st_ino, before.st_rdev)
+    assert not any(p.name.startswith(".") for p in Path("/dev").iterdir() if p.name.startswith(".null"))
+
+
+@pytest.mark.skipif(not Path("/dev/full").exists(), reason="no /dev/full on this system")
+@pytest.mark.parametrize("argv", [
+    ["formats", "--registers", "/dev/full"],
+    ["simulate", "{d}/scene.toml", "-o", "{d}/new.npz", "--truth", "/dev/full", "-q"],
+    ["score", "{d}/tracks.csv", "--truth", "{d}/gt.csv", "--json", "/dev/full"],
+], ids=["formats", "simulate --truth", "score --json"])  # fmt: skip
+def test_a_full_device_is_reported_as_one_line(argv, files, tmp_path, capsys):
+    folder = work_folder(files, tmp_path)
+    assert_refused(capsys, folder, [a.replace("{d}", str(folder)) for a in argv], "/dev/full")
+
+
+def test_simulate_writes_both_outputs_or_neither(files, tmp_path, capsys):
+    """--truth that cannot be written (its folder is a file): the event file is not left either."""
+    folder = work_folder(files, tmp_path)
+    assert_refused(capsys, folder, ["simulate", str(folder / "scene.toml"), "-o", str(folder / "new.npz"), "--truth", str(folder / "tracks.csv" / "gt.csv"), "-q"])
+
+
+def test_sigterm_mid_run_leaves_no_temporary_or_partial_file(files, tmp_path):
+    """A long simulation killed with SIGTERM: exit 143, one line, nothing left in the folder."""
+    folder = work_folder(files, tmp_path)
+    long_scene = SCENE.replace("frames = 6", "frames = 4000").replace("frames = 5,", "frames = 3999,").replace("width = 40", "width = 640").replace("height = 30", "height = 480")
+    (folder / "long.toml").write_text(long_scene)
+    before = snapshot(folder)
+    proc = subprocess.Popen([sys.executable, "-c", "import sys; from evclust.cli import main; sys.exit(main())", "simulate", str(folder / "long.toml"), "-o", str(folder / "long.npz"), "-q"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)  # fmt: skip
+    deadline = time.monotonic() + 120
+    while not any(p.name.startswith(".long.npz") for p in folder.iterdir()):  # the writer has started
+        assert proc.poll() is None and time.monotonic() < deadline, proc.communicate()
+        time.sleep(0.05)
+    proc.send_signal(signal.SIGTERM)
+    out, err = proc.communicate(timeout=60)
+    assert proc.returncode == 128 + signal.SIGTERM, err
+    assert err.strip().splitlines() == ["evclust: terminated"]
+    assert snapshot(folder) == before
+
+
+# ------------------------------------------------------------------------------------------
+# Malformed inputs: each case writes its own bad file (name: content as bytes, or a callable
+# that writes it) and runs argv; the promise above must hold.
+
+
+def _npz(path: Path, **arrays) -> None:
+    import numpy as np
+
+    with open(path, "wb") as f:
+        np.savez(f, **arrays)
+
+
+def _good_arrays(files: Path) -> dict:
+    import numpy as np
+
+    with np.load(files / "ev.npz", allow_pickle=False) as z:
+        return {k: z[k] for k in z.files}
+
+
+def _h5(path: Path, layout: dict) -> None:
+    import h5py
+
+    with h5py.File(path, "w") as f:
+        for name, value in layout.items():
+            if isinstance(value, dict):
+                group = f.create_group(name)
+                for k, v in value.items():
+                    group.attrs[k] = v
+            else:
+                f[name] = value
+
+
+def _scene_with(**replace) -> bytes:
+    text = SCENE
+    for old, new in replace.items():
+        text = text.replace(old.replace("_", " "), new)
+    return text.encode()
+
+
+MALFORMED = {
+    "zero-byte npz": ({"bad.npz": b""}, ["track", "{d}/bad.npz", "-o", "{d}/out.csv", "-q"]),
+    "npz of garbage": ({"bad.npz": b"PK\x03\x04 not a zip at all"}, ["track", "{d}/bad.npz", "-o", "{d}/out.csv", "-q"]),
+    "zero-byte h5": ({"bad.h5": b""}, ["track", "{d}/bad.h5", "-o", "{d}/out.csv", "-q"]),
+    "h5 without events": ({"bad.h5": lambda p, f: _h5(p, {"other": [1, 2, 3]})}, ["track", "{d}/bad.h5", "-o", "{d}/out.csv", "-q"]),
+    "h5 with events as a group": ({"bad.h5": lambda p, f: _h5(p, {"events": {"width": 40}})}, ["track", "{d}/bad.h5", "-o", "{d}/out.csv", "-q"]),
+    "zero-byte scene": ({"bad.toml": b""}, ["simulate", "{d}/bad.toml", "-o", "{d}/out.npz", "-q"]),
+    "scene not UTF-8": ({"bad.toml": b"width = 40\nlabel = \"\xff\xfe\"\n"}, ["simulate", "{d}/bad.toml", "-o", "{d}/out.npz", "-q"]),
+    "params not UTF-8": ({"bad.toml": b"[clusterer]\nn_clusters = \xff\n"}, ["track", "{d}/ev.npz", "-o", "{d}/out.csv", "--params", "{d}/bad.toml", "-q"]),
+    "params of the wrong type": ({"bad.toml": b"[clusterer]\nn_clusters = \"many\"\n"}, ["track", "{d}/ev.npz", "-o", "{d}/out.csv", "--params", "{d}/bad.toml", "-q"]),
+    "params not TOML": ({"bad.toml": b"[clusterer\n"}, ["track", "{d}/ev.npz", "-o", "{d}/out.csv", "--params", "{d}/bad.toml", "-q"]),
+    "scene velocity NaN": ({"bad.toml": _scene_with(**{"velocity = [2.0, 0.0]": "velocity = [nan, 0.0]"})}, ["simulate", "{d}/bad.toml", "-o", "{d}/out.npz", "-q"]),
+    "scene velocity inf": ({"bad.toml": _scene_with(**{"velocity = [2.0, 0.0]": "velocity = [inf, 0.0]"})}, ["simulate", "{d}/bad.toml", "-o", "{d}/out.npz", "-q"]),
+    "scene start NaN": ({"bad.toml": _scene_with(**{"start = [10, 15]": "start = [nan, 15]"})}, ["simulate", "{d}/bad.toml", "-o", "{d}/out.npz", "-q"]),
+    "scene size inf": ({"bad.toml": _scene_with(**{"size = [8, 8]": "size = [inf, 8]"})}, ["simulate", "{d}/bad.toml", "-o", "{d}/out.npz", "-q"]),
+    "scene size negative": ({"bad.toml": _scene_with(**{"size = [8, 8]": "size = [-8, 8]"})}, ["simulate", "{d}/bad.toml", "-o", "{d}/out.npz", "-q"]),
+    "scene colour out of range": ({"bad.toml": _scene_with(**{"colour = [210, 40, 40]": "colour = [999, 40, 40]"})}, ["simulate", "{d}/bad.toml", "-o", "{d}/out.npz", "-q"]),
+    "scene width zero": ({"bad.toml": _scene_with(**{"width = 40": "width = 0"})}, ["simulate", "{d}/bad.toml", "-o", "{d}/out.npz", "-q"]),
+    "scene fps NaN": ({"bad.toml": _scene_with(**{"fps = 30": "fps = nan"})}, ["simulate", "{d}/bad.toml", "-o", "{d}/out.npz", "-q"]),
+    "--fps NaN": ({}, ["simulate", "{d}/scene.toml", "-o", "{d}/out.npz", "--fps", "nan", "-q"]),
+    "--fps inf": ({}, ["simulate", "{d}/scene.toml", "-o", "{d}/out.npz", "--fps", "inf", "-q"]),
+    "--fps 1e-300": ({}, ["simulate", "{d}/scene.toml", "-o", "{d}/out.npz", "--fps", "1e-300", "-q"]),
+    "--seed negative": ({}, ["simulate", "{d}/scene.toml", "-o", "{d}/out.npz", "--seed", "-1", "-q"]),
+    "--frame-us NaN": ({}, ["track", "{d}/ev.npz", "-o", "{d}/out.csv", "--frame-us", "nan", "-q"]),
+    "--frame-us negative": ({}, ["track", "{d}/ev.npz", "-o", "{d}/out.csv", "--frame-us", "-33333", "-q"]),
+    "show to an unknown picture format": ({}, ["show", "{d}/ev.npz", "-o", "{d}/out.xyz"]),
+    "show with --span NaN": ({}, ["show", "{d}/ev.npz", "-o", "{d}/out.png", "--span", "nan"]),
+    "render with --t1 inf": ({}, ["render", "{d}/ev.npz", "{d}/tracks.csv", "-o", "{d}/out.png", "--t1", "inf", "-q"]),
+    "render with --window inf": ({}, ["render", "{d}/ev.npz", "{d}/tracks.csv", "-o", "{d}/out.png", "--window", "inf", "-q"]),
+    "render with --scale 0": ({}, ["render", "{d}/ev.npz", "{d}/tracks.csv", "-o", "{d}/out.png", "--scale", "0", "-q"]),
+    "render to an unknown format": ({}, ["render", "{d}/ev.npz", "{d}/tracks.csv", "-o", "{d}/out.gif", "-q"]),
+    "render with --window NaN": ({}, ["render", "{d}/ev.npz", "{d}/tracks.csv", "-o", "{d}/out.png", "--window", "nan", "-q"]),
+    "render with --scale 1e9": ({}, ["render", "{d}/ev.npz", "{d}/tracks.csv", "-o", "{d}/out.png", "--scale", "1e9", "-q"]),
+    "score a truth of garbage": ({"bad.csv": b"\x00\x01\x02garbage"}, ["score", "{d}/tracks.csv", "--truth", "{d}/bad.csv"]),
+    "score an empty tracks file": ({"bad.csv": b""}, ["score", "{d}/bad.csv", "--truth", "{d}/gt.csv"]),
+    "formats --params with tau_us = inf": ({"bad.toml": b"[clusterer]\ntau_us = inf\n"}, ["formats", "--params", "{d}/bad.toml"]),
+    "formats --params with NaN": ({"bad.toml": b"[clusterer]\nalpha_pos = nan\n"}, ["formats", "--params", "{d}/bad.toml"]),
+    "formats --width NaN-like": ({}, ["formats", "--width", "0"]),
+    "fixed model with tau_us = inf": ({"bad.toml": b"[clusterer]\ntau_us = inf\n"}, ["track", "{d}/ev.npz", "-o", "{d}/out.csv", "--model", "fixed", "--params", "{d}/bad.toml", "-q"]),
+}
+
+
+
+
+def _npz_meta(meta) -> callable:
+    """An event file whose metadata is replaced (a JSON text, or a raw object for the wrong type)."""
+    import json
+
+    def write(path: Path, files: Path) -> None:
+        arrays = _good_arrays(files)
+        good = json.loads(str(arrays["meta"]))
+        arrays["meta"] = meta if not isinstance(meta, dict) else __import__("numpy").array(json.dumps(good | meta))
+        _npz(path, **arrays)
+
+    return write
+
+
+def _h5_from_good(attrs: dict | None = None, reshape: str | None = None) -> callable:
+    """An HDF5 event file from the good events, with attributes replaced or one field reshaped."""
+
+    def write(path: Path, files: Path) -> None:
+        import h5py
+
+        from evclust.events import read_events, write_events
+
+        events, meta = read_events(files / "ev.npz")
+        write_events(path, events, meta)
+        with h5py.File(path, "a") as f:
+            for key, value in (attrs or {}).items():
+                f.attrs[key] = value
+            if reshape:
+                data = f["events"][reshape][...]
+                del f["events"][reshape]
+                f["events"][reshape] = data.reshape(1, -1) if data.size else data.reshape(1, 0)
+
+    return write
+
+
+TRACK = ["track", "{d}/bad.npz", "-o", "{d}/out.csv", "-q"]
+TRACK_H5 = ["track", "{d}/bad.h5", "-o", "{d}/out.csv", "-q"]
+MALFORMED.update({
+    "npz meta width a string": ({"bad.npz": _npz_meta({"width": "wide"})}, TRACK),
+    "npz meta width negative": ({"bad.npz": _npz_meta({"width": -40})}, TRACK),
+    "npz meta width zero": ({"bad.npz": _npz_meta({"width": 0})}, TRACK),
+    "npz meta sensor 60000 x 60000": ({"bad.npz": _npz_meta({"width": 60000, "height": 60000})}, TRACK),
+    "npz meta t_frame_us negative": ({"bad.npz": _npz_meta({"t_frame_us": -33333.0})}, TRACK),
+    "npz meta t_frame_us a list": ({"bad.npz": _npz_meta({"t_frame_us": [1, 2]})}, TRACK),
+    "npz meta not JSON": ({"bad.npz": _npz_meta(__import__("numpy").array("{not json"))}, TRACK),
+    "npz meta a number array": ({"bad.npz": _npz_meta(__import__("numpy").arange(3))}, TRACK),
+    "npz meta JSON list": ({"bad.npz": _npz_meta(__import__("numpy").array("[1, 2]"))}, TRACK),
+    "h5 width a string": ({"bad.h5": _h5_from_good({"width": "wide"})}, TRACK_H5),
+    "h5 width an array": ({"bad.h5": _h5_from_good({"width": [40, 40]})}, TRACK_H5),
+    "h5 height negative": ({"bad.h5": _h5_from_good({"height": -30})}, TRACK_H5),
+    "h5 sensor 60000 x 60000": ({"bad.h5": _h5_from_good({"width": 60000, "height": 60000})}, TRACK_H5),
+    "h5 field t two-dimensional": ({"bad.h5": _h5_from_good(reshape="t")}, TRACK_H5),
+    "h5 field x two-dimensional": ({"bad.h5": _h5_from_good(reshape="x")}, TRACK_H5),
+})
+
+
+@pytest.mark.parametrize("case", sorted(MALFORMED))
+def test_malformed_input_is_one_line_and_leaves_nothing(case, files, tmp_path, capsys):
+    folder = work_folder(files, tmp_path)
+    made, argv = MALFORMED[case]
+    for name, content in made.items():
+        if callable(content):
+            content(folder / name, files)
+        else:
+            (folder / name).write_bytes(content)
+    assert_refused(capsys, folder, [a.replace("{d}", str(folder)) for a in argv])
