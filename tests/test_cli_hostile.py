@@ -307,6 +307,46 @@ MALFORMED.update({
 })
 
 
+
+
+# Unbounded work: refused at once, before anything is allocated or drawn.
+SIM = ["simulate", "{d}/bad.toml", "-o", "{d}/out.npz", "-q"]
+MALFORMED.update({
+    "scene 40000 x 25000": ({"bad.toml": _scene_with(**{"width = 40": "width = 40000", "height = 30": "height = 25000"})}, SIM),
+    "scene wider than 65535": ({"bad.toml": _scene_with(**{"width = 40": "width = 70000"})}, SIM),
+    "scene of 10^12 frames": ({"bad.toml": _scene_with(**{"frames = 6": "frames = 1000000000000"})}, SIM),
+    "object of 10^8 px": ({"bad.toml": _scene_with(**{"size = [8, 8]": "size = [10000, 10000]"})}, SIM),
+    "sensor threshold 1e-300": ({"bad.toml": (SCENE + "[sensor]\nthreshold_on = 1e-300\n").encode()}, SIM),
+    "sensor threshold 0": ({"bad.toml": (SCENE + "[sensor]\nthreshold_off = 0\n").encode()}, SIM),
+})
+
+
+def _video_with_truth(truth: bytes) -> callable:
+    """A three-frame video and a truth CSV beside it (the one `simulate --truth` passes through)."""
+
+    def write(path: Path, files: Path) -> None:
+        import cv2
+        import numpy as np
+
+        writer = cv2.VideoWriter(str(path), cv2.VideoWriter_fourcc(*"MJPG"), 30, (32, 24))
+        for v in (40, 40, 200):
+            writer.write(np.full((24, 32, 3), v, np.uint8))
+        writer.release()
+        path.with_suffix(".csv").write_bytes(truth)
+
+    return write
+
+
+TRUTH_HEADER = b"frame,t_us,id,cx,cy,w,h,vx,vy,Y,Cb,Cr,label,fully_visible\n"
+VIDEO = ["simulate", "{d}/clip.avi", "-o", "{d}/out.npz", "--truth", "{d}/out.csv", "-q"]
+MALFORMED.update({
+    "video truth CSV of garbage": ({"clip.avi": _video_with_truth(b"\x00\x01garbage\n")}, VIDEO),
+    "video truth CSV without a column": ({"clip.avi": _video_with_truth(TRUTH_HEADER.replace(b",label", b"") + b"0,0,1,5,5,2,2,0,0,40,128,128,1\n")}, VIDEO),
+    "video truth CSV with NaN": ({"clip.avi": _video_with_truth(TRUTH_HEADER + b"0,0,1,nan,5,2,2,0,0,40,128,128,grey,1\n")}, VIDEO),
+    "video truth CSV not UTF-8": ({"clip.avi": _video_with_truth(TRUTH_HEADER + b"0,0,1,5,5,2,2,0,0,40,128,128,gr\xffy,1\n")}, VIDEO),
+})
+
+
 @pytest.mark.parametrize("case", sorted(MALFORMED))
 def test_malformed_input_is_one_line_and_leaves_nothing(case, files, tmp_path, capsys):
     folder = work_folder(files, tmp_path)

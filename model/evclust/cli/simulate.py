@@ -44,6 +44,7 @@ def run(args) -> int:
         raise EvclustError(f"--seed {args.seed}: a seed is a whole number >= 0")
     from evclust.events import event_writer
     from evclust.scenes import load_scene, write_truth
+    from evclust.scenes.truth import read_truth
     from evclust.simulator import Simulation, stream_scene
 
     scene = load_scene(args.scene, fps=args.fps, max_frames=args.frames)
@@ -63,6 +64,7 @@ def run(args) -> int:
                 raise EvclustError(f"{args.scene}: only {result.frames} frame(s) could be read; at least 2 are needed")
             if args.truth:
                 if scene.truth_path is not None:
+                    read_truth(scene.truth_path)  # checked as `score` will read it, not copied blind
                     with atomic_output(args.truth) as tmp:
                         shutil.copyfile(scene.truth_path, tmp)
                 else:

@@ -47,17 +47,16 @@ class EventMeta:
         return meta
 
     def check(self) -> None:
-        """Types and ranges a stream can be run with; a sensor beyond the limit (the environment's
+        """Types and ranges a stream can be run with; a sensor beyond the limit (limits.py:
         EVCLUST_MAX_SENSOR_PIXELS, default 2^25) is refused before anything is allocated."""
+        from evclust import limits
         from evclust.errors import EvclustError
 
         for key in ("width", "height"):
             value = getattr(self, key)
             if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not 1 <= value <= MAX_SENSOR_SIDE:
                 raise EvclustError(f"metadata: sensor {key} {value!r}: expected a whole number of pixels from 1 to {MAX_SENSOR_SIDE}")
-        limit = max_sensor_pixels()
-        if int(self.width) * int(self.height) > limit:
-            raise EvclustError(f"metadata: a {self.width}x{self.height} sensor is over {limit:,} pixels (set EVCLUST_MAX_SENSOR_PIXELS to allow it)")
+        limits.check("SENSOR_PIXELS", int(self.width) * int(self.height), f"metadata: a {self.width}x{self.height} sensor's pixels")
         t = self.t_frame_us
         if t is not None and (isinstance(t, bool) or not isinstance(t, (int, float, np.integer, np.floating)) or not 0 < t < math.inf):
             raise EvclustError(f"metadata: t_frame_us {t!r}: expected a positive, finite frame period in µs")
@@ -67,27 +66,8 @@ class EventMeta:
             raise EvclustError(f"metadata: has_colour {self.has_colour!r}: expected true or false")
 
 
-# x and y are 16-bit; a sensor's pixel count is bounded separately (max_sensor_pixels).
+# x and y are 16-bit; a sensor's pixel count is bounded by limits.SENSOR_PIXELS.
 MAX_SENSOR_SIDE = 65535
-DEFAULT_MAX_SENSOR_PIXELS = 1 << 25  # an 8K sensor, 7680 x 4320, fits
-
-
-def max_sensor_pixels() -> int:
-    """The largest sensor accepted: EVCLUST_MAX_SENSOR_PIXELS if set (a user's explicit raise)."""
-    import os
-
-    from evclust.errors import EvclustError
-
-    raw = os.environ.get("EVCLUST_MAX_SENSOR_PIXELS")
-    if raw is None:
-        return DEFAULT_MAX_SENSOR_PIXELS
-    try:
-        value = int(raw)
-    except ValueError:
-        raise EvclustError(f"EVCLUST_MAX_SENSOR_PIXELS={raw!r}: expected a whole number") from None
-    if value < 1:
-        raise EvclustError(f"EVCLUST_MAX_SENSOR_PIXELS={raw!r}: expected a positive number")
-    return value
 
 
 _RECORD = np.dtype((np.void, EVENT_DTYPE.itemsize))

@@ -10,6 +10,9 @@ from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
+from evclust import limits
+from evclust.errors import EvclustError
+
 Colour = tuple[
     Annotated[float, Field(ge=0, le=255)],
     Annotated[float, Field(ge=0, le=255)],
@@ -28,8 +31,10 @@ class SensorSpec(Strict):
 
     detector: Literal["log", "linear"] = "log"
     log_eps: Annotated[float, Field(gt=0)] = 1.0  # L = ln(Y + log_eps), Y in 0..255
-    threshold_on: Annotated[float, Field(gt=0)] = 0.2  # in L units (ln for log, grey levels for linear)
-    threshold_off: Annotated[float, Field(gt=0)] = 0.2
+    # In L units (ln for log, grey levels for linear). Below 10^-3 every flicker of noise fires,
+    # and a scene's events grow without bound, so smaller thresholds are refused.
+    threshold_on: Annotated[float, Field(ge=1e-3)] = 0.2
+    threshold_off: Annotated[float, Field(ge=1e-3)] = 0.2
 
 
 class BackgroundSpec(Strict):
@@ -107,6 +112,14 @@ class SceneSpec(Strict):
             ids = [o.id for o in self.objects]
             if len(ids) != len(set(ids)):
                 raise ValueError("object ids must be unique")
+            # Bounds on the work a scene asks for, checked before anything is drawn (limits.py).
+            try:
+                limits.check("SENSOR_PIXELS", self.width * self.height, f"a {self.width}x{self.height} sensor's pixels")
+                limits.check("FRAMES", self.frames, "frames")
+                for o in self.objects:
+                    limits.check("OBJECT_AREA", o.size[0] * o.size[1], f"object {o.id}'s area in px²")
+            except EvclustError as exc:
+                raise ValueError(str(exc)) from None
         elif self.objects:
             raise ValueError("a video scene cannot also have objects")
         elif self.substeps != 1:
