@@ -347,6 +347,33 @@ MALFORMED.update({
 })
 
 
+def test_an_interrupted_vector_case_leaves_the_old_case_whole_and_no_half_new_one(tmp_path, monkeypatch):
+    """Ctrl-C between a case's files (here: as its manifest is written): the folder holds the
+    old case, every file of it, and no temporary folder is left."""
+    import json
+
+    from evclust.vectors import write
+
+    write.write_case("palette_tie", tmp_path / "palette_tie")
+    before = snapshot(tmp_path)
+    assert len(before) == 4
+
+    def interrupt(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(write.json, "dumps", interrupt)
+    with pytest.raises(KeyboardInterrupt):
+        write.write_case("palette_tie", tmp_path / "palette_tie")
+    monkeypatch.setattr(write.json, "dumps", json.dumps)
+    assert snapshot(tmp_path) == before
+    assert [p.name for p in tmp_path.iterdir()] == ["palette_tie"]
+    (tmp_path / "palette_tie").rename(tmp_path / "gone")
+    with pytest.raises(KeyboardInterrupt):
+        monkeypatch.setattr(write.json, "dumps", interrupt)
+        write.write_case("palette_tie", tmp_path / "palette_tie")
+    assert [p.name for p in tmp_path.iterdir()] == ["gone"]  # a new case: absent, not half written
+
+
 @pytest.mark.parametrize("case", sorted(MALFORMED))
 def test_malformed_input_is_one_line_and_leaves_nothing(case, files, tmp_path, capsys):
     folder = work_folder(files, tmp_path)

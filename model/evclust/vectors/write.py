@@ -11,6 +11,7 @@ import numpy as np
 
 from evclust import __version__
 from evclust.clusterer.run import records_to_tracks
+from evclust.errors import atomic_folder
 from evclust.fixed.model import FixedClusterer
 from evclust.vectors.cases import CASES, Case
 from evclust.vectors.pack import TRACE_FIELDS, event_fields, event_words, hex_lines, pack, record_fields, record_words
@@ -47,9 +48,6 @@ def write_case(name: str, folder: Path, case: Case | None = None) -> dict:
         "expected.hex": hex_lines(record_list, record_fields(table)),
         "trace.hex": hex_lines(trace_list, TRACE_FIELDS),
     }
-    folder.mkdir(parents=True, exist_ok=True)
-    for file, text in contents.items():
-        (folder / file).write_text(text)
     manifest = {
         "case": name,
         "description": case.description,
@@ -69,7 +67,10 @@ def write_case(name: str, folder: Path, case: Case | None = None) -> dict:
         "counts": {"events": int(case.events.size), "records": len(record_list), **model.stats()},
         "sha256": {file: hashlib.sha256(text.encode()).hexdigest() for file, text in contents.items()},
     }
-    (folder / "manifest.json").write_text(json.dumps(manifest, indent=1, sort_keys=False) + "\n")
+    with atomic_folder(folder) as tmp:  # a case is whole or absent, even if interrupted
+        for file, text in contents.items():
+            (tmp / file).write_text(text)
+        (tmp / "manifest.json").write_text(json.dumps(manifest, indent=1, sort_keys=False) + "\n")
     return manifest
 
 
