@@ -384,3 +384,28 @@ def test_malformed_input_is_one_line_and_leaves_nothing(case, files, tmp_path, c
         else:
             (folder / name).write_bytes(content)
     assert_refused(capsys, folder, [a.replace("{d}", str(folder)) for a in argv])
+
+
+@pytest.mark.parametrize("model", ["float", "fixed", "rtl"])
+def test_event_times_past_2_to_the_32_reach_the_records_whole(model, files, tmp_path, capsys):
+    """Events from t = 2^40 µs: the fixed datapath counts 32 bits (2^40 wraps to 0), so its
+    records are those of the unshifted stream, with the whole 64-bit time, not its low 32 bits."""
+    from evclust.events import read_events, write_events
+    from evclust.tracks import read_tracks
+
+    (tmp_path / "moving.toml").write_text(SCENE.replace("frames = 6", "frames = 90").replace("frames = 5,", "frames = 89,")
+                                          .replace("width = 40", "width = 64").replace("height = 30", "height = 48")
+                                          .replace("velocity = [2.0, 0.0]", "velocity = [0.5, 0.0]"))  # fmt: skip
+    assert main(["simulate", str(tmp_path / "moving.toml"), "-o", str(tmp_path / "early.npz"), "-q"]) == 0
+    events, meta = read_events(tmp_path / "early.npz")
+    shifted = events.copy()
+    shifted["t"] += 1 << 40
+    write_events(tmp_path / "late.npz", shifted, meta)
+    assert main(["track", str(tmp_path / "early.npz"), "-o", str(tmp_path / "early.csv"), "--model", model, "-q"]) == 0
+    assert main(["track", str(tmp_path / "late.npz"), "-o", str(tmp_path / "late.csv"), "--model", model, "-q"]) == 0
+    early, _ = read_tracks(tmp_path / "early.csv")
+    late, _ = read_tracks(tmp_path / "late.csv")
+    assert early.size > 0 and late.size == early.size
+    assert (late["t_us"].astype("int64") == early["t_us"].astype("int64") + (1 << 40)).all()
+    for name in ("x", "y", "vx_mcm", "vy_mcm", "Y"):
+        assert (late[name] == early[name]).all()

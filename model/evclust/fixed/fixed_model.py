@@ -605,5 +605,8 @@ def run_events(S, H, G, k, table, gains, palette, inv_ww, background_mask, suppo
         G[SINCE_FILTER] += 1
         if G[SINCE_FILTER] >= k[C_EVERY]:
             G[SINCE_FILTER] = 0
+            first = n_out
             n_out = _filter_step(S, H, G, t, k, table, gains, palette, inv_ww, background_mask, out, n_out, log, ranges)
+            for r in range(first, n_out):  # the datapath counts 32 bits; a record keeps the event's whole time
+                out[r, 0] = t_us[i]
     return n_out

@@ -90,7 +90,14 @@ class RtlClusterer:
         words = np.load(answer).tolist()
         answer.unlink()
         path.unlink()
-        return record_rows(words, self.table)
+        rows = record_rows(words, self.table)
+        if rows.size and events.size:
+            # The RTL's record holds the time's low 32 bits; its event is of this batch or just
+            # before, so the whole time is the latest event's minus their difference mod 2^32.
+            latest = int(events["t"][-1])
+            low = rows[:, 0].astype(np.int64)
+            rows[:, 0] = latest - ((latest - low) & 0xFFFFFFFF)
+        return rows
 
     def stats(self) -> dict:
         """The status counters read from the register file; ends the session."""

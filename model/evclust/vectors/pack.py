@@ -86,6 +86,8 @@ def record_words(tracks: np.ndarray, table: FormatTable) -> list[int]:
     raws = []
     for name, _, _, frac in fields:
         column = tracks[name].astype(np.float64) * 2.0**frac
+        if name == "t_us":  # the RTL's record carries the time's low 32 bits, as its counter does
+            column = np.mod(column, 2.0**32)
         raw = np.rint(column)
         if not np.array_equal(raw, column):
             raise ValueError(f"record field {name} is not a whole number of LSBs")
