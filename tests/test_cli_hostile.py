@@ -374,6 +374,24 @@ def test_an_interrupted_vector_case_leaves_the_old_case_whole_and_no_half_new_on
     assert [p.name for p in tmp_path.iterdir()] == ["gone"]  # a new case: absent, not half written
 
 
+def _image_folder(width: int, height: int) -> callable:
+    def write(path: Path, files: Path) -> None:
+        import cv2
+        import numpy as np
+
+        path.mkdir()
+        for k, v in enumerate((40, 200)):
+            assert cv2.imwrite(str(path / f"f{k}.png"), np.full((height, width, 3), v, np.uint8))
+
+    return write
+
+
+MALFORMED.update({
+    "images wider than 65535 px": ({"wide": _image_folder(70000, 1)}, ["simulate", "{d}/wide", "--fps", "30", "-o", "{d}/out.npz", "-q"]),
+    "images over the pixel limit": ({"big": _image_folder(8000, 4300)}, ["simulate", "{d}/big", "--fps", "30", "-o", "{d}/out.npz", "-q"]),
+})
+
+
 @pytest.mark.parametrize("case", sorted(MALFORMED))
 def test_malformed_input_is_one_line_and_leaves_nothing(case, files, tmp_path, capsys):
     folder = work_folder(files, tmp_path)

@@ -10,7 +10,9 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from evclust import limits
 from evclust.errors import EvclustError
+from evclust.events.format import MAX_SENSOR_SIDE
 
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".webp", ".ppm", ".pgm")
 
@@ -60,6 +62,12 @@ class VideoSource:
                 raise EvclustError(f"{self.path}: the video does not declare a frame rate; give fps in a scene file or --fps")
             first = cv2.cvtColor(first, cv2.COLOR_BGR2RGB)
         self.height, self.width = first.shape[:2]
+        if max(self.width, self.height) > MAX_SENSOR_SIDE:  # x and y are 16-bit: wider would wrap
+            raise EvclustError(f"{self.path}: {self.width}x{self.height} frames; event coordinates hold at most {MAX_SENSOR_SIDE} px a side")
+        try:
+            limits.check("SENSOR_PIXELS", self.width * self.height, f"{self.width}x{self.height} frames' pixels")
+        except EvclustError as exc:
+            raise EvclustError(f"{self.path}: {exc}") from None
         self.fps = float(fps)
         self.t_frame_us = 1e6 / self.fps
         self.n_frames = min(n_frames, max_frames) if (n_frames and max_frames) else (n_frames or max_frames)
