@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 from evclust.errors import EvclustError, atomic_output
 
 REFERENCE = ("traffic", 480, 270, 50000.0)  # the parameter set the committed RTL header is made from
@@ -38,9 +40,14 @@ def reference_table():
     return build_formats(params, REFERENCE[1], REFERENCE[2], params.t_frame_us or REFERENCE[3])
 
 
+MAX_SENSOR_SIDE = 65535  # events.format.MAX_SENSOR_SIDE, kept here so --help imports nothing heavy
+
+
 def run(args) -> int:
-    if args.width <= 0 or args.height <= 0:
-        raise EvclustError(f"sensor {args.width}x{args.height}: width and height must be positive")
+    if not (1 <= args.width <= MAX_SENSOR_SIDE and 1 <= args.height <= MAX_SENSOR_SIDE):
+        raise EvclustError(f"sensor {args.width}x{args.height}: width and height must be 1 to {MAX_SENSOR_SIDE} px (x and y are 16-bit)")
+    if args.t_frame_us is not None and not 0 < args.t_frame_us < math.inf:
+        raise EvclustError(f"--t-frame-us {args.t_frame_us}: the frame period must be a positive, finite number of µs")
     from evclust.clusterer import load_params
     from evclust.fixed import build_formats, render_table, verilog_header
 

@@ -42,8 +42,8 @@ def run(args) -> int:
     from evclust.tracks import track_writer
     from evclust.tracks.thin import PerFrame
 
-    if args.frame_us is not None and not args.frame_us > 0:
-        raise EvclustError(f"--frame-us {args.frame_us}: the frame period must be positive")
+    if args.frame_us is not None and not 0 < args.frame_us < float("inf"):
+        raise EvclustError(f"--frame-us {args.frame_us}: the frame period must be a positive, finite number of µs")
     if (args.ranges or args.beta_shift) and args.model != "fixed":
         raise EvclustError("--ranges and --beta-shift are options of the fixed model: add --model fixed")
     reader = open_events(args.events, progress=not args.quiet)

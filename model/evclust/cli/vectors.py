@@ -71,7 +71,7 @@ def _own_case(args) -> int:
 
     if args.max_events < 1:
         raise EvclustError(f"--max-events {args.max_events}: at least one event")
-    if args.frame_us is not None and not args.frame_us > 0:
+    if args.frame_us is not None and not 0 < args.frame_us < float("inf"):
         raise EvclustError(f"--frame-us {args.frame_us}: the frame period must be positive")
     params, origin = load_params(args.params, EventReader(args.events).meta.source)
     case = file_case(args.events, args.max_events, params, args.frame_us)
