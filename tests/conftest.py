@@ -9,6 +9,22 @@ from evclust.scenes import scene_from_toml
 from evclust.simulator import simulate_scene
 
 
+# One red square crossing a small sensor: the CLI tests' scene.
+GOOD_SCENE = """
+width = 40
+height = 30
+fps = 30
+frames = 6
+[[objects]]
+id = 1
+label = "red"
+size = [8, 8]
+colour = [210, 40, 40]
+start = [10, 15]
+legs = [{ frames = 5, velocity = [2.0, 0.0] }]
+"""
+
+
 def simulate_toml(text: str, seed: int | None = None):
     return simulate_scene(scene_from_toml(text, "test"), seed=seed)
 

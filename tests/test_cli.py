@@ -13,19 +13,7 @@ from evclust.cli import main
 from evclust.events import read_events
 from evclust.scenes import load_scene
 
-GOOD_SCENE = """
-width = 40
-height = 30
-fps = 30
-frames = 6
-[[objects]]
-id = 1
-label = "red"
-size = [8, 8]
-colour = [210, 40, 40]
-start = [10, 15]
-legs = [{ frames = 5, velocity = [2.0, 0.0] }]
-"""
+from conftest import GOOD_SCENE
 
 
 def run_cli(capsys, *argv):

@@ -20,19 +20,9 @@ import pytest
 
 from evclust.cli import main
 
-SCENE = """
-width = 40
-height = 30
-fps = 30
-frames = 6
-[[objects]]
-id = 1
-label = "red"
-size = [8, 8]
-colour = [210, 40, 40]
-start = [10, 15]
-legs = [{ frames = 5, velocity = [2.0, 0.0] }]
-"""
+from conftest import GOOD_SCENE
+
+SCENE = GOOD_SCENE  # the cases below edit it by text
 
 
 @pytest.fixture(scope="module")

@@ -40,10 +40,9 @@ def reference_table():
     return build_formats(params, REFERENCE[1], REFERENCE[2], params.t_frame_us or REFERENCE[3])
 
 
-MAX_SENSOR_SIDE = 65535  # events.format.MAX_SENSOR_SIDE, kept here so --help imports nothing heavy
-
-
 def run(args) -> int:
+    from evclust.events.format import MAX_SENSOR_SIDE
+
     if not (1 <= args.width <= MAX_SENSOR_SIDE and 1 <= args.height <= MAX_SENSOR_SIDE):
         raise EvclustError(f"sensor {args.width}x{args.height}: width and height must be 1 to {MAX_SENSOR_SIDE} px (x and y are 16-bit)")
     if args.t_frame_us is not None and not 0 < args.t_frame_us < math.inf:
