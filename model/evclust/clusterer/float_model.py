@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
 
 from evclust.clusterer.layout import (
@@ -18,6 +17,7 @@ from evclust.clusterer.layout import (
     PY, RECORD_COLUMNS, REPORTED, RX, RY, SINCE_FILTER, STEP, T_FILTER, T_LAST, VALID, VI_COUNT, VIX, VIY, VMX,
     VMY,
 )  # fmt: skip
+from evclust.jit import njit
 
 # The parameter vector the compiled loop reads (built by `param_vector`).
 (
@@ -64,7 +64,7 @@ def param_vector(p, width: int, height: int, t_frame_us: float, has_colour: bool
     return v
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def _q(x, signal, precision):
     """x rounded to its signal's format (floor, or nearest) and saturated; x itself when the
     signal is exact or there is no precision table."""
@@ -75,7 +75,7 @@ def _q(x, signal, precision):
     return min(max(v, precision[signal, P_LO]), precision[signal, P_HI])
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def _decayed(activity, dt_us, t_half_us, precision=None):
     """A · 2^(-Δt / T_half); with the decay table quantised, 2^-frac comes from its table entry."""
     if precision is None or precision[Q_DECAY, P_FRAC] < 0:
@@ -85,7 +85,7 @@ def _decayed(activity, dt_us, t_half_us, precision=None):
     return activity * math.exp2(-whole) * _q(math.exp2(-(u - whole)), Q_DECAY, precision)
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def _gamma(activity, k):
     """γ of eq. (5) from the activity: the paper's global constant, or the cluster's events per
     frame, A·ln2·T_frame/T_half (also the count mode's guess until its first full interval).
@@ -96,7 +96,7 @@ def _gamma(activity, k):
     return activity * LN2 * k[K_T_FRAME] / k[K_T_HALF]
 
 
-@numba.njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def _nearest_palette(y, cb, cr, palette, luma_w):
     """§7.2.2: the palette entry nearest to a colour, L1 with the luminance weighted."""
     best, best_d = 0, np.inf
@@ -107,7 +107,7 @@ def _nearest_palette(y, cb, cr, palette, luma_w):
     return best
 
 
-@numba.njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def _mixing_palette(y, cb, cr, bg_y, bg_cb, bg_cr, palette, background_mask, luma_w, tolerance):
     """§7.2.1 + §7.2.2: the nearest entry among those whose segment from the background colour
     passes within `tolerance` of the event (an edge event mixes background and object); the
@@ -128,13 +128,13 @@ def _mixing_palette(y, cb, cr, bg_y, bg_cb, bg_cr, palette, background_mask, lum
     return best if best >= 0 else _nearest_palette(y, cb, cr, palette, luma_w)
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def _margin(S, s, k):
     """The seek margin of a cluster: S, grown by seek_scale·max(Rx, Ry) (beyond the paper)."""
     return k[K_SEEK] + k[K_SEEK_SCALE] * max(S[s, RX], S[s, RY])
 
 
-@numba.njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def _seek(S, x, y, k):
     """Step 1: the valid cluster whose box grown by its margin holds the event, nearest in L1;
     ties: lower slot."""
@@ -152,7 +152,7 @@ def _seek(S, x, y, k):
     return best
 
 
-@numba.njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def _slot_for_new(S, G, t, k, precision):
     """Step 2: a free slot; if none, the least active slot if its activity is below A_valid."""
     for s in range(S.shape[0]):
@@ -169,7 +169,7 @@ def _slot_for_new(S, G, t, k, precision):
     return -1
 
 
-@numba.njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def _create(S, H, G, s, t, x, y, lum, cb, cr, k, precision):
     S[s, :] = 0.0
     S[s, VALID] = 1.0
@@ -186,7 +186,7 @@ def _create(S, H, G, s, t, x, y, lum, cb, cr, k, precision):
     G[CREATED] += 1
 
 
-@numba.njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def _update(S, H, G, s, t, x, y, lum, cb, cr, k, palette, background_mask, precision):
     """Step 3: mean-shift update of the chosen cluster."""
     a = _q(_decayed(S[s, ACT], t - S[s, T_LAST], k[K_T_HALF], precision), Q_ACT, precision) + 1.0
@@ -230,13 +230,13 @@ def _update(S, H, G, s, t, x, y, lum, cb, cr, k, palette, background_mask, preci
     S[s, T_LAST] = t
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def _near_border(px, py, k):
     m = k[K_EXIT_M]
     return px < m or px > k[K_WIDTH] - 1.0 - m or py < m or py > k[K_HEIGHT] - 1.0 - m
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def _mcm_velocity(S, s, k):
     """V_MCM as reported: optionally divided by 1 - α^n, which removes the pull of V's zero start."""
     if k[K_MCM_CORRECT] != 0.0 and S[s, MCM_NORM] > 0.0:
@@ -244,7 +244,7 @@ def _mcm_velocity(S, s, k):
     return S[s, VMX], S[s, VMY]
 
 
-@numba.njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def _exiting(S, s, k):
     """§6.3, Fig. 8: near a border, fast enough, heading out within θ_exit of the border normal."""
     px, py = S[s, PX], S[s, PY]
@@ -263,7 +263,7 @@ def _exiting(S, s, k):
     )
 
 
-@numba.njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def _mergeable(S, s, j, k):
     """Two clusters are one object's when their boxes overlap and their velocities do not
     disagree (a young cluster has none yet), or when their boxes grown by merge_scale times
@@ -281,7 +281,7 @@ def _mergeable(S, s, j, k):
     return dx <= sx and dy <= sy
 
 
-@numba.njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def _merge(S, H, G, s, j, k, precision):
     """Slot s absorbs slot j: the centre is the activity-weighted mean (where the two clusters'
     events average), the box covers both boxes, activities and event counts add; identity,
@@ -311,7 +311,7 @@ def _merge(S, H, G, s, j, k, precision):
     G[MERGED] += 1
 
 
-@numba.njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def _filter_step(S, H, G, t, k, palette, background_mask, out, n_out, precision):
     """Every N_f events: decay, free, interval velocity, noise and exit decisions, records."""
     # τ boundaries crossed since the last step: usually 0 or 1, more when events are sparse.
@@ -410,7 +410,7 @@ def _filter_step(S, H, G, t, k, palette, background_mask, out, n_out, precision)
     return n_out
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def _supported(support, cx, cy, t, window):
     """Beyond the paper: some event of the 3x3 cells around (cx, cy) (map coordinates, border
     included) is at most `window` µs old."""
@@ -421,7 +421,7 @@ def _supported(support, cx, cy, t, window):
     return False
 
 
-@numba.njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def run_events(S, H, G, k, palette, background_mask, support, t_us, xs, ys, lums, cbs, crs, out, precision=None):
     """Feed events through the table; write track records into `out`; return how many. With a
     `precision` table (PRECISION_SIGNALS x 4) each quantisation point rounds to its format.

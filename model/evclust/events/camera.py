@@ -12,11 +12,11 @@ import json
 from pathlib import Path
 from typing import Iterator
 
-import numba
 import numpy as np
 
 from evclust.errors import EvclustError
 from evclust.events.format import EVENT_DTYPE, EventMeta
+from evclust.jit import njit
 
 AEDAT_SUFFIXES = (".aedat4",)
 EVT_SUFFIXES = (".raw",)
@@ -37,7 +37,7 @@ def from_faery(packet: np.ndarray) -> np.ndarray:
     return ev
 
 
-@numba.njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def _convert(t, x, y, on, t_out, x_out, y_out, p_out, lum, cb, cr):  # pragma: no cover (compiled)
     # One pass writing every field of each record: several times faster than a numpy pass per
     # field on fresh memory, which reading speed comes down to.

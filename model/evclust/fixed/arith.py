@@ -38,9 +38,9 @@ from decimal import ROUND_FLOOR, Decimal, localcontext
 from fractions import Fraction
 
 import numpy as np
-from numba import njit
 
 from evclust.errors import EvclustError
+from evclust.jit import njit
 
 FLOOR = 0
 NEAREST = 1

@@ -8,7 +8,6 @@ which wraps by design. The state layout is the float model's (clusterer/layout.p
 
 from __future__ import annotations
 
-import numba
 import numpy as np
 
 from evclust.clusterer.layout import (
@@ -20,6 +19,7 @@ from evclust.clusterer.layout import (
 )  # fmt: skip
 from evclust.fixed.arith import FLOOR, NEAREST, alpha_step_nb, decay_apply_nb, decay_nb, decay_steps_nb
 from evclust.fixed.formats import DECAY_FRAC_BITS, DECAY_TABLE_BITS, GAMMA_MODES, NOISE_GATE_FRAC_BITS, SCALE_FRAC_BITS
+from evclust.jit import njit
 
 TIME_MASK = (1 << 32) - 1
 # Globals beyond the float model's: the τ phase (µs since the last boundary).
@@ -109,7 +109,7 @@ def constant_vector(table, params, has_colour: bool) -> np.ndarray:
     return k
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def _store(value, lo, hi, signal, log, ranges):
     """Saturate to [lo, hi] and count a saturation; with range instrumentation on (`ranges` an
     array, not None), also keep the value's range before saturation. numba compiles the
@@ -128,7 +128,7 @@ def _store(value, lo, hi, signal, log, ranges):
     return value
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def _seen(value, signal, ranges):
     """Range instrumentation of a value that cannot leave its format (an α filter's result lies
     between its state and its input, both in range): no saturation logic, just min/max."""
@@ -140,7 +140,7 @@ def _seen(value, signal, ranges):
     return value
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def _align(raw, from_frac, to_frac):
     """Change the fraction bits of a raw value (floor when dropping)."""
     if to_frac >= from_frac:
@@ -148,13 +148,13 @@ def _align(raw, from_frac, to_frac):
     return raw >> (from_frac - to_frac)
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def _decayed(a, dt, k, table):
     """For comparisons only (eviction): the activity decayed to now, the slot left unchanged."""
     return decay_nb(a, dt, k[C_INV_TH], k[C_INV_TH_F], table, DECAY_TABLE_BITS, DECAY_FRAC_BITS, FLOOR)
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def _decay_slot(S, s, t, k, table):
     """Decay the slot's activity to t, carrying the residual; t becomes its reference time."""
     m, S[s, DECAY_RESIDUAL] = decay_steps_nb((t - S[s, T_LAST]) & TIME_MASK, S[s, DECAY_RESIDUAL], k[C_INV_TH], k[C_INV_TH_F], DECAY_TABLE_BITS)
@@ -162,7 +162,7 @@ def _decay_slot(S, s, t, k, table):
     S[s, T_LAST] = t
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def _decay_background(G, t, k, table):
     """The background's activity decayed to t, as a slot's (its residual carried)."""
     m, G[BG_RESIDUAL] = decay_steps_nb((t - G[BG_T]) & TIME_MASK, G[BG_RESIDUAL], k[C_INV_TH], k[C_INV_TH_F], DECAY_TABLE_BITS)
@@ -170,20 +170,20 @@ def _decay_background(G, t, k, table):
     G[BG_T] = t
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def _gamma_from_activity(a, k):
     if k[C_GAMMA_MODE] == 0:
         return k[C_GAMMA_GLOBAL]
     return (a * k[C_GPA]) >> (k[C_FA] + k[C_GPA_F] - k[C_FG])  # A · ln2·T_frame/T_half, in γ's format
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def _margin(S, s, k):
     """The seek margin in P's format: S + seek_scale·max(Rx, Ry), the product floored."""
     return k[C_SEEK] + _align(k[C_SEEK_SCALE] * max(S[s, RX], S[s, RY]), k[C_SCALE_F] + k[C_FR], k[C_FP])
 
 
-@numba.njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def _seek(S, x, y, k):
     """Step 1: the candidate nearest in L1; ties go to the lower slot. R is brought to P's
     fraction bits with one fixed shift (hoisted out of the loop)."""
@@ -202,7 +202,7 @@ def _seek(S, x, y, k):
     return best
 
 
-@numba.njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def _nearest_palette(ey, ecb, ecr, palette, k):
     """Integer L1 with the luminance weighted; distances in units of 2^-F_w."""
     best, best_d = 0, np.int64(1) << 62
@@ -214,7 +214,7 @@ def _nearest_palette(ey, ecb, ecr, palette, k):
     return best
 
 
-@numba.njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def _mixing_palette(ey, ecb, ecr, bg, palette, inv_ww, background_mask, k):
     """The mixing rule (docs/FIXED_POINT.md): q in Q0.16 from a precomputed 1/|w|², then the
     L1 residual against the tolerance; distances in units of 2^-F_w."""
@@ -237,7 +237,7 @@ def _mixing_palette(ey, ecb, ecr, bg, palette, inv_ww, background_mask, k):
     return best if best >= 0 else _nearest_palette(ey, ecb, ecr, palette, k)
 
 
-@numba.njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def palette_vote(lum, cb, cr, G, k):
     """The event's vote: 1, or with contrast votes |e - BG|₁ from the exact background, rounded half up."""
     if k[C_VOTE_CONTRAST] == 0:
@@ -246,7 +246,7 @@ def palette_vote(lum, cb, cr, G, k):
     return (abs((lum << fb) - G[BG_Y]) + abs((cb << fb) - G[BG_CB]) + abs((cr << fb) - G[BG_CR]) + (np.int64(1) << (fb - 1))) >> fb
 
 
-@numba.njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def refresh_mixing(G, palette, inv_ww, k):
     """1/|palette_j - BG|² in Q0.32 (integer colours): a division per entry, at filter steps only."""
     fb = k[C_FB]
@@ -258,7 +258,7 @@ def refresh_mixing(G, palette, inv_ww, k):
         inv_ww[j] = 0 if ww == 0 else (np.int64(1) << 32) // ww
 
 
-@numba.njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def _create(S, H, G, s, t, ex, ey, lum, cb, cr, k):
     S[s, :] = 0
     S[s, VALID] = 1
@@ -275,7 +275,7 @@ def _create(S, H, G, s, t, ex, ey, lum, cb, cr, k):
     G[CREATED] += 1
 
 
-@numba.njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def _update(S, H, G, s, t, ex, ey, lum, cb, cr, k, table, palette, inv_ww, background_mask, log, ranges):
     fp, fr = k[C_FP], k[C_FR]
     # 3a. Activity: decay over (t - t_last) mod 2^32, then count the event.
@@ -327,7 +327,7 @@ def _update(S, H, G, s, t, ex, ey, lum, cb, cr, k, table, palette, inv_ww, backg
     S[s, T_LAST] = t
 
 
-@numba.njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def _slot_for_new(S, G, t, k, table):
     for s in range(S.shape[0]):
         if S[s, VALID] == 0:
@@ -343,7 +343,7 @@ def _slot_for_new(S, G, t, k, table):
     return -1
 
 
-@numba.njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def _near(px, py, k):
     m = k[C_EXIT_M]
     hi_x = ((k[C_WIDTH] - 1) << k[C_FP]) - m
@@ -351,7 +351,7 @@ def _near(px, py, k):
     return px < m, px > hi_x, py < m, py > hi_y
 
 
-@numba.njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def _speed_sq(vx, vy, frac, k):
     """|V|² in the speed_sq format from a velocity with `frac` fraction bits. Each component is
     first clamped to full scale (±2^V_FULL_BITS px/frame), so the squares fit an int64."""
@@ -361,7 +361,7 @@ def _speed_sq(vx, vy, frac, k):
     return _align(vx * vx + vy * vy, 2 * frac, k[C_SQ_F])
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def _corrected(colour, background, k):
     """Eq. (11): BG + (C - BG)·(1/p), in C's format, clamped to the byte range."""
     bg = _align(background, k[C_FB], k[C_FC])
@@ -369,7 +369,7 @@ def _corrected(colour, background, k):
     return min(max(obj, 0), np.int64(255) << k[C_FC])
 
 
-@numba.njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def _mergeable(S, s, j, k):
     """As the float model's: boxes that overlap (velocities not disagreeing), or boxes grown by
     merge_scale·max(R) that overlap with measured velocities that agree. In P's format; the
@@ -387,7 +387,7 @@ def _mergeable(S, s, j, k):
     return dx <= sx and dy <= sy
 
 
-@numba.njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def _merge(S, H, G, s, j, k, log, ranges):
     """Slot s absorbs slot j (the float model's _merge): the centre is the activity-weighted
     mean, floored (the sweep's one division); the box covers both boxes; activities and
@@ -422,13 +422,13 @@ def _merge(S, H, G, s, j, k, log, ranges):
     G[MERGED] += 1
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def _box_pixels(S, s, k):
     """The pixels of a cluster's box, (2·floor(Rx) + 1)·(2·floor(Ry) + 1)."""
     return (2 * (S[s, RX] >> k[C_FR]) + 1) * (2 * (S[s, RY] >> k[C_FR]) + 1)
 
 
-@numba.njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def _filter_step(S, H, G, t, k, table, gains, palette, inv_ww, background_mask, out, n_out, log, ranges):
     # τ boundaries since the last step, from a phase counter (no division of the wrapping time).
     phase = G[TAU_PHASE] + ((t - G[T_FILTER]) & TIME_MASK)
@@ -543,7 +543,7 @@ def _filter_step(S, H, G, t, k, table, gains, palette, inv_ww, background_mask, 
 TRACE_UPDATE, TRACE_CREATE, TRACE_EVICT, TRACE_DROP, TRACE_UNSUPPORTED = range(5)
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def _supported(support, seen, cx, cy, t, window):
     """Some cell of the 3x3 around (cx, cy) had an event at most `window` µs ago (mod 2^32)."""
     for dy in range(-1, 2):
@@ -553,7 +553,7 @@ def _supported(support, seen, cx, cy, t, window):
     return False
 
 
-@numba.njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def run_events(S, H, G, k, table, gains, palette, inv_ww, background_mask, support, seen, t_us, xs, ys, lums, cbs, crs, out, log,
                ranges, trace=None):  # fmt: skip
     """Feed events; write records into `out`; with `trace` (an int64 array), write each event's

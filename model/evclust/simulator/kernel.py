@@ -11,10 +11,10 @@ from __future__ import annotations
 
 import sys
 
-import numba
 import numpy as np
 
 from evclust.events.format import EVENT_DTYPE
+from evclust.jit import njit
 
 # The kernel writes each event as the two little-endian uint64 words of its 16-byte record:
 # word 0 = t; word 1 = x | y << 16 | p << 32 | Y << 40 | Cb << 48 | Cr << 56.
@@ -24,17 +24,17 @@ _ON_BITS = np.uint64(1) << np.uint64(32)
 _OFF_BITS = np.uint64(0xFF) << np.uint64(32)  # int8 -1
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def _ycbcr(m, row, rgb, i):
     return m[row, 0] * rgb[i, 0] + m[row, 1] * rgb[i, 1] + m[row, 2] * rgb[i, 2] + m[row, 3]
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def _byte(v):
     return np.uint64(np.int64(min(max(v, 0.0), 255.0) + 0.5))
 
 
-@numba.njit(cache=True, nogil=True, boundscheck=False)
+@njit(cache=True, nogil=True, boundscheck=False)
 def detect_interval(l0, l1, rgb0, rgb1, ref, th_on, th_off, th_stride, width, t0_us, dt_us, first_pixel, words, keys, m):
     """Emit the events of pixels first_pixel.. as packed records into `words` (2 per event), and
     their sort keys ((t - floor(t0)) << 32 | emission index) into `keys`.

@@ -4,15 +4,15 @@ from __future__ import annotations
 
 from typing import Annotated, Literal
 
-import numba
 import numpy as np
 from pydantic import Field
 
 from evclust.events import sort_events
+from evclust.jit import njit
 from evclust.simulator.effects.base import Effect, EffectParams, round_us
 
 
-@numba.njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def _fifo(t, depth, service_us):
     """Serve events (sorted by arrival time t) through a FIFO of `depth` places, one every service_us.
 

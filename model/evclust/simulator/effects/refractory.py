@@ -4,14 +4,14 @@ from __future__ import annotations
 
 from typing import Annotated
 
-import numba
 import numpy as np
 from pydantic import Field
 
+from evclust.jit import njit
 from evclust.simulator.effects.base import Effect, EffectParams
 
 
-@numba.njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True)
 def _refractory_keep(t, x, y, width, n_pixels, period_us):
     """keep[i]: event i comes period_us or more after the last kept event of its pixel."""
     last = np.full(n_pixels, -np.inf)

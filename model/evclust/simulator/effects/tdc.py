@@ -11,17 +11,17 @@ from __future__ import annotations
 
 from typing import Annotated
 
-import numba
 import numpy as np
 from pydantic import Field, ValidationInfo, field_validator
 
 from evclust.colour import RGB_TO_YCBCR, YCBCR_TO_RGB
+from evclust.jit import njit, vectorize
 from evclust.simulator.effects.base import Effect, EffectParams
 
 
 # integration_time_us lives here, beside the compiled code that calls it: numba's on-disk cache
 # only notices edits to the calling function's own file. TFS latency imports it from here.
-@numba.vectorize(["float64(float64, float64, float64)"], cache=True, nopython=True)
+@vectorize(["float64(float64, float64, float64)"], cache=True, nopython=True)
 def integration_time_us(intensity, k_us, t_max_us):
     """Time-to-first-spike of the TFS pixel: the integration time k_us·255/I, capped at t_max_us.
 
@@ -34,7 +34,7 @@ def integration_time_us(intensity, k_us, t_max_us):
     return min(k_us * 255.0 / max(intensity, 1e-12), t_max_us)
 
 
-@numba.vectorize(["float64(float64, float64, float64, int64)"], cache=True, nopython=True)
+@vectorize(["float64(float64, float64, float64, int64)"], cache=True, nopython=True)
 def tdc_read(intensity, k_us, t_max_us, bits):
     """An intensity 0..255 -> what the TFS pixel and its `bits`-bit TDC read back, 0..255."""
     t = integration_time_us(intensity, k_us, t_max_us)
@@ -46,7 +46,7 @@ def tdc_read(intensity, k_us, t_max_us, bits):
     return min(k_us * 255.0 / ((code + 0.5) * step), 255.0)
 
 
-@numba.njit(cache=True, nogil=True, boundscheck=False)
+@njit(cache=True, nogil=True, boundscheck=False)
 def _requantise(lum, cb, cr, to_rgb, to_ycc, k_us, t_max_us, bits):
     """In place: YCbCr -> RGB, each channel through the TDC, -> YCbCr (rounded as the change detector does).
 
@@ -60,13 +60,13 @@ def _requantise(lum, cb, cr, to_rgb, to_ycc, k_us, t_max_us, bits):
         cr[i] = _byte(to_ycc[2, 0] * r + to_ycc[2, 1] * g + to_ycc[2, 2] * b + to_ycc[2, 3])
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def _read_channel(to_rgb, c, lum, cb, cr, k_us, t_max_us, bits):
     v = to_rgb[c, 0] * lum + to_rgb[c, 1] * cb + to_rgb[c, 2] * cr + to_rgb[c, 3]
     return tdc_read(min(max(v, 0.0), 255.0), k_us, t_max_us, bits)
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def _byte(v):
     return np.uint8(min(max(v, 0.0), 255.0) + 0.5)
 
