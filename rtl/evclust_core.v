@@ -80,8 +80,6 @@ module evclust_core #(
     localparam signed [63:0] MAX_ACT = (64'sd1 <<< ACTIVITY_W) - 1;
     localparam signed [63:0] MAX_GAMMA = (64'sd1 <<< GAMMA_W) - 1;
     localparam signed [63:0] MAX_EVCOUNT = (64'sd1 <<< EVENTS_IN_INTERVAL_W) - 1;
-    localparam signed [63:0] MAX_SIZE_TARGET = (64'sd1 <<< SIZE_TARGET_W) - 1;
-    localparam signed [63:0] MAX_SPEED_SQ = (64'sd1 <<< SPEED_SQ_W) - 1;
     localparam signed [63:0] MAX_V = (64'sd1 <<< (V_MCM_W - 1)) - 1, MIN_V = -(64'sd1 <<< (V_MCM_W - 1));
     localparam signed [63:0] MAX_VI = (64'sd1 <<< (V_INT_W - 1)) - 1, MIN_VI = -(64'sd1 <<< (V_INT_W - 1));
     localparam signed [63:0] MAX_STEP = (64'sd1 <<< (CENTRE_STEP_W - 1)) - 1, MIN_STEP = -(64'sd1 <<< (CENTRE_STEP_W - 1));
@@ -495,8 +493,8 @@ module evclust_core #(
         u_oy = abs64((ey <<< FP) - u_py);
         u_gx_full = (u64({{(64 - OFFSET_W){1'b0}}, u_ox[OFFSET_W-2:0]}) * K_GAIN) >>> (SIZE_GAIN_FRAC + FP - FR);
         u_gy_full = (u64({{(64 - OFFSET_W){1'b0}}, u_oy[OFFSET_W-2:0]}) * K_GAIN) >>> (SIZE_GAIN_FRAC + FP - FR);
-        u_gx = saturate(u_gx_full, 0, MAX_SIZE_TARGET);
-        u_gy = saturate(u_gy_full, 0, MAX_SIZE_TARGET);
+        u_gx = u_gx_full;  // < 2^SIZE_TARGET_W by construction: |e - P| < 2^coord, g_R < 2^bits(g_R)
+        u_gy = u_gy_full;
         u_rx = saturate(alpha_step(u64({{(63 - HALF_SIZE_W){1'b0}}, rx[e_slot]}), u_gx, K_B_SIZE, BETA_SIZE_FRAC, 0, 1'b0), K_R_MIN, K_R_MAX);
         u_ry = saturate(alpha_step(u64({{(63 - HALF_SIZE_W){1'b0}}, ry[e_slot]}), u_gy, K_B_SIZE, BETA_SIZE_FRAC, 0, 1'b0), K_R_MIN, K_R_MAX);
         // 3d. MCM velocity and its bias-correction weight.
@@ -601,12 +599,18 @@ module evclust_core #(
     wire [TAG_W-1:0]  t_tag;
     wire [Q_W-1:0]    t_qx, t_qy;
     wire              tail_en;
+`ifdef FORMAL
+    wire [(Q_W + SWEEP_DIV_STEP - 1) / SWEEP_DIV_STEP * TAG_W - 1:0] f_vmx_tags;  // the tail's stages (evclust_core_props.vh)
+`endif
     evclust_pipediv #(.Q_W(Q_W), .DEN_W(W20_W), .STEP(SWEEP_DIV_STEP), .TAG_W(TAG_W)) div_vmx (
         .clk(clk), .rst(dp_rst), .en(tail_en),
         .remainder_in(p_sat_x || !p_correct ? {W20_W{1'b0}} : p_mag_x[Q_W +: W20_W]), .bits_in(p_mag_x[Q_W-1:0]),
         .divisor(p_divisor),
         .tag_in({p_live, p_slot, p_correct, p_vmx[V_MCM_W-1], p_sat_x, p_vmy[V_MCM_W-1], p_sat_y, p_over_x, p_over_y}),
         .quotient(t_qx), .tag_out(t_tag)
+`ifdef FORMAL
+        , .f_tags(f_vmx_tags)
+`endif
     );
     wire [TAG_W-1:0] unused_tag_y;
     evclust_pipediv #(.Q_W(Q_W), .DEN_W(W20_W), .STEP(SWEEP_DIV_STEP), .TAG_W(TAG_W)) div_vmy (
@@ -660,7 +664,7 @@ module evclust_core #(
         f_sq_x = square(f_vmx, FV);
         f_sq_y = square(f_vmy, FV);
         f_speed_full = speed_sq({1'b0, f_sq_x} + {1'b0, f_sq_y}, FV);
-        f_speed_sq = saturate(f_speed_full, 0, MAX_SPEED_SQ);
+        f_speed_sq = f_speed_full;  // < 2^SPEED_SQ_W by construction: square() clamps each component below full scale
         f_left = f_px < K_EXIT_M;
         f_right = f_px > HI_X;
         f_top = f_py < K_EXIT_M;
@@ -822,10 +826,17 @@ module evclust_core #(
     wire        by_tau_done, frame_done;
     wire [32:0] by_tau_q;
     wire [TAU_PHASE_W:0] by_tau_left;
+`ifdef FORMAL
+    wire [$clog2(33 + 1)-1:0] f_by_tau_count;                  // the dividers' steps to go (evclust_core_props.vh)
+    wire [$clog2(FRAME_PER_TAU_W + 1)-1:0] f_frame_count;
+`endif
     evclust_udiv #(.NUM_W(33), .DEN_W(TAU_PHASE_W + 1)) div_phase (
         .clk(clk), .rst(dp_rst), .start(phase_start),
         .numerator(phase_q), .denominator(TAU[TAU_PHASE_W:0]),
         .done(by_tau_done), .quotient(by_tau_q), .remainder_out(by_tau_left)
+`ifdef FORMAL
+        , .f_count(f_by_tau_count)
+`endif
     );
     wire        many_boundaries = by_tau_q >= (33'd1 << FRAME_PER_TAU_W);
     wire        no_boundary = phase_q < {1'b0, TAU[31:0]};
@@ -836,6 +847,9 @@ module evclust_core #(
         .clk(clk), .rst(dp_rst), .start(frame_start),
         .numerator(K_FRAME_PER_TAU), .denominator(by_tau_q[FRAME_PER_TAU_W-1:0]),
         .done(frame_done), .quotient(frame_q), .remainder_out(unused_frame_left)
+`ifdef FORMAL
+        , .f_count(f_frame_count)
+`endif
     );
 
     // 1/|palette_j - BG|^2 for the mixing rule (model: refresh_mixing), one entry per cycle.
@@ -983,7 +997,6 @@ module evclust_core #(
         inc[COUNT_SAT_ACTIVITY * COUNTER_INC_W +: 2] = (do_update ? outside(u_act_full, 0, MAX_ACT) : 2'd0)
             + (bg_counts ? outside(bg_counted_full, 0, MAX_ACT) : 2'd0)
             + (m_write ? outside(m_weight, 0, MAX_ACT) : 2'd0);
-        inc[COUNT_SAT_SIZE_TARGET * COUNTER_INC_W +: 2] = do_update ? outside(u_gx_full, 0, MAX_SIZE_TARGET) + outside(u_gy_full, 0, MAX_SIZE_TARGET) : 2'd0;
         inc[COUNT_SAT_CENTRE_STEP * COUNTER_INC_W +: 2] = do_update ? outside(u_step_x_full, MIN_STEP, MAX_STEP) + outside(u_step_y_full, MIN_STEP, MAX_STEP) : 2'd0;
         inc[COUNT_SAT_MCM_STEP * COUNTER_INC_W +: 2] = do_update ? outside(u_ux_full, MIN_V, MAX_V) + outside(u_uy_full, MIN_V, MAX_V) : 2'd0;
         inc[COUNT_SAT_EVENTS_IN_INTERVAL * COUNTER_INC_W +: 2] = (do_update ? outside(u_evc_full, 0, MAX_EVCOUNT) : 2'd0)
@@ -992,7 +1005,6 @@ module evclust_core #(
             + (stage0 && f_gamma_by_count ? outside(f_gamma_count, 0, MAX_GAMMA) : 2'd0);
         inc[COUNT_SAT_V_INT * COUNTER_INC_W +: 2] = stage0 && boundaries != 33'd0 ? outside(f_mx_full, MIN_VI, MAX_VI) + outside(f_my_full, MIN_VI, MAX_VI) : 2'd0;
         inc[COUNT_SAT_V_MCM * COUNTER_INC_W +: 2] = tail_out && t_correct ? {1'b0, t_over_x} + {1'b0, t_over_y} : 2'd0;
-        inc[COUNT_SAT_SPEED_SQ * COUNTER_INC_W +: 2] = tail_out ? outside(f_speed_full, 0, MAX_SPEED_SQ) : 2'd0;
     end
     assign idle = state == ST_IDLE && !a_valid && !rec_valid;
 

@@ -10,7 +10,7 @@ parameter integer EV_W = 75,  // event word
 parameter integer REC_W = 411,  // record word
 parameter integer TRACE_W = 11,  // trace word
 parameter integer CFG_W = 2240,  // configuration block
-parameter integer COUNT_W = 38  // counter increments
+parameter integer COUNT_W = 34  // counter increments
 // verilator lint_on UNUSEDPARAM
 `else
 // verilator lint_off UNUSEDPARAM
@@ -467,7 +467,7 @@ localparam integer CFG_PALETTE_7_Y = 67;  // word index; bits [7:0]
 localparam integer CFG_PALETTE_7_CB = 68;  // word index; bits [7:0]
 localparam integer CFG_PALETTE_7_CR = 69;  // word index; bits [7:0]
 localparam [2239:0] CFG_RESET = {32'd124, 32'd135, 32'd62, 32'd128, 32'd130, 32'd96, 32'd128, 32'd130, 32'd32, 32'd127, 32'd130, 32'd144, 32'd128, 32'd128, 32'd233, 32'd156, 32'd43, 32'd191, 32'd104, 32'd188, 32'd64, 32'd193, 32'd109, 32'd59, 32'd8366981, 32'd8519680, 32'd6321603, 32'd192, 32'd1, 32'd1, 32'd1, 32'd1, 32'd1, 32'd1, 32'd217288, 32'd64, 32'd2200, 32'd0, 32'd5, 32'd61, 32'd79, 32'd0, 32'd12, 32'd32768, 32'd0, 32'd1810763, 32'd0, 32'd83214, 32'd12042, 32'd256, 32'd2173078, 32'd6705226, 32'd122880, 32'd4096, 32'd12736, 32'd76, 32'd7206, 32'd15080, 32'd173556, 32'd15360, 32'd0, 32'd21004078, 32'd259, 32'd262, 32'd470, 32'd402, 32'd376, 32'd341, 32'd287, 32'd426};  // the build's parameter set
-localparam integer N_COUNTERS = 19;
+localparam integer N_COUNTERS = 17;
 localparam integer COUNTER_INC_W = 2;
 localparam integer COUNT_EVENTS = 0;
 localparam integer COUNT_UPDATES = 1;
@@ -480,15 +480,13 @@ localparam integer COUNT_EXITS = 7;
 localparam integer COUNT_MERGES = 8;
 localparam integer COUNT_RECORDS = 9;
 localparam integer COUNT_SAT_ACTIVITY = 10;
-localparam integer COUNT_SAT_SIZE_TARGET = 11;
-localparam integer COUNT_SAT_CENTRE_STEP = 12;
-localparam integer COUNT_SAT_MCM_STEP = 13;
-localparam integer COUNT_SAT_EVENTS_IN_INTERVAL = 14;
-localparam integer COUNT_SAT_GAMMA = 15;
-localparam integer COUNT_SAT_V_INT = 16;
-localparam integer COUNT_SAT_V_MCM = 17;
-localparam integer COUNT_SAT_SPEED_SQ = 18;
+localparam integer COUNT_SAT_CENTRE_STEP = 11;
+localparam integer COUNT_SAT_MCM_STEP = 12;
+localparam integer COUNT_SAT_EVENTS_IN_INTERVAL = 13;
+localparam integer COUNT_SAT_GAMMA = 14;
+localparam integer COUNT_SAT_V_INT = 15;
+localparam integer COUNT_SAT_V_MCM = 16;
 localparam [31:0] REG_ID_VALUE = 32'h4556434c;
-localparam integer REG_VERSION_VALUE = 1;
+localparam integer REG_VERSION_VALUE = 2;
 // verilator lint_on UNUSEDPARAM
 `endif

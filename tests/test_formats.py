@@ -176,3 +176,49 @@ def test_a_parameter_set_for_another_build_is_written_within_its_formats():
     for field in registers.config_fields(table):
         value = sum(writes[field.address + 4 * i] << (32 * i) for i in range(field.words))
         assert value < 1 << field.width, field.name
+
+
+# Two stores the fixed model and the RTL do not saturate, because no input reaches their format's
+# top: the worst case of every input, for any parameter set the formats table accepts.
+_SENSORS = ((64, 48), (480, 270), (1280, 720), (65535, 2))
+_PARAMETER_SETS = (
+    ClustererParams(), ClustererParams(size_gain=1.0), ClustererParams(size_gain=3.9, r_max=63.0),
+    ClustererParams(alpha_vel_mcm=1 - 2**-17, r_max=63.0), ClustererParams(alpha_vel_int=0.1, alpha_size=0.5),
+)  # fmt: skip
+
+
+@pytest.mark.parametrize("dead_band_bits", [0, DEAD_BAND_BITS])
+@pytest.mark.parametrize("width, height", _SENSORS)
+@pytest.mark.parametrize("params", _PARAMETER_SETS, ids=range(len(_PARAMETER_SETS)))
+def test_size_target_and_speed_squared_cannot_overflow(params, width, height, dead_band_bits):
+    table = build_formats(params, width, height, 20_000.0, dead_band_bits=dead_band_bits)
+    f = table.formats
+    # g_R·|e - P|: the largest offset magnitude times the largest gain the size_gain register
+    # holds (a run-time value may use its whole format), floored to R's fraction.
+    gain = table.constants["size_gain"].fmt
+    offset_max = (1 << (f["offset"].int_bits + f["offset"].frac_bits)) - 1
+    shift = gain.frac_bits + f["centre"].frac_bits - f["half_size"].frac_bits
+    assert (offset_max * ((1 << gain.word_bits) - 1)) >> shift <= f["size_target"].raw_max
+    # |V|²: each component clamped to ±(2^V_FULL_BITS - LSB) before squaring, for both velocities.
+    for v in ("v_mcm", "v_int"):
+        frac = f[v].frac_bits
+        full = (1 << (f["v_int"].int_bits + frac)) - 1
+        square, shift = 2 * full * full, 2 * frac - f["speed_sq"].frac_bits
+        assert (square >> shift if shift >= 0 else square << -shift) <= f["speed_sq"].raw_max, v
+
+
+@pytest.mark.parametrize("options, message", [({"activity_bits": 0}, "activity_bits = 0"), ({"activity_bits": 18}, "activity_bits = 18"),
+                                              ({"interval_count_bits": 21}, "interval_count_bits = 21")])  # fmt: skip
+def test_counters_can_be_narrowed_not_widened(options, message):
+    with pytest.raises(EvclustError, match=message):
+        build_formats(ClustererParams(), 64, 48, 20_000.0, **options)
+    narrow = build_formats(ClustererParams(), 64, 48, 20_000.0, activity_bits=8, interval_count_bits=6)
+    assert (narrow["activity"].q, narrow["events_in_interval"].q) == ("UQ8.8", "UQ6.0")
+
+
+def test_a_new_clusters_gamma_that_would_overflow_its_format_is_refused():
+    # γ of a one-event cluster is ln2·T_frame/T_half unsaturated: at most γ's 14 integer bits.
+    fits = ClustererParams(t_half_us=math.log(2) * 1e6 / 16000)
+    build_formats(fits, 64, 48, 1e6)
+    with pytest.raises(EvclustError, match="a new cluster's γ"):
+        build_formats(fits.model_copy(update={"t_half_us": math.log(2) * 1e6 / 17000}), 64, 48, 1e6)

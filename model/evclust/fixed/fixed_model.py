@@ -48,12 +48,12 @@ SIGNALS = (
     C_V_MIN_SQ, C_V_EXIT_SQ, C_SQ_F, C_COS_SQ, C_COS_SQ_F, C_EXIT_M,
     C_WIDTH, C_HEIGHT, C_COLOUR, C_WARM, C_MCM_CORRECT, C_VOTE_CONTRAST, C_MIXING, C_MIX_TOL,
     C_MAX_ACT, C_MAX_V, C_MIN_V, C_MAX_VI, C_MIN_VI, C_MAX_GAMMA,
-    C_MAX_EVCOUNT, C_MAX_SIZE_TARGET, C_V_FULL_BITS, C_MAX_SPEED_SQ,
+    C_MAX_EVCOUNT, C_V_FULL_BITS,
     C_SEEK_SCALE, C_MERGE, C_MERGE_SCALE, C_MERGE_V_TOL, C_MERGE_V_REL, C_SCALE_F, C_NOISE_GATE, C_NOISE_GATE_F,
     C_SUPPORT, C_SUPPORT_BITS, C_SUPPORT_WINDOW, C_R_MAX_RAW, C_VI_CAP,
     C_MIN_STEP, C_MAX_STEP, C_FWD, C_FQ,
-) = range(88)  # fmt: skip
-N_CONSTANTS = 88
+) = range(86)  # fmt: skip
+N_CONSTANTS = 86
 
 
 def constant_vector(table, params, has_colour: bool) -> np.ndarray:
@@ -95,8 +95,7 @@ def constant_vector(table, params, has_colour: bool) -> np.ndarray:
     k[C_WARM], k[C_MCM_CORRECT] = params.velocity_warm_start, params.mcm_bias_correction
     k[C_VOTE_CONTRAST], k[C_MIXING], k[C_MIX_TOL] = params.palette_vote == "contrast", params.palette_assign == "mixing", raw("mixing_tolerance")
     k[C_MAX_ACT] = f["activity"].raw_max
-    k[C_MAX_SIZE_TARGET] = f["size_target"].raw_max
-    k[C_V_FULL_BITS], k[C_MAX_SPEED_SQ] = f["v_int"].int_bits, f["speed_sq"].raw_max
+    k[C_V_FULL_BITS] = f["v_int"].int_bits
     k[C_MAX_V], k[C_MIN_V] = f["v_mcm"].raw_max, f["v_mcm"].raw_min
     k[C_MAX_VI], k[C_MIN_VI] = f["v_int"].raw_max, f["v_int"].raw_min
     k[C_MAX_GAMMA], k[C_MAX_EVCOUNT] = f["gamma"].raw_max, f["events_in_interval"].raw_max
@@ -288,8 +287,9 @@ def _update(S, H, G, s, t, ex, ey, lum, cb, cr, k, table, palette, inv_ww, backg
     # 3c. Size: R += β_R (g_R |e - P| - R), then the clamp.
     gx = (abs((ex << fp) - px) * k[C_GAIN]) >> (k[C_GAIN_F] + fp - fr)
     gy = (abs((ey << fp) - py) * k[C_GAIN]) >> (k[C_GAIN_F] + fp - fr)
-    gx = _store(gx, 0, k[C_MAX_SIZE_TARGET], S_SIZE_TARGET, log, ranges)
-    gy = _store(gy, 0, k[C_MAX_SIZE_TARGET], S_SIZE_TARGET, log, ranges)
+    # No saturation: |e - P| < 2^coord and g_R < 2^bits(g_R), so the product fits size_target.
+    gx = _seen(gx, S_SIZE_TARGET, ranges)
+    gy = _seen(gy, S_SIZE_TARGET, ranges)
     S[s, RX] = _seen(min(max(alpha_step_nb(S[s, RX], gx, k[C_B_SIZE], k[C_BB_SIZE], 0, FLOOR), k[C_R_MIN]), k[C_R_MAX]), S_HALF, ranges)
     S[s, RY] = _seen(min(max(alpha_step_nb(S[s, RY], gy, k[C_B_SIZE], k[C_BB_SIZE], 0, FLOOR), k[C_R_MIN]), k[C_R_MAX]), S_HALF, ranges)
     # 3d. MCM: V += β_vm (γ (P_new - P) - V); the same filter on 1 gives the bias-correction weight.
@@ -481,7 +481,8 @@ def _filter_step(S, H, G, t, k, table, gains, palette, inv_ww, background_mask, 
             vmx = _store((S[s, VMX] << k[C_FWD]) // w_cut, k[C_MIN_V], k[C_MAX_V], S_VM, log, ranges)
             vmy = _store((S[s, VMY] << k[C_FWD]) // w_cut, k[C_MIN_V], k[C_MAX_V], S_VM, log, ranges)
         # Exit prediction on the squared speed (no square root).
-        speed_sq = _store(_speed_sq(vmx, vmy, fv, k), 0, k[C_MAX_SPEED_SQ], S_SPEED, log, ranges)
+        # No saturation: each component is clamped below 2^V_FULL_BITS, so the sum fits speed_sq.
+        speed_sq = _seen(_speed_sq(vmx, vmy, fv, k), S_SPEED, ranges)
         left, right, top, bottom = _near(S[s, PX], S[s, PY], k)
         if speed_sq >= k[C_V_EXIT_SQ] and speed_sq > 0:
             limit = (speed_sq * k[C_COS_SQ]) >> k[C_COS_SQ_F]

@@ -24,6 +24,12 @@ MAX_WORD_BITS = 63  # every raw value and intermediate fits an int64 (fixed/arit
 BETA_REL_ERROR_BITS = 8  # a β is quantised with at least 8 significant bits: < 0.4 % relative error
 MAX_BETA_FRAC_BITS = 32  # a β·x product then fits an int64 for every state format here
 DEAD_BAND_BITS = 6  # guard bits beyond 1/β: an α filter's dead band stays under 2^-6 of its input LSB
+# The event counters' integer bits: the activity (a decayed count; 2^17 holds 2^16 events in a
+# half-life with room) and a cluster's events in one τ (a dense cluster: 10^5). A build may narrow
+# them to save area, saturating sooner; the vector cases narrow them to reach saturation in a few
+# hundred events.
+ACTIVITY_BITS = 17
+INTERVAL_COUNT_BITS = 20
 DECAY_TABLE_BITS = 6  # 2^-f for f in [0, 1) in 64 steps
 DECAY_FRAC_BITS = 16
 SCALE_FRAC_BITS = 6  # seek, merge and velocity-agreement scales: steps of 1/64
@@ -144,21 +150,26 @@ def _quantise(value: float, fmt: Format, name: str, param: str) -> int:
 
 def build_formats(
     params: ClustererParams, width: int, height: int, t_frame_us: float, beta_shift_only: bool = False,
-    dead_band_bits: int = DEAD_BAND_BITS,
+    dead_band_bits: int = DEAD_BAND_BITS, activity_bits: int = ACTIVITY_BITS, interval_count_bits: int = INTERVAL_COUNT_BITS,
 ) -> FormatTable:  # fmt: skip
     """The formats of a parameter set on a sensor, and its quantised constants. With
     `beta_shift_only`, each β is rounded to the nearest power of two (a shift, no multiplier).
     `dead_band_bits` is the word-length knob: the guard bits every α filter's state keeps beyond
-    1/β, so each filtered signal's fraction moves with it."""
+    1/β, so each filtered signal's fraction moves with it. `activity_bits` and
+    `interval_count_bits` narrow the event counters (ACTIVITY_BITS, INTERVAL_COUNT_BITS at most)."""
     if not 0 <= dead_band_bits <= 16:
         raise EvclustError(f"dead_band_bits = {dead_band_bits}: expected 0..16 guard bits beyond 1/β")
+    if not 1 <= activity_bits <= ACTIVITY_BITS:
+        raise EvclustError(f"activity_bits = {activity_bits}: expected 1..{ACTIVITY_BITS} integer bits of the activity")
+    if not 1 <= interval_count_bits <= INTERVAL_COUNT_BITS:
+        raise EvclustError(f"interval_count_bits = {interval_count_bits}: expected 1..{INTERVAL_COUNT_BITS} bits of the events in a τ")
     p = params.resolved(t_frame_us)
     coord = _bits_for(max(width, height) - 1)
     # The L1 distance of two points of the sensor needs one bit more than a coordinate.
     seek_int = max(coord + 1, _bits_for(p.r_max + p.seek_margin + max(width, height)))
-    activity_bits = _bits_for(1 << 16) + 8
-    noise_int = max(activity_bits + _bits_for(width * height) + NOISE_GATE_FRAC_BITS,
-                    _bits_for(p.noise_gate) + NOISE_GATE_FRAC_BITS + activity_bits + 2 * _bits_for(2 * int(p.r_max) + 1)) - 8
+    activity_word = activity_bits + 8
+    noise_int = max(activity_word + _bits_for(width * height) + NOISE_GATE_FRAC_BITS,
+                    _bits_for(p.noise_gate) + NOISE_GATE_FRAC_BITS + activity_word + 2 * _bits_for(2 * int(p.r_max) + 1)) - 8
     betas = {
         "beta_pos": 1 - p.alpha_pos, "beta_size": 1 - p.alpha_size, "beta_vel_mcm": 1 - p.alpha_vel_mcm,
         "beta_vel_int": 1 - p.alpha_vel_int, "beta_lum": 1 - p.alpha_lum, "beta_chro": 1 - p.alpha_chro,
@@ -182,7 +193,7 @@ def build_formats(
         Format("ev_colour", False, 8, 0, "input", "event Y, Cb, Cr"),
         Format("centre", False, coord, pos_frac, "state", "cluster centre P and P_prev, px"),
         Format("half_size", False, _bits_for(p.r_max), guard("beta_size"), "state", "half-size R, px"),
-        Format("activity", False, _bits_for((1 << 16)), 8, "state", "decayed event count A"),
+        Format("activity", False, activity_bits, 8, "state", "decayed event count A"),
         Format("t_last", False, 32, 0, "state", "time the activity refers to, µs", overflow="wrap"),
         # V_MCM's input γ·(P_new - P) is large per event even when V is small: γ reaches ~10^4.
         # γ·step reaches γ (up to 2^14 events/frame) times a step of a px or two: as many integer
@@ -194,7 +205,7 @@ def build_formats(
         Format("colour", False, 8, guard("beta_chro") if p.alpha_chro >= p.alpha_lum else guard("beta_lum"), "state", "cluster colour Y, Cb, Cr"),
         Format("background", False, 8, guard("beta_bg"), "state", "background colour Y, Cb, Cr"),
         Format("gamma", False, 14, 8, "state", "γ: events per frame (the activity estimate reaches ~8000 early on)"),
-        Format("events_in_interval", False, 20, 0, "state", "events of the cluster since the last τ boundary (a dense cluster: 10^5 in a τ)"),
+        Format("events_in_interval", False, interval_count_bits, 0, "state", "events of the cluster since the last τ boundary (a dense cluster: 10^5 in a τ)"),
         Format("hist", False, p.hist_bits, 0, "state", "palette histogram counter"),
         Format("id", False, 32, 0, "state", "cluster id", overflow="wrap"),
         Format("offset", True, coord, pos_frac, "intermediate", "e - P, px"),
@@ -213,7 +224,7 @@ def build_formats(
         Format("mcm_weight", False, 1, 20, "intermediate", "w to 20 fraction bits: the MCM correction's divisor"),
         Format("dt", False, 32, 0, "intermediate", "t - t_last, µs (modulo 2^32)", overflow="wrap"),
         Format("support_time", False, 32, 0, "state", "creation-support map cell: time of its latest event, µs", overflow="wrap"),
-        Format("merge_moment", False, _bits_for((1 << 16)) + coord + 1, 8 + pos_frac, "intermediate",
+        Format("merge_moment", False, activity_bits + coord + 1, 8 + pos_frac, "intermediate",
                "A_s·P_s + A_j·P_j of a merge (activity × centre)"),
         # A·W·H << 4 against gate·A_bg·(2⌊R⌋ + 1)², the raw words with the activity's 8 fraction bits.
         Format("noise_count", False, noise_int, 8, "intermediate", "A·W·H against γ_n·A_bg·box (activity × px²)"),
@@ -243,6 +254,9 @@ def build_formats(
     gpa, fpt = math.log(2) * t_frame_us / p.t_half_us, t_frame_us / p.tau_us
     const("gamma_per_activity", gpa, False, _bits_for(gpa), _frac_for(gpa), "clusterer.t_half_us", "ln2·T_frame/T_half")
     const("frame_per_tau", fpt, False, _bits_for(fpt), _frac_for(fpt), "clusterer.tau_us", "T_frame/τ")
+    if _bits_for(gpa) > formats["gamma"].int_bits:  # a new cluster's γ is 1·ln2·T_frame/T_half, unsaturated
+        raise EvclustError(f"clusterer.t_half_us: ln2·T_frame/T_half = {gpa:.6g}; a new cluster's γ (one event's activity times it) "
+                           f"would not fit γ's format {formats['gamma'].q}: use a t_half_us above {math.log(2) * t_frame_us / 2**14:.6g} µs")
     const("inv_p", 1.0 / p.p_correction, False, _bits_for(1.0 / p.p_correction), 12, "clusterer.p_correction", "1/p of eq. (11)")
     if p.luma_weight > 0:
         const("luma_weight", p.luma_weight, False, _bits_for(p.luma_weight), 6, "clusterer.luma_weight", "w_Y")

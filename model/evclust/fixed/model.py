@@ -7,7 +7,7 @@ import numpy as np
 from evclust.clusterer.layout import BG_CB, BG_CR, BG_Y, RECORD_COLUMNS, SLOT_COLUMNS, run_stats, support_shape
 from evclust.clusterer.params import ClustererParams
 from evclust.fixed import fixed_model
-from evclust.fixed.formats import DEAD_BAND_BITS, FormatTable, build_formats, decay_table
+from evclust.fixed.formats import FormatTable, build_formats, decay_table
 from evclust.fixed.registers import runtime_table
 
 
@@ -27,17 +27,18 @@ class FixedClusterer:
 
     def __init__(
         self, params: ClustererParams, width: int, height: int, t_frame_us: float, has_colour: bool = True,
-        ranges: bool = False, beta_shift_only: bool = False, dead_band_bits: int = DEAD_BAND_BITS, build: FormatTable | None = None,
+        ranges: bool = False, build: FormatTable | None = None, **format_options,
     ):  # fmt: skip
         self.params = params = params.resolved(t_frame_us)
-        # beta_shift_only: every β a power of two, so each α filter multiplies by shifting;
-        # dead_band_bits: the filters' guard bits, the formats table's word-length knob.
+        # format_options: build_formats's knobs (beta_shift_only: every β a power of two, so each
+        # α filter multiplies by shifting; dead_band_bits: the filters' guard bits, the formats
+        # table's word-length knob; activity_bits, interval_count_bits: narrower event counters).
         # build: the formats of an RTL built for other parameters, which these are written into
         # at run time (fixed/registers.py): that build's formats with these parameters' constants.
         if build is not None:
             self.table = runtime_table(build, params, t_frame_us)
         else:
-            self.table = build_formats(params, width, height, t_frame_us, beta_shift_only=beta_shift_only, dead_band_bits=dead_band_bits)
+            self.table = build_formats(params, width, height, t_frame_us, **format_options)
         self.k = fixed_model.constant_vector(self.table, params, has_colour)
         self.decay = np.asarray(decay_table(self.table), dtype=np.int64)
         self.gains = np.asarray(self.table.warmup_gains, dtype=np.int64)

@@ -20,7 +20,7 @@ from evclust.errors import EvclustError
 from evclust.fixed.formats import OPTIONAL_CONSTANTS, Constant, FormatTable, _options, _quantise, build_formats
 
 ID_VALUE = 0x4556434C  # "EVCL"
-VERSION = 1
+VERSION = 2  # 2: no saturation counters for size_target and speed_sq, which cannot overflow
 # Control and status, then the counters, then the configuration (32-bit words, byte addresses).
 REG_ID, REG_VERSION, REG_CTRL, REG_STATUS, REG_IRQ_ENABLE, REG_BUILD = 0x000, 0x004, 0x008, 0x00C, 0x010, 0x014
 CTRL_CLEAR, CTRL_CLEAR_COUNTERS = 1, 2  # write-1 pulses
@@ -29,7 +29,7 @@ COUNTERS_BASE = 0x040
 CONFIG_BASE = 0x100
 
 # The fixed model's saturating signals (the `_store` sites of fixed_model.py), in counter order.
-SATURATING_SIGNALS = ("activity", "size_target", "centre_step", "mcm_step", "events_in_interval", "gamma", "v_int", "v_mcm", "speed_sq")
+SATURATING_SIGNALS = ("activity", "centre_step", "mcm_step", "events_in_interval", "gamma", "v_int", "v_mcm")
 ACTION_COUNTERS = ("events", "updates", "creates", "evictions", "drops", "unsupported", "expiries", "exits", "merges", "records")
 COUNTERS = ACTION_COUNTERS + tuple(f"sat_{name}" for name in SATURATING_SIGNALS)
 COUNTER_INC_BITS = 2  # the core adds at most 2 to a counter per cycle (x and y saturating together)

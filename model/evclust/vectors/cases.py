@@ -28,6 +28,7 @@ class Case:
     params: ClustererParams
     source: str
     seed: int = 0
+    formats: dict = dataclasses.field(default_factory=dict)  # build_formats's knobs, for a narrowed build
 
 
 def _events(rows) -> np.ndarray:
@@ -99,6 +100,70 @@ def saturating_corners() -> Case:
     corners = [(0, 0), (63, 0), (0, 47), (63, 47)]
     rows = [(1000 + 2 * i, *corners[i % 4], 255 * (i % 2), 255 * ((i // 2) % 2), 0) for i in range(2000)]
     return Case("events at the four corners with extreme colours", _events(rows), **SMALL, params=_small_params(), source="directed")
+
+
+def saturation_counts() -> Case:
+    # A build with narrow event counters (activity UQ8.8, events in a τ UQ6.0) and γ from the
+    # activity (ln2·T_frame/T_half = 69 events/frame per unit): a burst of 400 events at one
+    # microsecond saturates the activity and the τ count, then γ at the next filter step. Then
+    # events alternating 34 px apart in a window of R + S = 37 px with β_P = 0.5: the first
+    # centre step (17 px) saturates, every γ·step after it (γ ~10^4) saturates the MCM input,
+    # and the centre's swings over τ = 2 ms at T_frame/τ = 100 saturate the interval velocity.
+    rows = [(1000, 44 + i % 3, 36 + i % 2, 200, 90, 160) for i in range(400)]
+    rows += [(1500 + 20 * i, 5 if i % 2 == 0 else 39, 20, 200, 90, 160) for i in range(600)]
+    params = _small_params(alpha_pos=0.5, r_init=30.0, r_max=31.0, seek_margin=7.0, exit_margin=1.0, gamma_mode="activity",
+                           t_half_us=2000.0, tau_us=2000.0, alpha_vel_mcm=0.99, n_clusters=4)  # fmt: skip
+    return Case("narrow event counters and a 1 s frame period: the activity, the events in a τ, γ, the centre step, the MCM "
+                "input and the interval velocity saturate", _events(rows), 64, 48, 200_000.0, params, "directed",
+                formats={"activity_bits": 8, "interval_count_bits": 6})  # fmt: skip
+
+
+def saturation_mcm() -> Case:
+    # Spots racing 8 px per event right, down, left and up, γ = 4095 (global) and β_vm = 2^-17,
+    # which leaves V_MCM 14 integer bits: every γ·step saturates the MCM input from a cluster's
+    # first update, so V/w, the bias-corrected velocity, lands on or past the format's end (top
+    # or bottom, x or y) and saturates too. Each run starts ~30 px from where the last ended, after
+    # 150 ms of silence (7.5 half-lives): the last run's cluster expires at the first filter step,
+    # and each run is a new cluster whose velocity has one sign.
+    paths = (
+        [(x, 8) for x in range(2, 61, 8)], [(30, y) for y in range(2, 47, 8)],
+        [(x, 40) for x in range(60, 1, -8)], [(30, y) for y in range(46, 1, -8)],
+    )  # fmt: skip
+    rows, t = [], 1000
+    for run in range(40):
+        for x, y in paths[run % 4]:
+            rows.append((t, x, y, 200, 90, 160))
+            t += 50
+        t += 150_000
+    params = _small_params(alpha_pos=0.5, r_init=12.0, seek_margin=4.0, exit_margin=1.0, gamma_mode="global", gamma=4095.0,
+                           alpha_vel_mcm=1 - 2**-17, n_clusters=4, filter_every=4)  # fmt: skip
+    return Case("spots racing at 8 px per event in four directions with γ = 4095: the MCM input and the bias-corrected MCM velocity "
+                "saturate; each run's cluster expires in the silence after it", _events(rows), **SMALL, params=params,
+                source="directed")  # fmt: skip
+
+
+def expire_evict_recreate() -> Case:
+    # A two-slot table, T_half = 2 ms. Spots A and B fill it; after 6 ms of silence C evicts the
+    # weaker; after 40 ms more, D evicts C (the table is still full: expiry waits for a filter
+    # step), the filter step then expires B, and A returns into B's freed slot; E finds both
+    # slots strong and is dropped.
+    rows, t = [], 1000
+
+    def spot(x, y, count):
+        nonlocal t
+        for i in range(count):
+            rows.append((t, x + i % 2, y + i // 2 % 2, 200, 90, 160))
+            t += 10
+
+    spot(10, 10, 48)
+    spot(50, 10, 48)
+    t += 6000
+    spot(30, 38, 48)
+    t += 40_000
+    for x, y in ((10, 38), (10, 10), (50, 38)):
+        spot(x, y, 24)
+    return Case("a two-slot table: evictions of a weak cluster, an expiry, a re-creation in the freed slot, then drops", _events(rows),
+                **SMALL, params=_small_params(n_clusters=2, t_half_us=2000.0, a_valid=6.0), source="directed")  # fmt: skip
 
 
 def one_pixel() -> Case:
@@ -267,6 +332,9 @@ CASES = {
     "timestamp_wrap": timestamp_wrap,
     "table_full": table_full,
     "saturating_corners": saturating_corners,
+    "saturation_counts": saturation_counts,
+    "saturation_mcm": saturation_mcm,
+    "expire_evict_recreate": expire_evict_recreate,
     "one_pixel": one_pixel,
     "bursts": bursts,
     "gaps": gaps,

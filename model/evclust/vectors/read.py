@@ -75,7 +75,8 @@ def load_case(folder: str | Path, rtl_header: str | None = None) -> VectorCase:
         if digest != manifest["sha256"].get(file):
             raise EvclustError(f"{path}: sha256 differs from the manifest's (edited or truncated; `make vectors` regenerates)")
     params = ClustererParams(**manifest["parameters"])
-    own = build_formats(params, manifest["sensor"]["width"], manifest["sensor"]["height"], manifest["t_frame_us"])
+    own = build_formats(params, manifest["sensor"]["width"], manifest["sensor"]["height"], manifest["t_frame_us"],
+                        **manifest.get("format_options", {}))  # fmt: skip
     constants = {c.name: c.raw for c in own.constants.values()}
     if constants != manifest["constants"]:
         bad = sorted(set(constants.items()) ^ set(manifest["constants"].items()))[0][0]

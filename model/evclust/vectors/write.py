@@ -13,6 +13,7 @@ from evclust import __version__
 from evclust.clusterer.run import records_to_tracks
 from evclust.errors import atomic_folder
 from evclust.fixed.model import FixedClusterer
+from evclust.fixed.registers import SATURATING_SIGNALS
 from evclust.vectors.cases import CASES, Case
 from evclust.vectors.pack import TRACE_FIELDS, event_fields, event_words, hex_lines, pack, record_fields, record_words
 
@@ -37,10 +38,16 @@ def model_words(model: FixedClusterer, events: np.ndarray) -> tuple[list[int], l
     return event_words(events, model.table), record_words(tracks, model.table), words
 
 
+def _counts(model: FixedClusterer) -> dict:
+    """The run's counters, with every saturating signal's count (0 included) in register order."""
+    stats = model.stats()
+    return stats | {"saturations": {name: stats["saturations"].get(name, 0) for name in SATURATING_SIGNALS}}
+
+
 def write_case(name: str, folder: Path, case: Case | None = None) -> dict:
     """Write one case: a built-in one by name, or `case` (e.g. from an event file) under `name`."""
     case = case or CASES[name]()
-    model = FixedClusterer(case.params, case.width, case.height, case.t_frame_us)
+    model = FixedClusterer(case.params, case.width, case.height, case.t_frame_us, **case.formats)
     event_list, record_list, trace_list = model_words(model, case.events)
     table = model.table
     contents = {
@@ -59,12 +66,13 @@ def write_case(name: str, folder: Path, case: Case | None = None) -> dict:
         "n_clusters": case.params.n_clusters,
         "palette_size": len(case.params.palette),
         "parameters": case.params.model_dump(mode="json", exclude_none=True),
+        "format_options": case.formats,
         "constants": {c.name: c.raw for c in table.constants.values()},
         "formats": {f.name: {"q": f.q, "signed": f.signed, "int_bits": f.int_bits, "frac_bits": f.frac_bits,
                              "rounding": f.rounding, "overflow": f.overflow} for f in table.formats.values()},  # fmt: skip
         "layouts": {"events.hex": _layout(event_fields(table)), "expected.hex": _layout(record_fields(table)),
                     "trace.hex": _layout(TRACE_FIELDS)},  # fmt: skip
-        "counts": {"events": int(case.events.size), "records": len(record_list), **model.stats()},
+        "counts": {"events": int(case.events.size), "records": len(record_list), **_counts(model)},
         "sha256": {file: hashlib.sha256(text.encode()).hexdigest() for file, text in contents.items()},
     }
     with atomic_folder(folder) as tmp:  # a case is whole or absent, even if interrupted
