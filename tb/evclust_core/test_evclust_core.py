@@ -159,7 +159,7 @@ if cocotb is not None:
         config = _config()
         result = {"cases": {}, "runtime_config": int(dut.RUNTIME_CONFIG.value)}
         cocotb.start_soon(Clock(dut.clk, CLOCK_NS, unit="ns").start())
-        Registers(dut)  # the register bus idles (the build's parameters, from reset)
+        registers = Registers(dut)  # the build's parameters, from reset; the counters read after each case
         header = Path(config["header"]).read_text()
         for folder in config["cases"]:
             try:
@@ -171,7 +171,10 @@ if cocotb is not None:
             await harness.reset()
             trace, records, tags = await harness.stream(case.events, _seed(case.name, config["seed"]), config["gap"], config["stall"], case.table.n_clusters)
             error = _compare(case.name, case.events, case.trace, trace, case.expected, records, tags, case.table)
-            result["cases"][case.name] = harness.stats | {"records": len(records)}
+            counters = await registers.counters()
+            # The manifest's counts, saturations of every signal included, against the RTL's status counters.
+            error = error or _counter_mismatch(model_counters(case.manifest["counts"], len(case.expected)), counters)
+            result["cases"][case.name] = harness.stats | {"records": len(records), "counters": counters}
             if error:
                 result["error"] = error
                 break
