@@ -106,6 +106,44 @@ module evclust_tb #(
         .count_inc(count_inc)
     );
 
+    // Functional coverage (evclust.rtl.coverage reads it at the end of a run): cycles in each FSM
+    // state, each state change, the filter step's division paths, and the stream conditions
+    // (records held by back-pressure, input gaps while the core is ready). The core is reached
+    // by hierarchical reference, so the IP itself carries no debug port.
+    reg [31:0] cov_state [0:7];   // cycles in state s (ST_INIT .. ST_PHASE)
+    reg [31:0] cov_arc   [0:63];  // changes from state a to state b, at a * 8 + b
+    reg [31:0] cov_phase [0:3];   // cycles in ST_PHASE per phase_step (decide, divide by τ, divide the frame)
+    reg [31:0] cov_stream [0:3];  // record held (valid, not ready); input gap (ready, not valid); both; event and record in one cycle
+    reg [2:0]  cov_prev;
+    integer    cov_i;
+    initial begin
+        for (cov_i = 0; cov_i < 8; cov_i = cov_i + 1) cov_state[cov_i] = 32'd0;
+        for (cov_i = 0; cov_i < 64; cov_i = cov_i + 1) cov_arc[cov_i] = 32'd0;
+        for (cov_i = 0; cov_i < 4; cov_i = cov_i + 1) begin
+            cov_phase[cov_i] = 32'd0;
+            cov_stream[cov_i] = 32'd0;
+        end
+        cov_prev = 3'd0;
+    end
+    always @(posedge clk) begin
+        if (!rst) begin
+            cov_state[core.state] <= cov_state[core.state] + 32'd1;
+            if (core.state != cov_prev)
+                cov_arc[{cov_prev, core.state}] <= cov_arc[{cov_prev, core.state}] + 32'd1;
+            if (core.state == core.ST_PHASE)
+                cov_phase[core.phase_step] <= cov_phase[core.phase_step] + 32'd1;
+            if (rec_valid && !rec_ready)
+                cov_stream[0] <= cov_stream[0] + 32'd1;
+            if (running && ev_ready && !ev_valid)
+                cov_stream[1] <= cov_stream[1] + 32'd1;
+            if (rec_valid && !rec_ready && ev_valid && !ev_ready)
+                cov_stream[2] <= cov_stream[2] + 32'd1;
+            if (ev_valid && ev_ready && rec_valid && rec_ready)
+                cov_stream[3] <= cov_stream[3] + 32'd1;
+        end
+        cov_prev <= core.state;
+    end
+
     // The next event to offer, once the current one (if any) has been taken.
     wire [31:0] next_index = accepted + ((ev_valid && ev_ready) ? 32'd1 : 32'd0);
     wire        offer = running && next_index < count && random[7:0] >= gap_threshold;

@@ -130,4 +130,11 @@ def run(sim: str, header: str, testcase: str, config: dict, toplevel: str = TOPL
     result = json.loads(out.read_text())
     if result.get("error"):
         raise AssertionError(f"{sim}: {result['error']}")
+    if "coverage" in result:  # the run's functional-coverage bins, for evclust.rtl.coverage
+        from evclust.rtl.coverage import COVERAGE_DIR
+
+        folder = BUILD.parent / COVERAGE_DIR
+        folder.mkdir(parents=True, exist_ok=True)
+        label = {"toplevel": toplevel, "testcase": testcase, "sim": sim, "parameters": parameters or {}}
+        (folder / f"{sim}-{testcase}-{key}-{build_dir.name}.json").write_text(json.dumps(label | {"bins": result["coverage"]}))
     return result
