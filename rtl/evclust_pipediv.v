@@ -19,6 +19,10 @@ module evclust_pipediv #(
     input  wire [TAG_W-1:0] tag_in,
     output wire [Q_W-1:0]   quotient,
     output wire [TAG_W-1:0] tag_out
+`ifdef FORMAL
+    ,
+    output wire [(Q_W + STEP - 1) / STEP * TAG_W - 1:0] f_tags  // stage r's tag at [(r - 1) * TAG_W]: the core's proofs' invariants
+`endif
 );
     localparam integer STAGES = (Q_W + STEP - 1) / STEP;
     localparam integer FIRST = Q_W - (STAGES - 1) * STEP;  // the first stage takes what is left over
@@ -71,5 +75,13 @@ module evclust_pipediv #(
 
     assign quotient = bits_q[STAGES];
     assign tag_out = tag_q[STAGES];
+`ifdef FORMAL
+    genvar f_r;
+    generate
+        for (f_r = 1; f_r <= STAGES; f_r = f_r + 1) begin : f_stage
+            assign f_tags[(f_r - 1) * TAG_W +: TAG_W] = tag_q[f_r];
+        end
+    endgenerate
+`endif
 endmodule
 `default_nettype wire

@@ -14,6 +14,10 @@ module evclust_udiv #(
     output reg              done,         // quotient valid, until the next start
     output reg  [NUM_W-1:0] quotient,
     output wire [DEN_W-1:0] remainder_out  // numerator - quotient * denominator, with done
+`ifdef FORMAL
+    ,
+    output wire [$clog2(NUM_W + 1)-1:0] f_count  // the steps still to go (the core's proofs' invariants)
+`endif
 );
     localparam integer COUNT_W = $clog2(NUM_W + 1);
     localparam [COUNT_W-1:0] LAST = NUM_W[COUNT_W-1:0];
@@ -28,6 +32,9 @@ module evclust_udiv #(
     wire [DEN_W:0] reduced = shifted - {1'b0, divisor};
     wire           busy = count != {COUNT_W{1'b0}};
     assign remainder_out = remainder;
+`ifdef FORMAL
+    assign f_count = count;
+`endif
 
     always @(posedge clk) begin
         if (rst) begin

@@ -44,13 +44,39 @@ BREAKAGES = {
         "evclust_core",
         "wire sweep_advance = state == ST_SWEEP && (!rec_valid || rec_ready);",
         "wire sweep_advance = state == ST_SWEEP;",
-        ("assert (rec_valid && rec_data == $past(rec_data));",),
+        # The overwritten record is also one that the sweep's record accounting misses.
+        ("assert (rec_valid && rec_data == $past(rec_data));", "assert (f_offered[f_s] == (f_out[f_s] && f_reported[f_s]));",
+         "assert (&f_visited && f_out == f_kept"),
     ),
     "core traces an event twice": (
         "evclust_core",
         "        trace_valid <= 1'b0;\n",
         "        trace_valid <= trace_valid;\n",
         ("assert (f_open ==",),
+    ),
+    "core's sweep waits for the record consumer with no record on offer": (
+        "evclust_core",
+        "wire sweep_advance = state == ST_SWEEP && (!rec_valid || rec_ready);",
+        "wire sweep_advance = state == ST_SWEEP && rec_ready;",
+        ("assert (!f_filter || f_filter_cycles < F_FILTER_BOUND);", "f_filter_cycles <= F_PHASE_MAX + index);"),
+    ),
+    "core ends a sweep before its tail drains (the last slot's record skipped)": (
+        "evclust_core",
+        "LAST_SWEEP_I = SWEEP_LEN + TAIL - 1;",
+        "LAST_SWEEP_I = SWEEP_LEN + TAIL - 2;",
+        ("assert (&f_visited && f_out == f_kept", "assert (!f_live[f_j]);", "assert (f_kept[t] && !f_out[t]);"),
+    ),
+    "core's sweep skips the last slot": (
+        "evclust_core",
+        "wire sweep_live = sweep_advance && index < N_SLOTS && valid[k];",
+        "wire sweep_live = sweep_advance && index < N_SLOTS - 1'b1 && valid[k];",
+        ("assert (&f_visited && f_out == f_kept", "assert (!f_visited[f_s] || f_kept[f_s] || !valid[f_s]);"),
+    ),
+    "core offers a taken record again": (
+        "evclust_core",
+        "        if (rec_valid && rec_ready)\n            rec_valid <= 1'b0;\n",
+        "        if (rec_valid && rec_ready)\n            rec_valid <= 1'b1;\n",
+        ("!f_recorded[f_rec_slot]);", "assert (&f_visited && f_out == f_kept", "assert (state == ST_SWEEP || f_after_sweep);"),
     ),
 }
 

@@ -7,7 +7,14 @@
 //    under back-pressure);
 //  - every accepted event gives exactly one trace pulse: the events accepted and not yet
 //    traced are exactly those in stage A, in stage B and on the trace port, so none is lost or
-//    traced twice (a reset or clear discards those in flight, as documented).
+//    traced twice (a reset or clear discards those in flight, as documented);
+//  - a filter step ends within F_FILTER_BOUND cycles (80 in the reference build) in which no
+//    record waits for its consumer, and the core, IDLE again, takes the next event;
+//  - one record per reported slot per sweep: every slot visited once, each slot kept leaves the
+//    sweep's tail once, a record only for a slot out of the tail and never two for one slot,
+//    and at the sweep's end the records are exactly the table's reported clusters.
+// The dividers' steps to go and the tail's stage tags reach the properties through ports that
+// evclust_udiv and evclust_pipediv have only under `ifdef FORMAL.
 
     reg f_past_valid = 1'b0;
     always @(posedge clk)
@@ -30,3 +37,133 @@
     end
     always @(posedge clk) if (f_past_valid && !$past(dp_rst) && $past(rec_valid && !rec_ready))
         assert (rec_valid && rec_data == $past(rec_data));
+
+    // ---------------------------------------------------------------- the filter step ends
+    // Bounded liveness: a filter step (PHASE, SWEEP, MERGE) ends within F_FILTER_BOUND cycles
+    // in which no record waits for its consumer (a waiting record holds the sweep, for as long
+    // as the consumer likes), after which the core is IDLE and takes the next event. The bound:
+    // PHASE's deciding cycle, the division phase / tau (33 steps and the cycle it is read) and
+    // T_frame / n (FRAME_PER_TAU_W steps and one), then one sweep cycle per slot and tail stage.
+    // The reference build has no merges (MERGE = 0) and the bound no merge term: with MERGE = 1
+    // each merge holds the sweep MERGE_MOMENT_W + 3 cycles more, up to N - 1 per sweep, and this
+    // proof fails until the bound and an invariant on the slots left to absorb say so.
+    localparam integer F_PHASE_MAX = 1 + (33 + 1) + (FRAME_PER_TAU_W + 1);
+    localparam integer F_FILTER_BOUND = F_PHASE_MAX + LAST_SWEEP_I + 1;
+    localparam integer F_CYCLES_W = $clog2(F_FILTER_BOUND + 1);
+    wire f_filter = state == ST_PHASE || state == ST_SWEEP || state == ST_MERGE;
+    reg [F_CYCLES_W-1:0] f_filter_cycles;  // the filter step's cycles so far without a record waiting
+    always @(posedge clk)
+        if (dp_rst || !f_filter)
+            f_filter_cycles <= {F_CYCLES_W{1'b0}};
+        else if (!(rec_valid && !rec_ready))
+            f_filter_cycles <= f_filter_cycles + 1'b1;
+
+    always @* if (f_past_valid) begin
+        assert (!f_filter || f_filter_cycles < F_FILTER_BOUND);
+        assert (state != ST_IDLE || dp_rst || ev_ready);
+        // What k-induction needs: where each phase of the step stands, against the dividers'
+        // steps to go.
+        if (MERGE == 0)
+            assert (state != ST_MERGE);
+        if (state == ST_PHASE) begin
+            assert (index == {SWEEP_W{1'b0}} && phase_step != 2'd3);
+            if (phase_step == PHASE_DECIDE)
+                assert (f_filter_cycles == {F_CYCLES_W{1'b0}});
+            if (phase_step == PHASE_BY_TAU)
+                assert ((f_by_tau_count != 0 || by_tau_done) && f_filter_cycles + f_by_tau_count <= 1 + 33);
+            if (phase_step == PHASE_FRAME)
+                assert ((f_frame_count != 0 || frame_done) && f_filter_cycles + f_frame_count <= 1 + (33 + 1) + FRAME_PER_TAU_W);
+        end
+        if (state == ST_SWEEP)
+            assert (index <= LAST_SWEEP && f_filter_cycles <= F_PHASE_MAX + index);
+    end
+
+    // ---------------------------------------------------------------- one record per reported slot
+    // Within a sweep: stage 0 visits every slot once; each slot it keeps (valid, not expired)
+    // leaves the tail exactly once and before the sweep ends; a record is offered (valid up
+    // after a cycle with none waiting) only for a slot that has left the tail, never twice for
+    // one slot; and when the sweep ends, the slots with a record are exactly the table's
+    // reported clusters (valid and reported). With the stream property above (a record holds
+    // until taken), each is taken once.
+    localparam integer F_STAGES = (Q_W + SWEEP_DIV_STEP - 1) / SWEEP_DIV_STEP;  // div_vmx's stages
+    // The tail's positions: 0, its first register (p_*); j >= 1, div_vmx's stage j.
+    wire [F_STAGES:0]          f_live;
+    wire [SLOT_W-1:0]          f_slot [0:F_STAGES];
+    assign f_live[0] = p_live;
+    assign f_slot[0] = p_slot;
+    genvar f_j, f_s;
+    generate
+        for (f_j = 1; f_j <= F_STAGES; f_j = f_j + 1) begin : f_tail
+            assign f_live[f_j] = f_vmx_tags[(f_j - 1) * TAG_W + TAG_W - 1];
+            assign f_slot[f_j] = f_vmx_tags[(f_j - 1) * TAG_W + TAG_W - 2 -: SLOT_W];
+        end
+    endgenerate
+
+    reg [N-1:0] f_visited, f_kept, f_out, f_recorded;  // this sweep's slots: stage 0, the tail's exit, records
+    reg         f_held_q, f_after_sweep;
+    wire [REC_SLOT_W-1:0] f_rec_slot = rec_data[REC_SLOT_LSB +: REC_SLOT_W];
+    wire        f_new_record = rec_valid && !f_held_q;  // a record offered this cycle for the first time
+    wire [N-1:0] f_offered = f_recorded | (f_new_record ? {{(N - 1){1'b0}}, 1'b1} << f_rec_slot : {N{1'b0}});
+    wire [N-1:0] f_reported;
+    generate
+        for (f_s = 0; f_s < N; f_s = f_s + 1) begin : f_table
+            assign f_reported[f_s] = valid[f_s] && reported[f_s];
+        end
+    endgenerate
+    always @(posedge clk) begin
+        f_held_q <= rec_valid && !rec_ready;
+        f_after_sweep <= !dp_rst && state == ST_SWEEP && state_next == ST_IDLE;
+        if (dp_rst || state == ST_PHASE) begin
+            f_visited <= {N{1'b0}};
+            f_kept <= {N{1'b0}};
+            f_out <= {N{1'b0}};
+            f_recorded <= {N{1'b0}};
+        end else begin
+            if (tail_en && index < N_SLOTS)
+                f_visited[k] <= 1'b1;
+            if (stage0)
+                f_kept[k] <= 1'b1;
+            if (tail_out)
+                f_out[t] <= 1'b1;
+            if (f_new_record && f_rec_slot < N)
+                f_recorded[f_rec_slot] <= 1'b1;
+        end
+    end
+
+    always @* if (f_past_valid) begin
+        if (tail_out)
+            assert (f_kept[t] && !f_out[t]);
+        if (f_new_record)
+            assert (f_rec_slot < N && f_out[f_rec_slot] && !f_recorded[f_rec_slot]);
+        if (f_after_sweep)
+            assert (&f_visited && f_out == f_kept && f_offered == f_reported);
+        // What k-induction needs: the sweep's shadows against the index and the tail's tags.
+        if (f_new_record)
+            assert (state == ST_SWEEP || f_after_sweep);
+    end
+    generate
+        for (f_j = 0; f_j <= F_STAGES; f_j = f_j + 1) begin : f_position
+            always @* if (f_past_valid) begin
+                if (state != ST_SWEEP && state != ST_MERGE)
+                    assert (!f_live[f_j]);
+                if (f_live[f_j])
+                    assert (index >= f_j + 1 && index - f_j - 1 < N && f_slot[f_j] == index - f_j - 1);
+            end
+        end
+        for (f_s = 0; f_s < N; f_s = f_s + 1) begin : f_sweep_slot
+            always @* if (f_past_valid && state == ST_SWEEP) begin
+                assert (f_visited[f_s] == (f_s < index));
+                assert (f_visited[f_s] || !f_kept[f_s]);
+                assert (f_kept[f_s] || !f_out[f_s]);
+                assert (!f_visited[f_s] || f_kept[f_s] || !valid[f_s]);
+                assert (!f_kept[f_s] || f_out[f_s] || valid[f_s]);
+                assert (f_offered[f_s] == (f_out[f_s] && f_reported[f_s]));
+                if (index > f_s + F_STAGES + 1)
+                    assert (f_out[f_s] == f_kept[f_s]);
+            end
+            for (f_j = 0; f_j <= F_STAGES; f_j = f_j + 1) begin : f_in_tail
+                always @* if (f_past_valid && state == ST_SWEEP && index == f_s + f_j + 1)
+                    assert (!f_out[f_s] && f_kept[f_s] == f_live[f_j]);
+            end
+        end
+    endgenerate
