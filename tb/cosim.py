@@ -30,6 +30,12 @@ def selected_simulators() -> tuple[str, ...]:
 # stream's blobs are reported even in a four-slot table.
 CONFIGURATIONS = {"traffic": (480, 270, 50000.0), "pedestrian": (270, 480, 40000.0), "small": (64, 48, 10000.0),
                   "defaults": (160, 120, 16666.0)}  # fmt: skip
+# Configurations with a test of their own (tb/evclust_core/test_every_configuration.py, which
+# chooses its N and stream lengths): "paper", the paper's configuration (presets/paper.toml:
+# global γ, nearest-entry votes, velocity filters from zero, none of the one-cluster-per-object
+# additions) on the traffic sensor. The switches' other combinations are tb/switch_cover.py's
+# pairwise cover, on the small sensor.
+OTHER_CONFIGURATIONS = {"paper": (480, 270, 50000.0)}
 # The formats table's other shapes (build_formats options), on the traffic parameters: every β a
 # power of two, and the narrowest filter states (no guard bits beyond 1/β).
 FORMAT_VARIANTS = {"shift_only": {"beta_shift_only": True}, "no_guard_bits": {"dead_band_bits": 0}}
@@ -49,11 +55,13 @@ def configuration_params(name: str, n_clusters: int):
     return params.model_copy(update={"n_clusters": n_clusters})
 
 
-def random_config(name: str, n_clusters: int, seed: int, count: int, formats: dict | None = None, **extra) -> tuple[str, dict]:
-    """(header, testbench configuration) of a model-in-the-loop run; `formats` are build_formats's options."""
+def random_config(name: str, n_clusters: int, seed: int, count: int, formats: dict | None = None, params=None, **extra) -> tuple[str, dict]:
+    """(header, testbench configuration) of a model-in-the-loop run on configuration `name`'s sensor,
+    with its parameters or `params` (then of N = params.n_clusters); `formats` are build_formats's options."""
     formats = formats or {}
-    width, height, t_frame = CONFIGURATIONS[name]
-    params = configuration_params(name, n_clusters)
+    width, height, t_frame = (CONFIGURATIONS | OTHER_CONFIGURATIONS)[name]
+    params = params or configuration_params(name, n_clusters)
+    n_clusters = params.n_clusters
     t_frame = params.t_frame_us or t_frame
     header = params_header(params, width, height, t_frame, **formats)
     config = {"parameters": params.model_dump(mode="json", exclude_none=True), "n_clusters": n_clusters,

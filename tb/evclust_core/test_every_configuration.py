@@ -1,0 +1,122 @@
+"""Every configuration the model supports, co-simulated bit-exact to the fixed model in the loop
+(records, trace, status counters) under Icarus and Verilator: the paper's configuration, and a
+pairwise cover of the switches (tb/switch_cover.py). The cocotb test is test_evclust_core.py's
+`model_in_the_loop`; the presets and the small configuration run there too.
+
+`make test` runs two rows of the cover chosen from the commit hash (their numbers are in the test
+ids, and in a line at the end of the run); `make cosim-full` (EVCLUST_COVER=all) runs every row,
+and the paper's configuration at N = 4 as well and with full-length streams under Icarus;
+EVCLUST_COVER_ROWS=3,7 runs rows 3 and 7.
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from cosim import random_config, run, selected_simulators  # noqa: E402
+from switch_cover import (  # noqa: E402
+    COUNT, HEIGHT, SWITCHES, T_FRAME_US, WIDTH, all_pairs, cover, cover_stream, full, live_stream, pairs, row_params, selected_rows,
+)  # fmt: skip
+
+SIMS = selected_simulators()
+GAP, STALL = 64, 96  # random input gaps 25 % of cycles, output stalls 37.5 %, as in test_evclust_core.py
+ROWS, _ = selected_rows()
+
+
+# ------------------------------------------------------------------------------------------
+# The paper's configuration (presets/paper.toml) on the traffic sensor, at its own N = 16 (and
+# N = 4 under cosim-full). Icarus, some 40 times slower than Verilator here, takes 4,000 events
+# of the 10,000 in `make test`.
+
+
+@pytest.mark.parametrize("n_clusters", [4, 16] if full() else [16])
+@pytest.mark.parametrize("sim", SIMS)
+def test_the_papers_configuration_matches_the_model_in_the_loop(sim, n_clusters):
+    from evclust.clusterer import load_params
+
+    count = 10_000 if sim == "verilator" or full() else 4000
+    header, config = random_config("paper", n_clusters, seed=1000 + n_clusters, count=count, gap=GAP, stall=STALL)
+    paper, _ = load_params("paper")
+    assert config["parameters"] == paper.model_copy(update={"n_clusters": n_clusters}).model_dump(mode="json", exclude_none=True)
+    result = run(sim, header, "model_in_the_loop", config)
+    assert result["events"] == count
+    assert result["records"] > 0, "a stream that reports nothing checks little"
+    assert result["counters"]["records"] == result["records"]
+
+
+# ------------------------------------------------------------------------------------------
+# The switch cover.
+
+
+def test_the_cover_holds_every_pair_of_switch_values():
+    rows = cover()
+    assert len(all_pairs()) == 217  # two three-valued switches and eight two-valued ones
+    assert pairs(rows) == all_pairs()
+    # A pairwise cover needs at least 3 × 3 rows (the two three-valued switches); all
+    # 3 × 3 × 2^8 = 2,304 combinations would be exhaustive.
+    assert 9 <= len(rows) <= 12
+    assert len({row.name for row in rows}) == len(rows)
+    from evclust.clusterer import load_params
+
+    paper, _ = load_params("paper")  # row 0: the paper's switches, on the small sensor
+    assert all(getattr(row_params(rows[0]), name) == getattr(paper, name) for values in SWITCHES.values() for name in values[next(iter(values))])
+    for row in rows:  # each row a valid parameter set with its switches as its name says
+        params = row_params(row)
+        for switch, value in row.values.items():
+            for name, setting in SWITCHES[switch][value].items():
+                assert getattr(params, name) == setting, (row.name, name)
+
+
+def test_a_stream_that_reports_nothing_exercises_no_switch():
+    # The liveness check can fail: five events are too few to report a cluster (a_valid = 6), so no
+    # flip changes anything.
+    import switch_cover
+
+    row = cover()[0]
+    assert switch_cover.model_run(row, cover_stream(1, 5))[0] == []
+    assert len(switch_cover.dead_switches(row, cover_stream(1, 5))) == sum(len(v) - 1 for v in SWITCHES.values())
+    with pytest.raises(AssertionError, match=f"{row.name}: none of 3 streams exercises every switch"):
+        switch_cover.live_stream.__wrapped__(row, count=5, tries=3)
+
+
+def test_the_rotating_subset_follows_the_environment(monkeypatch):
+    monkeypatch.setenv("EVCLUST_COVER", "all")
+    assert selected_rows()[0] == cover()
+    monkeypatch.delenv("EVCLUST_COVER")
+    monkeypatch.setenv("EVCLUST_COVER_ROWS", "3,5")
+    assert [row.index for row in selected_rows()[0]] == [3, 5]
+    monkeypatch.setenv("EVCLUST_COVER_ROWS", "3,99")
+    with pytest.raises(SystemExit, match="EVCLUST_COVER_ROWS=3,99"):
+        selected_rows()
+    monkeypatch.delenv("EVCLUST_COVER_ROWS")
+    rows, how = selected_rows()
+    assert len(rows) == 2 and len(set(rows)) == 2
+    assert how.endswith("EVCLUST_COVER_ROWS=" + ",".join(str(row.index) for row in rows))
+    assert selected_rows() == (rows, how)  # the same on every call: every xdist worker agrees
+
+
+@pytest.mark.parametrize("row", ROWS, ids=lambda row: row.name)
+@pytest.mark.parametrize("sim", SIMS)
+def test_switch_cover_row_matches_the_model_in_the_loop(sim, row, tmp_path):
+    # The first stream of the row's own seeds on which flipping any one switch changes the
+    # model's records (live_stream), so that each switch's setting is one the RTL must get right.
+    seed, expected = live_stream(row)
+    events = tmp_path / f"{row.name}-{seed}.npy"
+    np.save(events, cover_stream(seed, COUNT))
+    params = row_params(row)
+    header, config = random_config("small", params.n_clusters, seed, COUNT, params=params, gap=GAP, stall=STALL, events=str(events))
+    assert (config["width"], config["height"], config["t_frame_us"]) == (WIDTH, HEIGHT, T_FRAME_US)
+    result = run(sim, header, "model_in_the_loop", config)  # records, trace and counters compared in the testbench
+    assert result["events"] == COUNT
+    assert result["records"] == expected["records"] > 0
+    assert result["counters"] == expected
+    if params.merge:
+        assert expected["merges"] > 0
+    if params.create_support:
+        assert expected["unsupported"] > 0
