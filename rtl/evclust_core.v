@@ -783,15 +783,24 @@ module evclust_core #(
     wire                  div_x_done, div_y_done;
     wire [MOMENT_W-1:0]   div_x_q, div_y_q;
     wire [ACTIVITY_W:0]   unused_left_x, unused_left_y;
+`ifdef FORMAL
+    wire [$clog2(MOMENT_W + 1)-1:0] f_merge_x_count, f_merge_y_count;  // the dividers' steps to go (evclust_core_props.vh)
+`endif
     evclust_udiv #(.NUM_W(MOMENT_W), .DEN_W(ACTIVITY_W + 1)) div_x (
         .clk(clk), .rst(dp_rst), .start(div_start),
         .numerator(m_moment_x[MOMENT_W-1:0]), .denominator(m_weight[ACTIVITY_W:0]),
         .done(div_x_done), .quotient(div_x_q), .remainder_out(unused_left_x)
+`ifdef FORMAL
+        , .f_count(f_merge_x_count)
+`endif
     );
     evclust_udiv #(.NUM_W(MOMENT_W), .DEN_W(ACTIVITY_W + 1)) div_y (
         .clk(clk), .rst(dp_rst), .start(div_start),
         .numerator(m_moment_y[MOMENT_W-1:0]), .denominator(m_weight[ACTIVITY_W:0]),
         .done(div_y_done), .quotient(div_y_q), .remainder_out(unused_left_y)
+`ifdef FORMAL
+        , .f_count(f_merge_y_count)
+`endif
     );
     wire m_write = state == ST_MERGE && m_started && div_x_done && div_y_done;  // the merge's last cycle
 

@@ -58,7 +58,7 @@ BREAKAGES = {
         "evclust_core",
         "wire sweep_advance = state == ST_SWEEP && (!rec_valid || rec_ready);",
         "wire sweep_advance = state == ST_SWEEP && rec_ready;",
-        ("assert (!f_filter || f_filter_cycles < F_FILTER_BOUND);", "f_filter_cycles <= F_PHASE_MAX + index);"),
+        ("assert (!f_filter || f_filter_cycles < F_FILTER_BOUND);", "f_filter_cycles <= f_sweep_cycles);"),
     ),
     "core ends a sweep before its tail drains (the last slot's record skipped)": (
         "evclust_core",
@@ -78,7 +78,17 @@ BREAKAGES = {
         "        if (rec_valid && rec_ready)\n            rec_valid <= 1'b1;\n",
         ("!f_recorded[f_rec_slot]);", "assert (&f_visited && f_out == f_kept", "assert (state == ST_SWEEP || f_after_sweep);"),
     ),
+    # The reference build (MERGE = 0) never merges and still proves with this core: only the
+    # merge-enabled job sees the MERGE state hang.
+    "core's merge never finishes (its dividers restart in every MERGE cycle)": (
+        "evclust_core",
+        "wire                  div_start = state == ST_MERGE && !m_started;",
+        "wire                  div_start = state == ST_MERGE;",
+        ("assert (!f_filter || f_filter_cycles < F_FILTER_BOUND);", "f_filter_cycles + f_merge_x_count <= f_sweep_cycles + 2 + MERGE_MOMENT_W);"),
+    ),
 }
+# The job that proves a breakage's module, where it is not <module>.sby.
+JOB = {"core's merge never finishes (its dividers restart in every MERGE cycle)": "evclust_core_merge"}
 
 
 @pytest.mark.parametrize("breakage", sorted(BREAKAGES))
@@ -92,7 +102,7 @@ def test_a_broken_interface_fails_its_proof(breakage, tmp_path):
     assert source.count(old) == 1
     (tmp_path / "rtl" / f"{module}.v").write_text(source.replace(old, new))
     shutil.copytree(FORMAL_DIR / module, tmp_path / "formal" / module)
-    result = prove(tmp_path / "formal" / module / f"{module}.sby", tmp_path / "run")
+    result = prove(tmp_path / "formal" / module / f"{JOB.get(breakage, module)}.sby", tmp_path / "run")
     # FAIL: a counterexample from reset within the depth; UNKNOWN: the induction step fails (a
     # sweep, for one, is more events from reset than the base case's depth). Either way the
     # property no longer holds as proved.

@@ -8,14 +8,19 @@
 //  - every accepted event gives exactly one trace pulse: the events accepted and not yet
 //    traced are exactly those in stage A, in stage B and on the trace port, so none is lost or
 //    traced twice (a reset or clear discards those in flight, as documented);
-//  - a filter step ends within F_FILTER_BOUND cycles (80 in the reference build) in which no
-//    record waits for its consumer, and the core, IDLE again, takes the next event;
+//  - a filter step ends within F_FILTER_BOUND cycles in which no record waits for its consumer
+//    (80 in the reference build, which has no merges; with MERGE = 1, up to N - 1 merges of
+//    MERGE_MOMENT_W + 3 cycles more: 227 in the merge job's build), and the core, IDLE again,
+//    takes the next event;
 //  - one record per reported slot per sweep: every slot visited once, each slot kept leaves the
 //    sweep's tail once, a record only for a slot out of the tail and never two for one slot,
 //    and at the sweep's end the records are exactly the table's reported clusters.
 // The dividers' steps to go and the tail's stage tags reach the properties through ports that
-// evclust_udiv and evclust_pipediv have only under `ifdef FORMAL.
+// evclust_udiv and evclust_pipediv have only under `ifdef FORMAL. Two jobs: evclust_core.sby on
+// the reference build's header (MERGE = 0, N = 16) and evclust_core_merge.sby on a generated
+// merge-enabled one (model/evclust/rtl/formal.py: the default parameters at N = 4).
 
+    genvar f_j, f_s;
     reg f_past_valid = 1'b0;
     always @(posedge clk)
         f_past_valid <= 1'b1;
@@ -43,14 +48,17 @@
     // in which no record waits for its consumer (a waiting record holds the sweep, for as long
     // as the consumer likes), after which the core is IDLE and takes the next event. The bound:
     // PHASE's deciding cycle, the division phase / tau (33 steps and the cycle it is read) and
-    // T_frame / n (FRAME_PER_TAU_W steps and one), then one sweep cycle per slot and tail stage.
-    // The reference build has no merges (MERGE = 0) and the bound no merge term: with MERGE = 1
-    // each merge holds the sweep MERGE_MOMENT_W + 3 cycles more, up to N - 1 per sweep, and this
-    // proof fails until the bound and an invariant on the slots left to absorb say so.
+    // T_frame / n (FRAME_PER_TAU_W steps and one), then one sweep cycle per slot and tail stage,
+    // and with MERGE = 1 up to N - 1 merges (each absorbs a valid later slot, and slot 0 is
+    // never absorbed) of F_MERGE_CYCLES each: the sweep cycle that finds it, the cycle that
+    // starts the dividers, their MERGE_MOMENT_W steps and the cycle that writes the slot.
     localparam integer F_PHASE_MAX = 1 + (33 + 1) + (FRAME_PER_TAU_W + 1);
-    localparam integer F_FILTER_BOUND = F_PHASE_MAX + LAST_SWEEP_I + 1;
+    localparam integer F_MERGE_CYCLES = MERGE_MOMENT_W + 3;
+    localparam integer F_MERGES_MAX = MERGE != 0 ? N - 1 : 0;
+    localparam integer F_FILTER_BOUND = F_PHASE_MAX + LAST_SWEEP_I + 1 + F_MERGES_MAX * F_MERGE_CYCLES;
     localparam integer F_CYCLES_W = $clog2(F_FILTER_BOUND + 1);
     wire f_filter = state == ST_PHASE || state == ST_SWEEP || state == ST_MERGE;
+    wire f_sweeping = state == ST_SWEEP || state == ST_MERGE;
     reg [F_CYCLES_W-1:0] f_filter_cycles;  // the filter step's cycles so far without a record waiting
     always @(posedge clk)
         if (dp_rst || !f_filter)
@@ -58,13 +66,32 @@
         else if (!(rec_valid && !rec_ready))
             f_filter_cycles <= f_filter_cycles + 1'b1;
 
+    // The slots this sweep's merges have absorbed, and how many.
+    reg [N-1:0] f_absorbed;
+    always @(posedge clk)
+        if (dp_rst || state == ST_PHASE)
+            f_absorbed <= {N{1'b0}};
+        else if (m_write)
+            f_absorbed[m_j] <= 1'b1;
+    function automatic integer f_count_ones;
+        input [N-1:0] bits;
+        integer b;
+        begin
+            f_count_ones = 0;
+            for (b = 0; b < N; b = b + 1)
+                f_count_ones = f_count_ones + bits[b];
+        end
+    endfunction
+    wire [31:0] f_merges = f_count_ones(f_absorbed);
+    wire [31:0] f_sweep_cycles = F_PHASE_MAX + index + f_merges * F_MERGE_CYCLES;  // the most cycles so far at this point of the sweep
+
     always @* if (f_past_valid) begin
         assert (!f_filter || f_filter_cycles < F_FILTER_BOUND);
         assert (state != ST_IDLE || dp_rst || ev_ready);
         // What k-induction needs: where each phase of the step stands, against the dividers'
         // steps to go.
         if (MERGE == 0)
-            assert (state != ST_MERGE);
+            assert (state != ST_MERGE && f_absorbed == {N{1'b0}});
         if (state == ST_PHASE) begin
             assert (index == {SWEEP_W{1'b0}} && phase_step != 2'd3);
             if (phase_step == PHASE_DECIDE)
@@ -75,8 +102,28 @@
                 assert ((f_frame_count != 0 || frame_done) && f_filter_cycles + f_frame_count <= 1 + (33 + 1) + FRAME_PER_TAU_W);
         end
         if (state == ST_SWEEP)
-            assert (index <= LAST_SWEEP && f_filter_cycles <= F_PHASE_MAX + index);
+            assert (index <= LAST_SWEEP && f_filter_cycles <= f_sweep_cycles);
+        // A merge: slot k (the index) absorbs a valid later slot m_j, not yet absorbed; no record
+        // is on offer (the sweep cycle that found it had none waiting and sent none to the tail);
+        // the two dividers step together, and the cycles so far against their steps to go.
+        assert (!f_absorbed[0]);
+        assert (f_merge_x_count == f_merge_y_count && div_x_done == div_y_done);
+        if (state != ST_MERGE)
+            assert (!m_started);
+        if (state == ST_MERGE) begin
+            assert (index < N_SLOTS && m_j > k && m_j <= LAST_SLOT_I && valid[m_j] && !f_absorbed[m_j] && !rec_valid);
+            if (!m_started)
+                assert (f_filter_cycles <= f_sweep_cycles + 1);
+            else
+                assert (div_x_done == (f_merge_x_count == 0) && f_filter_cycles + f_merge_x_count <= f_sweep_cycles + 2 + MERGE_MOMENT_W);
+        end
     end
+    generate
+        for (f_s = 0; f_s < N; f_s = f_s + 1) begin : f_absorbed_slot
+            always @* if (f_past_valid && f_sweeping && f_absorbed[f_s])
+                assert (!valid[f_s]);
+        end
+    endgenerate
 
     // ---------------------------------------------------------------- one record per reported slot
     // Within a sweep: stage 0 visits every slot once; each slot it keeps (valid, not expired)
@@ -91,7 +138,6 @@
     wire [SLOT_W-1:0]          f_slot [0:F_STAGES];
     assign f_live[0] = p_live;
     assign f_slot[0] = p_slot;
-    genvar f_j, f_s;
     generate
         for (f_j = 1; f_j <= F_STAGES; f_j = f_j + 1) begin : f_tail
             assign f_live[f_j] = f_vmx_tags[(f_j - 1) * TAG_W + TAG_W - 1];
@@ -151,7 +197,7 @@
             end
         end
         for (f_s = 0; f_s < N; f_s = f_s + 1) begin : f_sweep_slot
-            always @* if (f_past_valid && state == ST_SWEEP) begin
+            always @* if (f_past_valid && f_sweeping) begin
                 assert (f_visited[f_s] == (f_s < index));
                 assert (f_visited[f_s] || !f_kept[f_s]);
                 assert (f_kept[f_s] || !f_out[f_s]);
@@ -162,7 +208,7 @@
                     assert (f_out[f_s] == f_kept[f_s]);
             end
             for (f_j = 0; f_j <= F_STAGES; f_j = f_j + 1) begin : f_in_tail
-                always @* if (f_past_valid && state == ST_SWEEP && index == f_s + f_j + 1)
+                always @* if (f_past_valid && f_sweeping && index == f_s + f_j + 1)
                     assert (!f_out[f_s] && f_kept[f_s] == f_live[f_j]);
             end
         end

