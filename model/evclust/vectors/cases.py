@@ -107,10 +107,12 @@ def saturation_counts() -> Case:
     # activity (ln2·T_frame/T_half = 69 events/frame per unit): a burst of 400 events at one
     # microsecond saturates the activity and the τ count, then γ at the next filter step. Then
     # events alternating 34 px apart in a window of R + S = 37 px with β_P = 0.5: the first
-    # centre step (17 px) saturates, every γ·step after it (γ ~10^4) saturates the MCM input,
+    # centre step (17 px) saturates high, every γ·step after it (γ ~10^4) saturates the MCM input,
     # and the centre's swings over τ = 2 ms at T_frame/τ = 100 saturate the interval velocity.
     rows = [(1000, 44 + i % 3, 36 + i % 2, 200, 90, 160) for i in range(400)]
     rows += [(1500 + 20 * i, 5 if i % 2 == 0 else 39, 20, 200, 90, 160) for i in range(600)]
+    # The same mirrored, after 100 ms in which the others expire: the first step saturates low.
+    rows += [(113_500 + 20 * i, 58 if i % 2 == 0 else 24, 8, 200, 90, 160) for i in range(600)]
     params = _small_params(alpha_pos=0.5, r_init=30.0, r_max=31.0, seek_margin=7.0, exit_margin=1.0, gamma_mode="activity",
                            t_half_us=2000.0, tau_us=2000.0, alpha_vel_mcm=0.99, n_clusters=4)  # fmt: skip
     return Case("narrow event counters and a 1 s frame period: the activity, the events in a τ, γ, the centre step, the MCM "
