@@ -115,6 +115,7 @@ module evclust_tb #(
     reg [31:0] cov_phase [0:3];   // cycles in ST_PHASE per phase_step (decide, divide by τ, divide the frame)
     reg [31:0] cov_stream [0:3];  // record held (valid, not ready); input gap (ready, not valid); both; event and record in one cycle
     reg [2:0]  cov_prev;
+    reg        cov_armed;  // from the first reset on: the core's state before it is not the design's
     integer    cov_i;
     initial begin
         for (cov_i = 0; cov_i < 8; cov_i = cov_i + 1) cov_state[cov_i] = 32'd0;
@@ -124,9 +125,12 @@ module evclust_tb #(
             cov_stream[cov_i] = 32'd0;
         end
         cov_prev = 3'd0;
+        cov_armed = 1'b0;
     end
     always @(posedge clk) begin
-        if (!rst) begin
+        if (rst)
+            cov_armed <= 1'b1;
+        if (cov_armed && !rst) begin
             cov_state[core.state] <= cov_state[core.state] + 32'd1;
             if (core.state != cov_prev)
                 cov_arc[{cov_prev, core.state}] <= cov_arc[{cov_prev, core.state}] + 32'd1;

@@ -151,8 +151,10 @@ async def _coverage(dut, counters: dict, records: list[dict]) -> dict:
     core's FSM, the status counters summed over the run, the records' flags and classes."""
     from evclust.rtl.coverage import run_bins
 
-    fsm = {name: [int(handle[i].value) for i in range(len(handle))]
-           for name, handle in (("state", dut.cov_state), ("arc", dut.cov_arc), ("phase", dut.cov_phase), ("stream", dut.cov_stream))}  # fmt: skip
+    def read(handle):  # X before the first clock edge (a run refused before it starts): nothing counted
+        return [int(handle[i].value) if handle[i].value.is_resolvable else 0 for i in range(len(handle))]
+
+    fsm = {name: read(handle) for name, handle in (("state", dut.cov_state), ("arc", dut.cov_arc), ("phase", dut.cov_phase), ("stream", dut.cov_stream))}
     return run_bins(fsm, counters, records)
 
 

@@ -213,6 +213,18 @@ def palette_tie() -> Case:
                 source="directed")  # fmt: skip
 
 
+def no_class() -> Case:
+    # Contrast votes against a fixed background: a blob of the background's own colour casts
+    # votes of 0, so its histogram stays empty and its records carry no class (-1); a second blob
+    # of another colour is classed as usual.
+    rows = []
+    for i in range(800):
+        own = i % 2 == 0
+        rows.append((1000 + 5 * i, (15 if own else 45) + i % 3, 24 + (i // 3) % 3, *((128, 128, 128) if own else (200, 90, 160))))
+    return Case("a blob of the background's colour: contrast votes of 0, records with no class", _events(rows), **SMALL,
+                params=_small_params(palette_vote="contrast", background=(128.0, 128.0, 128.0)), source="directed")  # fmt: skip
+
+
 def _bar(x0: float, speed: float, steps: int, dt: int, rows: range, length: int, t0: int = 1000):
     """Events of a uniform bar `length` px long moving right at `speed` px per step: its leading
     and trailing edges only, one event per edge pixel and step (a uniform object's events)."""
@@ -342,6 +354,7 @@ CASES = {
     "gaps": gaps,
     "borders": borders,
     "palette_tie": palette_tie,
+    "no_class": no_class,
     "merge_edges": merge_edges,
     "merge_overlap": merge_overlap,
     "scaled_seek": scaled_seek,
