@@ -13,7 +13,7 @@ from evclust.cli import main
 from evclust.events import read_events
 from evclust.scenes import load_scene
 
-from conftest import GOOD_SCENE
+from testkit import GOOD_SCENE
 
 
 def run_cli(capsys, *argv):

@@ -20,7 +20,7 @@ import pytest
 
 from evclust.cli import main
 
-from conftest import GOOD_SCENE
+from testkit import GOOD_SCENE
 
 SCENE = GOOD_SCENE  # the cases below edit it by text
 

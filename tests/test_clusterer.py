@@ -13,7 +13,7 @@ from evclust.errors import EvclustError
 from evclust.events import EVENT_DTYPE, EventMeta
 from evclust.metrics.convergence import converged_after
 
-from conftest import classic_params, simulate_toml
+from testkit import classic_params, simulate_toml
 
 FPS = 100.0
 T_FRAME = 1e6 / FPS

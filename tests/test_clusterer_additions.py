@@ -12,7 +12,7 @@ from evclust.clusterer.run import FloatClusterer
 from evclust.events import EVENT_DTYPE
 from evclust.fixed.model import FixedClusterer
 
-from conftest import classic_params
+from testkit import classic_params
 
 W, H, T_FRAME = 64, 48, 10_000.0
 

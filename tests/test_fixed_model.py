@@ -9,7 +9,7 @@ from scipy.optimize import linear_sum_assignment
 from evclust.clusterer import track_events
 from evclust.events import EVENT_DTYPE, EventMeta
 
-from conftest import classic_params, simulate_toml
+from testkit import classic_params, simulate_toml
 from test_clusterer import square_scene
 
 T_FRAME = 1e4

@@ -20,7 +20,7 @@ from evclust.simulator.kernel import EventBuffer
 
 from evclust.scenes import scene_from_toml
 
-from conftest import pixel_events, simulate_toml
+from testkit import pixel_events, simulate_toml
 
 FPS = 100
 T_US = 1e6 / FPS
