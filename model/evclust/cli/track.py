@@ -11,8 +11,10 @@ def add_parser(sub) -> None:
         "track",
         help="cluster an event file into tracks (position, size, velocity, colour)",
         description=(
-            "Run the event-by-event clusterer over an event file and write one track record per reported "
-            "cluster per filter step (SPEC §4). The stream is read and the records written chunk by chunk, so "
+            "Run the event-by-event clusterer and its object layer over an event file and write the objects: one "
+            "record per reported object per frame period (its last filter step's), or every filter step with "
+            "--every-step; --clusters writes the clusters instead, one record per reported cluster per filter step "
+            "(SPEC §4). The stream is read and the records written chunk by chunk, so "
             "files larger than memory pass through. Parameters come from --params (a TOML file with a [clusterer] "
             "table, or a preset name), else from the preset of the events' source scene, else the defaults, which "
             "hold across the generalization suite: their time constants are in frames of the event file's frame "
@@ -25,7 +27,10 @@ def add_parser(sub) -> None:
     p.add_argument("--params", metavar="P", help=f"parameter file (.toml) or preset ({preset_list()})")
     p.add_argument("--model", default="float", choices=TRACK_MODELS, help="clusterer model (default: float)")
     p.add_argument("--frame-us", type=float, metavar="US", help="frame period in µs, the unit of the velocities (default: the event file's; camera recordings have none)")
-    p.add_argument("--per-frame", action="store_true", help="write one record per cluster per frame (its last) instead of one per filter step: far smaller outputs for videos")
+    p.add_argument("--clusters", action="store_true", help="write the cluster records (the event-rate clusterer's output) instead of the objects")
+    every = p.add_mutually_exclusive_group()
+    every.add_argument("--per-frame", action="store_true", help="one record per cluster or object per frame period, its last (the default for objects; for --clusters, far smaller outputs for videos)")
+    every.add_argument("--every-step", action="store_true", help="one record per object or cluster per filter step (the default for --clusters)")
     p.add_argument("--ranges", action="store_true", help="fixed model: print each signal's range seen and its saturation count")
     p.add_argument("--beta-shift", action="store_true", help="fixed model: round every β to a power of two (shift-only filters)")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
@@ -54,18 +59,26 @@ def run(args) -> int:
     options = {"ranges": args.ranges, "beta_shift_only": args.beta_shift} if args.model == "fixed" else {}
     # The metadata is known before the first event: the file is opened once and filled as we go.
     _, out_meta = prepare_run(meta, params, args.model)
-    out_meta = dataclasses.replace(out_meta, per_frame=args.per_frame)
+    objects = params.objects and not args.clusters
+    note = "" if objects or args.clusters else " (these parameters have no object layer: clusters written)"
+    if args.clusters:
+        params = params.model_copy(update={"objects": False})  # the object layer would run for nothing
+    per_frame = args.per_frame or (objects and not args.every_step)
+    out_meta = dataclasses.replace(out_meta, per_frame=per_frame, kind="objects" if objects else "clusters")
+    discard = lambda records: None  # noqa: E731  (the other kind of record, not written)
     with track_writer(args.output, out_meta) as writer:
-        thinner = PerFrame(writer.write, out_meta.t_frame_us) if args.per_frame else None
+        thinner = PerFrame(writer.write, out_meta.t_frame_us) if per_frame else None
+        sink = thinner.write if thinner else writer.write
         result = track_stream(
             reader.chunks(), meta, params, model=args.model, progress=not args.quiet, total=reader.count,
-            sink=thinner.write if thinner else writer.write, **options,
+            sink=discard if objects else sink, object_sink=sink if objects else None, **options,
         )  # fmt: skip
         if thinner:
             thinner.close()
     times = params.times(out_meta.t_frame_us)
-    written = f"; {writer.count} written, one per cluster per frame" if args.per_frame else ""
-    print(f"{args.events}: parameters from {origin} ({times}); {result.summary()}{written}")
+    kind = "object" if objects else "cluster"
+    written = f"; {writer.count} {kind} records written" + (f", one per {kind} per frame" if per_frame else "")
+    print(f"{args.events}: parameters from {origin}{note} ({times}); {result.summary()}{written}")
     if args.ranges:
         print_ranges(result.clusterer)
     return 0

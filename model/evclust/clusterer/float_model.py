@@ -422,13 +422,15 @@ def _supported(support, cx, cy, t, window):
 
 
 @njit(cache=True, nogil=True)
-def run_events(S, H, G, k, palette, background_mask, support, t_us, xs, ys, lums, cbs, crs, out, precision=None):
-    """Feed events through the table; write track records into `out`; return how many. With a
-    `precision` table (PRECISION_SIGNALS x 4) each quantisation point rounds to its format.
-    `support` is the creation-support map (layout.support_shape), each cell the time of its
-    latest event (-inf: none)."""
+def run_events(S, H, G, k, palette, background_mask, support, t_us, xs, ys, lums, cbs, crs, out, steps, precision=None):
+    """Feed events through the table; write track records into `out`; return how many. Each
+    filter step's time goes into `steps`, in order (the object layer's clock; G[STEP] counts
+    them). With a `precision` table (PRECISION_SIGNALS x 4) each quantisation point rounds to
+    its format. `support` is the creation-support map (layout.support_shape), each cell the time
+    of its latest event (-inf: none)."""
     bits = int(k[K_SUPPORT_BITS])
     n_out = 0
+    first_step = G[STEP]
     every = int(k[K_EVERY])
     for i in range(t_us.size):
         t = float(t_us[i])
@@ -466,5 +468,6 @@ def run_events(S, H, G, k, palette, background_mask, support, t_us, xs, ys, lums
         G[SINCE_FILTER] += 1
         if G[SINCE_FILTER] >= every:
             G[SINCE_FILTER] = 0
+            steps[int(G[STEP] - first_step)] = t
             n_out = _filter_step(S, H, G, t, k, palette, background_mask, out, n_out, precision)
     return n_out

@@ -51,3 +51,33 @@ def support_shape(width: int, height: int, cell_bits: int) -> tuple[int, int]:
     """The creation-support map: one cell per 2^cell_bits px square, with a border of one cell
     all round so that every 3x3 neighbourhood lies inside."""
     return ((height - 1) >> cell_bits) + 3, ((width - 1) >> cell_bits) + 3
+
+# Track-record columns by name, as the float and fixed models write them.
+(
+    R_T, R_STEP, R_SLOT, R_ID, R_X, R_Y, R_RX, R_RY, R_ACT, R_VMX, R_VMY, R_VIX, R_VIY, R_LUM, R_CB, R_CR, R_CLASS, R_FLAGS,
+) = range(RECORD_COLUMNS)  # fmt: skip
+
+# The object layer (beyond the paper): one row per object slot. The first block is the object's
+# state; the second is what its member clusters of the current filter step add up to.
+(
+    O_VALID, O_ID, O_X, O_Y, O_RX, O_RY, O_VX, O_VY, O_LUM, O_CB, O_CR, O_CLASS, O_T_BORN, O_T_SEEN,
+    O_CONFIRMED, O_EVER_REPORTED,
+    O_MEMBERS, O_LO_X, O_HI_X, O_LO_Y, O_HI_Y, O_W, O_WVX, O_WVY, O_BEST_W, O_BEST_CLASS, O_LUM_M, O_CB_M, O_CR_M,
+    O_OWNER_W,
+) = range(30)  # fmt: skip
+OBJECT_COLUMNS = (
+    "valid", "id", "x", "y", "rx", "ry", "vx", "vy", "Y", "Cb", "Cr", "class", "t_born", "t_seen",
+    "confirmed", "ever_reported",
+    "members", "lo_x", "hi_x", "lo_y", "hi_y", "velocity_weight", "member_vx", "member_vy", "colour_weight", "member_class",
+    "member_Y", "member_Cb", "member_Cr", "owner_weight",
+)  # fmt: skip
+# Object-layer globals.
+OG_NEXT_ID, OG_T_PREV, OG_STARTED, OG_STEPS, OG_CREATED, OG_CONFIRMED, OG_FREED, OG_UNASSIGNED, OG_MERGED = range(9)
+OBJECT_GLOBAL_COLUMNS = ("next_id", "t_prev", "started", "steps", "created", "confirmed", "freed", "unassigned", "merged")
+# Object-record columns (the order of evclust.tracks.OBJECT_DTYPE).
+(
+    OR_T, OR_STEP, OR_SLOT, OR_ID, OR_X, OR_Y, OR_RX, OR_RY, OR_VX, OR_VY, OR_LUM, OR_CB, OR_CR, OR_CLASS, OR_MEMBERS, OR_FLAGS,
+) = range(16)  # fmt: skip
+OBJECT_RECORD_COLUMNS = 16
+# Flags of an object record (evclust.tracks.ObjectFlags).
+OFLAG_NEW, OFLAG_COASTING = 1, 2

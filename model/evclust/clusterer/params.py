@@ -118,6 +118,23 @@ class ClustererParams(BaseModel):
     exit_margin: NonNegative = 5.4  # M, px: the border band where exit prediction acts
     v_exit: NonNegative = 1.0  # px/frame: minimum speed to predict an exit
     theta_exit_deg: Annotated[float, Field(gt=0.0, le=90.0)] = 45.0  # max angle to the border normal
+    # The object layer (beyond the paper; clusterer/objects.py): once per filter step, the reported
+    # clusters are grouped into objects by common fate, each kept under one id by prediction and
+    # gated association. Times in frames of the event stream.
+    objects: bool = True
+    n_objects: Annotated[int, Field(ge=1, le=256)] = 16  # object slots
+    object_gate: NonNegative = 4.0  # px: the margin of the overlap tests (cluster with cluster, group with object)
+    object_link_along: NonNegative = 3.0  # along their motion, clusters link this many of their half-sizes across it apart
+    object_v_tol: NonNegative = 0.3  # px/frame: common fate, velocities within this (L1)
+    object_v_rel: NonNegative = 0.2  # plus this fraction of the faster L1 speed
+    object_track_frames: Positive = 1.0  # the centre's α-β filter: time constant, frames
+    object_rate_frames: Positive = 8.0  # ... and of the velocity's pull by the centre's residual
+    object_velocity_frames: Positive = 2.0  # the velocity's pull towards its clusters' velocities
+    object_size_frames: Positive = 1.0
+    object_colour_frames: Positive = 2.0
+    object_birth_frames: NonNegative = 0.5  # members for this long before an object is reported
+    object_coast_frames: NonNegative = 3.0  # an object without members is predicted and reported this long,
+    object_keep_frames: NonNegative = 30.0  # and kept, unreported, this long for its clusters to return
 
     @model_validator(mode="after")
     def _consistent(self):

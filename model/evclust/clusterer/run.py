@@ -10,29 +10,38 @@ import numpy as np
 from tqdm import tqdm
 
 from evclust.clusterer import float_model
-from evclust.clusterer.layout import BG_CB, BG_CR, BG_Y, GLOBAL_COLUMNS, RECORD_COLUMNS, SLOT_COLUMNS, run_stats, support_shape
+from evclust.clusterer.layout import BG_CB, BG_CR, BG_Y, GLOBAL_COLUMNS, RECORD_COLUMNS, SLOT_COLUMNS, STEP, run_stats, support_shape
 from evclust.clusterer.params import ClustererParams
 from evclust.choices import TRACK_MODELS
 from evclust.errors import EvclustError
 from evclust.events import EventMeta
-from evclust.tracks import TRACK_DTYPE, TrackMeta
+from evclust.tracks import OBJECT_DTYPE, TRACK_DTYPE, TrackMeta
 
 CHUNK = 1 << 18  # events per compiled call: the progress bar's granularity
 
 
 @dataclasses.dataclass
 class TrackRun:
-    tracks: np.ndarray | None  # None when the records went to a sink as they came
+    tracks: np.ndarray | None  # cluster records; None when they went to a sink as they came
     meta: TrackMeta
     stats: dict
     wall_s: float
     clusterer: object = None  # the model after the run: its state, and the fixed model's logs
+    objects: np.ndarray | None = None  # object records (None: no object layer, or they went to a sink)
+    object_meta: TrackMeta | None = None  # their metadata (None: no object layer)
+
+    @property
+    def output(self) -> tuple[np.ndarray, TrackMeta]:
+        """What the run reports: its object records when it has an object layer, else its cluster records."""
+        return (self.objects, self.object_meta) if self.object_meta is not None else (self.tracks, self.meta)
 
     def summary(self) -> str:
         s = self.stats
         rate = s["events"] / self.wall_s if self.wall_s > 0 else float("inf")
+        objects = (f", {s['object_records']} object records ({s['objects_confirmed']} objects confirmed of "
+                   f"{s['objects_created']} created)") if "object_records" in s else ""  # fmt: skip
         return (
-            f"{s['events']} events, {s['steps']} filter steps, {s['records']} track records, "
+            f"{s['events']} events, {s['steps']} filter steps, {s['records']} cluster records{objects}, "
             f"{s['created']} clusters created ({s['evicted']} by eviction), {s['dropped']} events dropped, "
             f"wall time {self.wall_s:.2f} s, {rate / 1e6:.2f} Mevents/s"
         )
@@ -58,15 +67,20 @@ class FloatClusterer:
         bg = params.background if params.background is not None else (128.0, 128.0, 128.0)
         self.globals[[BG_Y, BG_CB, BG_CR]] = bg
         self.support = np.full(support_shape(width, height, params.support_cell_bits), -np.inf)
+        self.steps = np.zeros(0)  # the times of the filter steps the last feed completed
 
     def feed(self, events: np.ndarray) -> np.ndarray:
-        """Process events; return the (n, RECORD_COLUMNS) float64 records of the filter steps they completed."""
+        """Process events; return the (n, RECORD_COLUMNS) float64 records of the filter steps they
+        completed (their times, records or not, in `self.steps`)."""
         every = self.params.filter_every
         out = np.empty(((events.size // every + 1) * self.params.n_clusters, RECORD_COLUMNS))
+        steps = np.empty(events.size // every + 1)
+        first = self.globals[STEP]
         n = float_model.run_events(
             self.slots, self.hist, self.globals, self.k, self.palette, self.background_mask, self.support,
-            events["t"], events["x"], events["y"], events["Y"], events["Cb"], events["Cr"], out, self.precision,
+            events["t"], events["x"], events["y"], events["Y"], events["Cb"], events["Cr"], out, steps, self.precision,
         )  # fmt: skip
+        self.steps = steps[: int(self.globals[STEP] - first)]
         return out[:n]
 
     def stats(self) -> dict:
@@ -88,12 +102,29 @@ def _rtl_clusterer(*args, **kwargs):
 MODELS = dict(zip(TRACK_MODELS, (FloatClusterer, _fixed_clusterer, _rtl_clusterer)))  # names: evclust.choices, for the CLI
 
 
-def records_to_tracks(rows: np.ndarray) -> np.ndarray:
-    tracks = np.zeros(len(rows), TRACK_DTYPE)
-    for j, name in enumerate(TRACK_DTYPE.names):
+def rows_to_records(rows: np.ndarray, dtype: np.dtype) -> np.ndarray:
+    """The models' float64 record rows (one column per field, in the dtype's order) as records."""
+    records = np.zeros(len(rows), dtype)
+    for j, name in enumerate(dtype.names):
         column = rows[:, j]
-        tracks[name] = np.rint(column) if np.issubdtype(TRACK_DTYPE[name], np.integer) else column
-    return tracks
+        records[name] = np.rint(column) if np.issubdtype(dtype[name], np.integer) else column
+    return records
+
+
+def records_to_tracks(rows: np.ndarray) -> np.ndarray:
+    return rows_to_records(rows, TRACK_DTYPE)
+
+
+def _object_layer(clusterer, params: ClustererParams, model: str, width: int, height: int, t_frame_us: float):
+    """The object layer that follows a clusterer model (None when the parameters switch it off):
+    the float one, the fixed one, or the RTL's own object unit."""
+    if not params.objects:
+        return None
+    if model == "float":
+        from evclust.clusterer.objects import FloatObjects
+
+        return FloatObjects(params, width, height, t_frame_us)
+    return clusterer.object_layer()
 
 
 def track_meta(params: ClustererParams, meta: EventMeta, model: str, t_frame_us: float) -> TrackMeta:
@@ -137,30 +168,49 @@ def track_stream(
     progress: bool = False,
     total: int | None = None,
     sink: Callable[[np.ndarray], None] | None = None,
+    object_sink: Callable[[np.ndarray], None] | None = None,
     **options,
 ) -> TrackRun:
-    """Run a clusterer model over a stream given in chunks; `options` go to the model (fixed:
-    ranges=True). With a `sink`, each chunk's track records go to it as they come and the run
-    keeps none (`TrackRun.tracks` is None), so memory does not grow with the stream."""
+    """Run a clusterer model, and its object layer when the parameters have one, over a stream
+    given in chunks; `options` go to the model (fixed: ranges=True). With a `sink`, each
+    chunk's cluster records go to it as they come and the run keeps none (`TrackRun.tracks` is
+    None), so memory does not grow with the stream; `object_sink` does the same for the object
+    records."""
     params, out_meta = prepare_run(meta, params, model)
     clusterer = MODELS[model](params, meta.width, meta.height, out_meta.t_frame_us, out_meta.has_colour, **options)
+    layer = _object_layer(clusterer, params, model, meta.width, meta.height, out_meta.t_frame_us)
+    object_meta = dataclasses.replace(out_meta, kind="objects") if layer is not None else None
     start = time.perf_counter()
-    kept, n_records = [], 0
+    kept, kept_objects, n_records, n_objects = [], [], 0, 0
     with tqdm(total=total, unit="ev", unit_scale=True, disable=None if progress else True, desc=f"track ({model})") as bar:
         for chunk in chunks:
             step = getattr(clusterer, "feed_size", CHUNK)  # the RTL takes smaller bites, for the progress bar
             for lo in range(0, chunk.size, step):
                 piece = chunk[lo : lo + step]
-                tracks = records_to_tracks(clusterer.feed(piece))
+                rows = clusterer.feed(piece)
+                tracks = records_to_tracks(rows)
                 n_records += tracks.size
                 if sink is None:
                     kept.append(tracks)
                 elif tracks.size:
                     sink(tracks)
+                if layer is not None:
+                    objects = rows_to_records(layer.feed(rows, clusterer.steps), OBJECT_DTYPE)
+                    n_objects += objects.size
+                    if object_sink is None:
+                        kept_objects.append(objects)
+                    elif objects.size:
+                        object_sink(objects)
                 bar.update(piece.size)
     wall = time.perf_counter() - start
     tracks = None if sink is not None else (np.concatenate(kept) if kept else np.zeros(0, TRACK_DTYPE))
-    return TrackRun(tracks, out_meta, {**clusterer.stats(), "records": n_records}, wall, clusterer)
+    objects = None
+    if layer is not None and object_sink is None:
+        objects = np.concatenate(kept_objects) if kept_objects else np.zeros(0, OBJECT_DTYPE)
+    stats = {**clusterer.stats(), "records": n_records}
+    if layer is not None:
+        stats |= layer.stats() | {"object_records": n_objects}
+    return TrackRun(tracks, out_meta, stats, wall, clusterer, objects, object_meta)
 
 
 def track_events(

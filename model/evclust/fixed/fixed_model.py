@@ -555,12 +555,14 @@ def _supported(support, seen, cx, cy, t, window):
 
 
 @njit(cache=True, nogil=True)
-def run_events(S, H, G, k, table, gains, palette, inv_ww, background_mask, support, seen, t_us, xs, ys, lums, cbs, crs, out, log,
-               ranges, trace=None):  # fmt: skip
-    """Feed events; write records into `out`; with `trace` (an int64 array), write each event's
+def run_events(S, H, G, k, table, gains, palette, inv_ww, background_mask, support, seen, t_us, xs, ys, lums, cbs, crs, out, steps,
+               log, ranges, trace=None):  # fmt: skip
+    """Feed events; write records into `out` and each filter step's time (the 32-bit
+    datapath's clock wraps, the step keeps the whole event time) into `steps`; with `trace` (an int64 array), write each event's
     action << 16 | slot there (a None trace compiles without it). `support` holds each map
     cell's latest event time (32-bit), `seen` whether it has one."""
     n_out = 0
+    first_step = G[STEP]
     fb = k[C_FB]
     bits = k[C_SUPPORT_BITS]
     for i in range(t_us.size):
@@ -606,6 +608,7 @@ def run_events(S, H, G, k, table, gains, palette, inv_ww, background_mask, suppo
         G[SINCE_FILTER] += 1
         if G[SINCE_FILTER] >= k[C_EVERY]:
             G[SINCE_FILTER] = 0
+            steps[G[STEP] - first_step] = t_us[i]
             first = n_out
             n_out = _filter_step(S, H, G, t, k, table, gains, palette, inv_ww, background_mask, out, n_out, log, ranges)
             for r in range(first, n_out):  # the datapath counts 32 bits; a record keeps the event's whole time

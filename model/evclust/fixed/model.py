@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from evclust.clusterer.layout import BG_CB, BG_CR, BG_Y, RECORD_COLUMNS, SLOT_COLUMNS, run_stats, support_shape
+from evclust.clusterer.layout import BG_CB, BG_CR, BG_Y, RECORD_COLUMNS, SLOT_COLUMNS, STEP, run_stats, support_shape
 from evclust.clusterer.params import ClustererParams
 from evclust.fixed import fixed_model
 from evclust.fixed.formats import FormatTable, build_formats, decay_table
@@ -60,17 +60,21 @@ class FixedClusterer:
         if ranges:
             self.ranges = np.zeros((len(fixed_model.SIGNALS), 2), dtype=np.int64)
             self.ranges[:, 0], self.ranges[:, 1] = np.iinfo(np.int64).max, np.iinfo(np.int64).min
+        self.steps = np.zeros(0, dtype=np.int64)  # the times of the filter steps the last feed completed
 
     def feed(self, events: np.ndarray, trace: np.ndarray | None = None) -> np.ndarray:
         """Records of the filter steps these events complete; with `trace` (int64, one per event),
         each event's action << 16 | slot (fixed_model.TRACE_*)."""
         every = self.params.filter_every
         out = np.empty(((events.size // every + 1) * self.params.n_clusters, RECORD_COLUMNS))
+        steps = np.empty(events.size // every + 1, dtype=np.int64)
+        first = self.globals[STEP]
         n = fixed_model.run_events(
             self.slots, self.hist, self.globals, self.k, self.decay, self.gains, self.palette, self.inv_ww, self.background_mask,
-            self.support, self.seen, events["t"], events["x"], events["y"], events["Y"], events["Cb"], events["Cr"], out, self.overflow, self.ranges,
-            trace,
+            self.support, self.seen, events["t"], events["x"], events["y"], events["Y"], events["Cb"], events["Cr"], out, steps,
+            self.overflow, self.ranges, trace,
         )  # fmt: skip
+        self.steps = steps[: int(self.globals[STEP] - first)]
         return out[:n]
 
     def stats(self) -> dict:

@@ -22,7 +22,7 @@ from scipy.optimize import linear_sum_assignment
 from evclust.choices import DEFAULT_GATE_PX
 from evclust.errors import EvclustError
 from evclust.scenes.truth import LABEL_CHARS, truth_array
-from evclust.tracks import TRACK_FIELDS, TrackMeta
+from evclust.tracks import RECORD_DTYPES, VELOCITY_METHODS, TrackMeta, record_kind
 
 
 MATCH_DTYPE = np.dtype(
@@ -57,6 +57,20 @@ MATCH_DTYPE = np.dtype(
 )
 
 
+def velocity_fields(kind: str) -> tuple[str, ...]:
+    """The record fields that hold a kind's velocity estimates, (vx, vy) per method."""
+    return tuple(f for _, vx, vy in VELOCITY_METHODS[kind] for f in (vx, vy))
+
+
+def match_dtype(kind: str) -> np.dtype:
+    """MATCH_DTYPE for cluster records; for object records the velocity fields are the object's (vx, vy)."""
+    if kind == "clusters":
+        return MATCH_DTYPE
+    fields = [(name, MATCH_DTYPE[name]) for name in MATCH_DTYPE.names if name not in velocity_fields("clusters")]
+    at = [name for name, _ in fields].index("gt_vx")
+    return np.dtype(fields[:at] + [(f, np.float64) for f in velocity_fields(kind)] + fields[at:])
+
+
 @dataclasses.dataclass(frozen=True)
 class MatchCounts:
     """What the matches alone cannot tell: the sizes of the populations they were drawn from."""
@@ -79,7 +93,7 @@ def _check_inputs(tracks, meta: TrackMeta, gate_px: float) -> np.ndarray:
         raise EvclustError(f"gate must be a positive number of pixels, not {gate_px}")
     tracks = np.asarray(tracks)
     names = tracks.dtype.names or ()
-    missing = [name for name in TRACK_FIELDS if name not in names]
+    missing = [name for name in RECORD_DTYPES[record_kind(tracks)].names if name not in names]
     if missing:
         raise EvclustError(f"tracks: missing field(s) {', '.join(missing)}")
     if len(meta.palette_ycbcr) and len(meta.palette_ycbcr) != len(meta.palette):
@@ -152,15 +166,22 @@ def match_with_counts(
             raise EvclustError(f"ground truth: object {obj} has two rows for frame {frame}")
         where[(frame, obj)] = i
 
-    # Group the records by filter step, in time order.
+    # Group the records by filter step, in time order; a file thinned to one record per id per
+    # frame (meta.per_frame) by frame, evaluated at the frame's last record time.
     order = np.lexsort((tracks["step"], tracks["t_us"]))
     t_all = tracks["t_us"][order]
     s_all = tracks["step"][order]
+    if meta.per_frame:
+        s_all = np.floor(t_all / t_frame).astype(np.int64)
+        t_all = t_all.copy()
     if order.size:
-        changes = np.flatnonzero((t_all[1:] != t_all[:-1]) | (s_all[1:] != s_all[:-1])) + 1
+        changes = np.flatnonzero((s_all[1:] != s_all[:-1]) | ((t_all[1:] != t_all[:-1]) & (not meta.per_frame))) + 1
         bounds = np.r_[0, changes, order.size]
     else:
         bounds = np.zeros(1, np.int64)
+    if meta.per_frame:  # each frame's records at the frame's last record time
+        for a, b in zip(bounds[:-1], bounds[1:]):
+            t_all[a:b] = t_all[b - 1]
 
     rec_index: list[np.ndarray] = []  # matched track record (index into tracks)
     gt_index: list[np.ndarray] = []  # matched truth row (frame k)
@@ -201,14 +222,15 @@ def match_with_counts(
 
     rec = np.concatenate(rec_index) if rec_index else empty
     gti = np.concatenate(gt_index) if gt_index else empty
-    out = np.zeros(rec.size, dtype=MATCH_DTYPE)
+    kind = record_kind(tracks)
+    out = np.zeros(rec.size, dtype=match_dtype(kind))
     out["step"] = tracks["step"][rec]
     out["t_us"] = tracks["t_us"][rec]
     out["frame"] = np.concatenate(frame_of) if frame_of else empty
     out["gt_id"] = truth["id"][gti]
     out["track_id"] = tracks["id"][rec]
     out["slot"] = tracks["slot"][rec]
-    for name in ("x", "y", "vx_mcm", "vy_mcm", "vx_int", "vy_int", "Y", "Cb", "Cr"):
+    for name in ("x", "y", *velocity_fields(kind), "Y", "Cb", "Cr"):
         out[name] = tracks[name][rec]
     if gt_xy:
         xy = np.concatenate(gt_xy)
@@ -220,7 +242,8 @@ def match_with_counts(
     out["gt_label"] = truth["label"][gti]
     out["fully_visible"] = truth["fully_visible"][gti]
 
-    steps = np.unique(tracks["step"]) if tracks.size else np.empty(0, np.uint32)
+    # Steps (frames, per_frame) below the last one with no record.
+    steps = np.unique(s_all) if tracks.size else np.empty(0, np.uint32)
     counts = MatchCounts(
         n_steps=int(bounds.size - 1),
         n_steps_missing=int(steps[-1]) + 1 - steps.size if steps.size else 0,
@@ -238,9 +261,10 @@ def match(
     gate_px: float = DEFAULT_GATE_PX,
     fully_visible_only: bool = False,
 ) -> np.ndarray:
-    """One MATCH_DTYPE row per matched (track record, ground-truth object) pair, in time order.
+    """One MATCH_DTYPE row per matched (record, ground-truth object) pair, in time order
+    (`match_dtype("objects")` for object records).
 
-    tracks: TRACK_DTYPE records (`evclust.tracks.read_tracks`); meta: their TrackMeta (gives
+    tracks: cluster or object records (`evclust.tracks.read_tracks`); meta: their TrackMeta (gives
     t_frame_us, the palette and luma_weight); truth: TRUTH_DTYPE rows (`read_truth`) or dicts
     keyed by TRUTH_COLUMNS. gate_px: pairs farther apart than this are not matched.
     fully_visible_only: drop pairs whose object is not fully inside the sensor in frame k

@@ -8,7 +8,7 @@ import math
 import numpy as np
 
 from evclust.metrics.match import DEFAULT_GATE_PX, MatchCounts, match_with_counts
-from evclust.tracks import TrackMeta
+from evclust.tracks import VELOCITY_METHODS, TrackMeta
 
 
 @dataclasses.dataclass(frozen=True)
@@ -48,8 +48,7 @@ class Scores:
     # Table 5: velocity
     gt_vx_range: tuple[float, float] | None  # [min, max] of the true vx over the matches
     gt_vy_range: tuple[float, float] | None
-    mcm: VelocityScores
-    interval: VelocityScores
+    velocity: dict[str, VelocityScores]  # per method of the record kind: mcm and interval, or object
     # Table 7: colour and classification
     has_colour: bool
     ycbcr: ColourError
@@ -63,8 +62,19 @@ class Scores:
     id_switches: int
     tracks_per_object: float | None  # distinct track ids matched to each object matched at all
 
+    NO_VELOCITY = VelocityScores(None, None, None)
+
+    @property
+    def mcm(self) -> VelocityScores:
+        return self.velocity.get("mcm", self.NO_VELOCITY)
+
+    @property
+    def interval(self) -> VelocityScores:
+        return self.velocity.get("interval", self.NO_VELOCITY)
+
     def to_dict(self) -> dict:
-        """Plain JSON-ready dict (nested for the velocity and colour groups; tuples as lists)."""
+        """Plain JSON-ready dict (nested for the velocity and colour groups, each velocity method
+        under its own name; tuples as lists)."""
 
         def plain(value):
             if isinstance(value, dict):
@@ -75,7 +85,9 @@ class Scores:
                 return None
             return value
 
-        return plain(dataclasses.asdict(self))
+        out = dataclasses.asdict(self)
+        out |= out.pop("velocity")
+        return plain(out)
 
 
 def _ratio(num: float, den: float) -> float | None:
@@ -139,8 +151,7 @@ def scores_from_matches(matches: np.ndarray, counts: MatchCounts, meta: TrackMet
 
     gt_v = np.stack([m["gt_vx"], m["gt_vy"]], axis=1)
     moving = np.hypot(gt_v[:, 0], gt_v[:, 1]) > 0
-    mcm = _velocity(np.stack([m["vx_mcm"], m["vy_mcm"]], axis=1)[moving], gt_v[moving])
-    interval = _velocity(np.stack([m["vx_int"], m["vy_int"]], axis=1)[moving], gt_v[moving])
+    velocity = {name: _velocity(np.stack([m[vx], m[vy]], axis=1)[moving], gt_v[moving]) for name, vx, vy in VELOCITY_METHODS[meta.kind]}
     vx_range = (float(m["gt_vx"].min()), float(m["gt_vx"].max())) if n else None
     vy_range = (float(m["gt_vy"].min()), float(m["gt_vy"].max())) if n else None
 
@@ -183,8 +194,7 @@ def scores_from_matches(matches: np.ndarray, counts: MatchCounts, meta: TrackMet
         position_rmse_px=position,
         gt_vx_range=vx_range,
         gt_vy_range=vy_range,
-        mcm=mcm,
-        interval=interval,
+        velocity=velocity,
         has_colour=bool(meta.has_colour),
         ycbcr=ycbcr,
         luminance=luminance,

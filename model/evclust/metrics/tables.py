@@ -7,6 +7,7 @@ from collections.abc import Mapping
 from evclust.metrics.scores import Scores
 
 NA = "n/a"
+METHOD_NAMES = {"mcm": "MCM", "interval": "Interval", "object": "Object"}
 
 
 def _num(value, digits: int = 3) -> str:
@@ -57,12 +58,11 @@ def format_tables(scores: Scores | Mapping[str, Scores]) -> str:
 
     velocity = [
         ("Ground Truth Range", "vx × vy [px/Tframe]", each(_range)),
-        ("MCM", "RMSE [px/Tframe]", each(lambda s: _num(s.mcm.rmse))),
-        ("MCM", "NRMSE", each(lambda s: _pct(s.mcm.nrmse))),
-        ("MCM", "Angular", each(lambda s: _deg(s.mcm.angular_deg))),
-        ("Interval", "RMSE [px/Tframe]", each(lambda s: _num(s.interval.rmse))),
-        ("Interval", "NRMSE", each(lambda s: _pct(s.interval.nrmse))),
-        ("Interval", "Angular", each(lambda s: _deg(s.interval.angular_deg))),
+        *(row for method in S[0].velocity for row in (
+            (METHOD_NAMES[method], "RMSE [px/Tframe]", each(lambda s, m=method: _num(s.velocity[m].rmse))),
+            (METHOD_NAMES[method], "NRMSE", each(lambda s, m=method: _pct(s.velocity[m].nrmse))),
+            (METHOD_NAMES[method], "Angular", each(lambda s, m=method: _deg(s.velocity[m].angular_deg))),
+        )),  # fmt: skip
     ]
     colour = [
         ("Position", "RMSE [px]", each(lambda s: _num(s.position_rmse_px))),

@@ -20,7 +20,8 @@ from scipy.optimize import linear_sum_assignment
 from evclust.metrics.match import nearest_palette_class
 from evclust.metrics.scores import class_correct, tracks_per_object  # noqa: F401 (tracks_per_object: re-exported)
 from evclust.scenes.truth import truth_array
-from evclust.tracks import TrackMeta
+from evclust.metrics.match import velocity_fields
+from evclust.tracks import VELOCITY_METHODS, TrackMeta, record_kind
 
 MIN_VISIBLE = 0.5  # area fraction in view below which an object is "don't care"
 MIN_RADIUS_PX = 8.0  # the similarity radius of the smallest objects: a cluster lags a few px
@@ -83,14 +84,25 @@ def _failures(sim: np.ndarray, gi: np.ndarray, ti: np.ndarray, ok: np.ndarray) -
     return [missed, off, fragment, ghost]
 
 
-MATCH_FIELDS = np.dtype([
-    ("frame", np.int64), ("gt_id", np.int64), ("track_id", np.int64), ("d", np.float64), ("radius", np.float64),
-    ("vx_mcm", np.float64), ("vy_mcm", np.float64), ("vx_int", np.float64), ("vy_int", np.float64),
-    ("gt_vx", np.float64), ("gt_vy", np.float64), ("Y", np.float64), ("Cb", np.float64), ("Cr", np.float64),
-    ("gt_Y", np.float64), ("gt_Cb", np.float64), ("gt_Cr", np.float64), ("class_palette", np.int32),
-    ("class_direct", np.int32), ("gt_label", "U32"),
-    ("steady", np.bool_),  # the object moves, with the velocity it had one second earlier
-])  # fmt: skip
+def match_fields(kind: str = "clusters") -> np.dtype:
+    """One row per frame-sampled match; the velocity fields are the record kind's."""
+    return np.dtype([
+        ("frame", np.int64), ("gt_id", np.int64), ("track_id", np.int64), ("d", np.float64), ("radius", np.float64),
+        *((name, np.float64) for name in velocity_fields(kind)),
+        ("gt_vx", np.float64), ("gt_vy", np.float64), ("Y", np.float64), ("Cb", np.float64), ("Cr", np.float64),
+        ("gt_Y", np.float64), ("gt_Cb", np.float64), ("gt_Cr", np.float64), ("class_palette", np.int32),
+        ("class_direct", np.int32), ("gt_label", "U32"),
+        ("steady", np.bool_),  # the object moves, with the velocity it had one second earlier
+    ])  # fmt: skip
+
+
+MATCH_FIELDS = match_fields("clusters")
+
+
+def velocity_methods(matches: np.ndarray) -> tuple[tuple[str, str, str], ...]:
+    """The velocity methods whose estimates a match array holds: (name, vx field, vy field)."""
+    names = matches.dtype.names
+    return tuple(m for kind in VELOCITY_METHODS for m in VELOCITY_METHODS[kind] if m[1] in names)
 
 
 def radius(w, h):
@@ -101,6 +113,8 @@ def radius(w, h):
 def frame_pairs(tracks: np.ndarray, meta: TrackMeta, truth, min_visible: float = MIN_VISIBLE) -> FramePairs:
     truth = truth_array(truth)
     t_frame = float(meta.t_frame_us)
+    kind = record_kind(tracks)
+    speeds = velocity_fields(kind)
     # Filter steps in order, each with its time: several steps can share a microsecond (a burst
     # of simultaneous events), so a sample takes the last step, not every record of that time.
     order = np.lexsort((tracks["step"], tracks["t_us"]))
@@ -173,12 +187,13 @@ def frame_pairs(tracks: np.ndarray, meta: TrackMeta, truth, min_visible: float =
                 row, rec = objs[care][g], recs_c[t]
                 rows.append((
                     k, truth["id"][row], tracks["id"][rec], d[care][:, keep][g, t], r[care][g],
-                    tracks["vx_mcm"][rec], tracks["vy_mcm"][rec], tracks["vx_int"][rec], tracks["vy_int"][rec],
+                    *(tracks[name][rec] for name in speeds),
                     truth["vx"][row], truth["vy"][row], tracks["Y"][rec], tracks["Cb"][rec], tracks["Cr"][rec],
                     truth["Y"][row], truth["Cb"][row], truth["Cr"][row], tracks["class"][rec], -1, truth["label"][row],
                     steady(row),
                 ))  # fmt: skip
-    matches = np.array(rows, dtype=MATCH_FIELDS) if rows else np.zeros(0, MATCH_FIELDS)
+    fields = match_fields(kind)
+    matches = np.array(rows, dtype=fields) if rows else np.zeros(0, fields)
     if matches.size:
         matches["class_direct"] = nearest_palette_class(np.stack([matches["Y"], matches["Cb"], matches["Cr"]], axis=1), meta)
     summary = {i: ObjectSummary(len(vals), *(float(np.mean([v[c] for v in vals])) for c in range(3))) for i, vals in objects.items()}
@@ -241,16 +256,17 @@ def accuracy(matches: np.ndarray, meta: TrackMeta) -> dict:
     relative to the object's half-diagonal, velocity NRMSE and angle per method, colour NRMSE,
     classification. None where nothing stands under a figure."""
     m = matches
+    methods = velocity_methods(m)
     out = {"n_matches": int(m.size)}
     if m.size == 0:
-        return out | {k: None for k in ("position_rel_rmse", "mcm_nrmse", "interval_nrmse", "mcm_angle_deg", "interval_angle_deg",
-                                         "mcm_nrmse_steady", "interval_nrmse_steady", "mcm_angle_deg_steady", "interval_angle_deg_steady",
-                                         "steady_share", "luminance_nrmse", "chrominance_nrmse", "class_palette", "class_direct")}  # fmt: skip
+        per_method = [f"{name}_{figure}{suffix}" for name, _, _ in methods for figure in ("nrmse", "angle_deg") for suffix in ("", "_steady")]
+        return out | {k: None for k in ("position_rel_rmse", *per_method, "steady_share", "luminance_nrmse", "chrominance_nrmse",
+                                         "class_palette", "class_direct")}  # fmt: skip
     out["position_rel_rmse"] = float(np.sqrt(np.mean((m["d"] / m["radius"]) ** 2)))
     gt = np.stack([m["gt_vx"], m["gt_vy"]], axis=1)
     moving = np.hypot(gt[:, 0], gt[:, 1]) > 0
     for suffix, chosen in (("", moving), ("_steady", moving & m["steady"])):
-        for method, (vx, vy) in (("mcm", ("vx_mcm", "vy_mcm")), ("interval", ("vx_int", "vy_int"))):
+        for method, vx, vy in methods:
             est = np.stack([m[vx], m[vy]], axis=1)[chosen]
             g = gt[chosen]
             if g.size == 0:

@@ -1,6 +1,7 @@
 """Plots of one tracked object against its ground truth, after the paper's figures:
 
-- `plot_velocity` (Fig. 7): vy on top, vx below; ground truth blue, MCM green, interval yellow;
+- `plot_velocity` (Fig. 7): vy on top, vx below; ground truth blue, MCM green, interval yellow
+  (cluster records) or the object's velocity green (object records);
 - `plot_colour` (Fig. 10): Y, Cb, Cr; estimate green, ground truth blue;
 - `plot_scatter` (Fig. 9): the colours of the events inside the matched cluster's box, as a Cb–Cr
   and a Y–Cb scatter with the palette entries marked, and the cluster's content at one record.
@@ -34,8 +35,9 @@ MCM_COLOUR = "tab:green"
 INT_COLOUR = "#e6b800"  # yellow, dark enough to read on white
 EST_COLOUR = "tab:green"
 EXIT_COLOUR = "red"
-_MATCH_FIELDS = ("step", "t_us", "frame", "gt_id", "track_id", "vx_mcm", "vy_mcm", "vx_int", "vy_int",
-                 "gt_vx", "gt_vy", "Y", "Cb", "Cr", "gt_Y", "gt_Cb", "gt_Cr")
+_MATCH_FIELDS = ("step", "t_us", "frame", "gt_id", "track_id", "gt_vx", "gt_vy", "Y", "Cb", "Cr", "gt_Y", "gt_Cb", "gt_Cr")
+# Each velocity method's line: (label, colour, width).
+METHOD_LINES = {"mcm": ("MCM", MCM_COLOUR, 1.0), "interval": ("interval", INT_COLOUR, 1.4), "object": ("object", EST_COLOUR, 1.4)}
 
 
 def check_plot_path(path: str | Path) -> Path:
@@ -49,8 +51,8 @@ def pick_object(matches: np.ndarray, gt_id: int | None = None) -> tuple[int, np.
     """(gt_id, its match rows in time order). Default: the object with the most matches."""
     names = matches.dtype.names or ()
     missing = [name for name in _MATCH_FIELDS if name not in names]
-    if missing:
-        raise EvclustError(f"matches: missing field(s) {', '.join(missing)}")
+    if missing or not _methods(matches):
+        raise EvclustError(f"matches: missing field(s) {', '.join(missing) or 'of a velocity'}")
     if matches.size == 0:
         raise EvclustError("no track record was matched to a ground-truth object")
     ids, counts = np.unique(matches["gt_id"], return_counts=True)
@@ -62,6 +64,14 @@ def pick_object(matches: np.ndarray, gt_id: int | None = None) -> tuple[int, np.
     rows = matches[matches["gt_id"] == gt_id]
     rows = rows[np.lexsort((rows["track_id"], rows["step"], rows["t_us"]))]
     return int(gt_id), rows
+
+
+def _methods(matches: np.ndarray) -> tuple[tuple[str, str, str], ...]:
+    """The velocity methods the matches hold (name, vx field, vy field)."""
+    from evclust.tracks import VELOCITY_METHODS
+
+    names = matches.dtype.names or ()
+    return tuple(m for methods in VELOCITY_METHODS.values() for m in methods if m[1] in names and m[2] in names)
 
 
 def presence_gaps(truth: np.ndarray | None, gt_id: int) -> list[tuple[int, int]]:
@@ -145,11 +155,12 @@ def plot_velocity(matches: np.ndarray, path: str | Path, gt_id: int | None = Non
     x, xlabel = _x_values(rows, axis)
     fig, axes = plt.subplots(2, 1, figsize=(11, 6.5), sharex=True, constrained_layout=True)
     for ax, c in zip(axes, ("y", "x")):
-        gt, mcm, itv = rows[f"gt_v{c}"], rows[f"v{c}_mcm"], rows[f"v{c}_int"]
-        for values, colour, name, lw, z in ((gt, GT_COLOUR, "ground truth", 2.0, 3),
-                                            (mcm, MCM_COLOUR, f"MCM (RMSE {_rmse(mcm, gt):.3g})", 1.0, 2),
-                                            (itv, INT_COLOUR, f"interval (RMSE {_rmse(itv, gt):.3g})", 1.4, 2)):
-            ax.plot(*_with_breaks(x, values, rows["frame"]), color=colour, lw=lw, label=name, zorder=z)
+        gt = rows[f"gt_v{c}"]
+        ax.plot(*_with_breaks(x, gt, rows["frame"]), color=GT_COLOUR, lw=2.0, label="ground truth", zorder=3)
+        for method, vx, vy in _methods(rows):
+            name, colour, lw = METHOD_LINES[method]
+            values = rows[vx if c == "x" else vy]
+            ax.plot(*_with_breaks(x, values, rows["frame"]), color=colour, lw=lw, label=f"{name} (RMSE {_rmse(values, gt):.3g})", zorder=2)
         ax.set_ylabel(f"v{c} (px/frame)")
         ax.grid(alpha=0.3)
     _mark_events(axes, rows, x, axis, presence_gaps(truth, gt_id), t_frame_us)

@@ -1,9 +1,11 @@
 """Pictures of tracks over events, like the paper's Fig. 5: one frame (PNG) or a video (MP4).
 
 Each frame shows the events of a sliding time window, drawn in the colour they carry on a dark
-background, and over them every track record of the latest filter step inside the window: the
-cluster box (red), the seek region (green), the centre (orange), the MCM velocity (blue) and the
-interval velocity (yellow), a swatch of the estimated colour and a label with the id and class.
+background, and over them the records of the latest filter step inside the window (of a file
+thinned to one record per frame, each id's latest record in the window). A cluster record shows
+its box (red), seek region (green), centre (orange), MCM velocity (blue) and interval velocity
+(yellow); an object record its box (cyan; dashed while it coasts), centre and velocity (yellow).
+Both carry a swatch of the estimated colour and a label with the id and class.
 
 Frames are drawn with OpenCV on a canvas `scale` times the sensor size. A sensor pixel `i` covers
 `[i - 0.5, i + 0.5]` (docs/DESIGN.md); it becomes the canvas pixels `i·K .. i·K + K - 1`, so a
@@ -22,7 +24,7 @@ from tqdm import tqdm
 from evclust.colour import ycbcr_to_rgb
 from evclust.errors import EvclustError, atomic_output
 from evclust.events.format import EventMeta
-from evclust.tracks.record import TRACK_DTYPE, TrackMeta, read_tracks
+from evclust.tracks.record import RECORD_DTYPES, ObjectFlags, TrackMeta, read_tracks
 
 DEFAULT_FRAME_US = 33333.0
 PNG_SUFFIXES = (".png",)
@@ -35,6 +37,7 @@ SEEK = (0, 255, 0)  # green: the seek region, the box grown by the seek margin
 CENTRE = (0, 150, 255)  # orange
 V_MCM = (255, 110, 0)  # blue: mean-centre-motion velocity
 V_INT = (0, 230, 255)  # yellow: regular-interval velocity (Fig. 7 uses yellow for it too)
+OBJECT = (255, 220, 0)  # cyan: an object's box
 TEXT = (235, 235, 235)
 FOOTER_PX = 16  # a strip below the image for the time and the legend; image rows are untouched
 
@@ -53,17 +56,18 @@ def frame_period(ev_meta: EventMeta, track_meta: TrackMeta | None = None) -> flo
 
 
 def sort_tracks(tracks: np.ndarray) -> np.ndarray:
-    """Track records ordered by filter step (stable), as the frame lookup needs."""
+    """Cluster or object records ordered by filter step (stable), as the frame lookup needs."""
     tracks = np.asarray(tracks)
-    if tracks.dtype != TRACK_DTYPE:
-        raise EvclustError(f"records of dtype {tracks.dtype} are not tracks")
+    if tracks.dtype not in RECORD_DTYPES.values():
+        raise EvclustError(f"records of dtype {tracks.dtype} are not cluster or object records")
     if tracks.size > 1 and np.any(tracks["step"][1:] < tracks["step"][:-1]):
         tracks = tracks[np.argsort(tracks["step"], kind="stable")]
     return tracks
 
 
-def latest_records(tracks: np.ndarray, t_lo_us: float, t_hi_us: float) -> np.ndarray:
-    """The records of the latest filter step with t_lo < t_us <= t_hi (empty if none).
+def latest_records(tracks: np.ndarray, t_lo_us: float, t_hi_us: float, per_frame: bool = False) -> np.ndarray:
+    """The records of the latest filter step with t_lo < t_us <= t_hi (empty if none); of a file
+    thinned per frame (`per_frame`), each id's latest record with t_lo < t_us <= t_hi.
 
     `tracks` must be ordered by step (see `sort_tracks`); step times never decrease with the step.
     """
@@ -73,6 +77,11 @@ def latest_records(tracks: np.ndarray, t_lo_us: float, t_hi_us: float) -> np.nda
     i = int(np.searchsorted(t, np.uint64(max(0, math.floor(t_hi_us))), side="right")) - 1
     if i < 0 or float(t[i]) <= t_lo_us:
         return tracks[:0]
+    if per_frame:
+        lo = int(np.searchsorted(t, np.uint64(max(0, math.floor(t_lo_us) + 1)), side="left"))
+        window = tracks[lo : i + 1]
+        _, last_from_end = np.unique(window["id"][::-1], return_index=True)
+        return window[np.sort(window.size - 1 - last_from_end)]
     step = tracks["step"][i]
     lo, hi = np.searchsorted(tracks["step"], [step, step + 1])
     return tracks[lo:hi]
@@ -125,27 +134,43 @@ def _arrow(canvas: np.ndarray, start: np.ndarray, v: tuple[float, float], gain: 
     cv2.arrowedLine(canvas, p0, p1, colour, 1 + scale // 3, cv2.LINE_AA, shift, tipLength=0.25)
 
 
+def _dashed_rectangle(canvas: np.ndarray, p0: tuple[int, int], p1: tuple[int, int], colour, dash: int) -> None:
+    (x0, y0), (x1, y1) = p0, p1
+    for a, b, fixed, horizontal in ((x0, x1, y0, True), (x0, x1, y1, True), (y0, y1, x0, False), (y0, y1, x1, False)):
+        for u in range(a, b + 1, 2 * dash):
+            v = min(u + dash - 1, b)
+            cv2.line(canvas, (u, fixed) if horizontal else (fixed, u), (v, fixed) if horizontal else (fixed, v), colour, 1, cv2.LINE_8)
+
+
 def draw_tracks(canvas: np.ndarray, records: np.ndarray, meta: TrackMeta, scale: int, arrow_frames: float = 5.0) -> None:
-    """Draw track records on a canvas (BGR, `scale` times the sensor), in place.
+    """Draw cluster or object records on a canvas (BGR, `scale` times the sensor), in place.
 
     Velocities are in px/frame; an arrow shows the displacement over `arrow_frames` frames.
     """
     font = 0.3 + 0.05 * scale
     h, w = canvas.shape[:2]
+    objects = meta.kind == "objects"
     for r in records:
         x, y, rx, ry = float(r["x"]), float(r["y"]), float(r["rx"]), float(r["ry"])
-        s = float(meta.seek_margin) + float(meta.seek_scale) * max(rx, ry)
+        s = 0.0 if objects else float(meta.seek_margin) + float(meta.seek_scale) * max(rx, ry)
         if s > 0:
             x0, y0 = to_canvas([x - rx - s, y - ry - s], scale)
             x1, y1 = to_canvas([x + rx + s, y + ry + s], scale)
             cv2.rectangle(canvas, (int(x0), int(y0)), (int(x1), int(y1)), SEEK, 1, cv2.LINE_8)
         bx0, by0 = (int(v) for v in to_canvas([x - rx, y - ry], scale))
         bx1, by1 = (int(v) for v in to_canvas([x + rx, y + ry], scale))
-        cv2.rectangle(canvas, (bx0, by0), (bx1, by1), BOX, 1, cv2.LINE_8)
         centre = (x + 0.5) * scale - 0.5, (y + 0.5) * scale - 0.5
         centre = np.array(centre)
-        _arrow(canvas, centre, (float(r["vx_int"]), float(r["vy_int"])), arrow_frames, scale, V_INT)
-        _arrow(canvas, centre, (float(r["vx_mcm"]), float(r["vy_mcm"])), arrow_frames, scale, V_MCM)
+        if objects:
+            if int(r["flags"]) & ObjectFlags.COASTING:
+                _dashed_rectangle(canvas, (bx0, by0), (bx1, by1), OBJECT, max(2, 2 * scale))
+            else:
+                cv2.rectangle(canvas, (bx0, by0), (bx1, by1), OBJECT, 1 + scale // 2, cv2.LINE_8)
+            _arrow(canvas, centre, (float(r["vx"]), float(r["vy"])), arrow_frames, scale, V_INT)
+        else:
+            cv2.rectangle(canvas, (bx0, by0), (bx1, by1), BOX, 1, cv2.LINE_8)
+            _arrow(canvas, centre, (float(r["vx_int"]), float(r["vy_int"])), arrow_frames, scale, V_INT)
+            _arrow(canvas, centre, (float(r["vx_mcm"]), float(r["vy_mcm"])), arrow_frames, scale, V_MCM)
         cv2.circle(canvas, (int(round(centre[0])), int(round(centre[1]))), max(2, scale), CENTRE, -1, cv2.LINE_AA)
         label = f"{int(r['id'])}"
         cls = int(r["class"])
@@ -207,11 +232,15 @@ class FrameDrawer:
         width, height = self.size
         canvas = np.zeros((height, width, 3), np.uint8)
         canvas[: height - FOOTER_PX] = cv2.resize(image, None, fx=k, fy=k, interpolation=cv2.INTER_NEAREST) if k > 1 else image
-        records = latest_records(self.tracks, t_us - self.window, t_us)
+        records = latest_records(self.tracks, t_us - self.window, t_us, self.meta.per_frame)
         body = canvas[: height - FOOTER_PX]  # a view: draw_tracks writes into the canvas
         draw_tracks(body, records, self.meta, k, self.arrow_frames)
-        pieces = [(f"t={t_us / 1e6:.3f}s {win.size} ev {records.size} tr", TEXT), ("box", BOX), ("seek", SEEK),
-                  ("Vmcm", V_MCM), (f"Vint (x{self.arrow_frames:g} frames)", V_INT)]
+        if self.meta.kind == "objects":
+            pieces = [(f"t={t_us / 1e6:.3f}s {win.size} ev {records.size} obj", TEXT), ("object (dashed: coasting)", OBJECT),
+                      (f"V (x{self.arrow_frames:g} frames)", V_INT)]
+        else:
+            pieces = [(f"t={t_us / 1e6:.3f}s {win.size} ev {records.size} tr", TEXT), ("box", BOX), ("seek", SEEK),
+                      ("Vmcm", V_MCM), (f"Vint (x{self.arrow_frames:g} frames)", V_INT)]
         x = 3
         for text, colour in pieces:  # as many as fit, in their own colours
             (tw, _), _ = cv2.getTextSize(text, cv2.FONT_HERSHEY_SIMPLEX, 0.35, 1)

@@ -12,6 +12,9 @@ from __future__ import annotations
 import numpy as np
 
 from evclust.metrics import tracking
+from evclust.tracks import VELOCITY_METHODS
+
+VELOCITY_METHOD_NAMES = tuple(name for methods in VELOCITY_METHODS.values() for name, _, _ in methods)
 
 SMALL_PX = 32.0
 SLOW_PX_PER_FRAME = 1.0
@@ -49,7 +52,8 @@ def figures(results, objects=None, trackeval: bool = True) -> dict:
         n_samples += sum(r.objects[i].samples for i in keep)
         n_records += r.n_records
         kept_matches.append(r.matches[np.isin(r.matches["gt_id"], sorted(keep))])
-    matches = np.concatenate(kept_matches) if kept_matches else np.zeros(0, tracking.MATCH_FIELDS)
+    kind = results[0].meta.kind if results else "clusters"
+    matches = np.concatenate(kept_matches) if kept_matches else np.zeros(0, tracking.match_fields(kind))
     out = {
         "scenes": len(results),
         "objects": n_objects,
@@ -62,6 +66,21 @@ def figures(results, objects=None, trackeval: bool = True) -> dict:
     if results:
         out |= tracking.accuracy(matches, results[0].meta)
     return out
+
+
+def best_velocity(f: dict) -> dict:
+    """The better velocity method's figures (lower NRMSE, lower angle; each on its own) of a
+    figures dict, over the methods its records have: best_velocity_nrmse, best_angle_deg and
+    their _steady forms."""
+
+    def low(figure):
+        vals = [f.get(f"{m}_{figure}") for m in VELOCITY_METHOD_NAMES if f.get(f"{m}_{figure}") is not None]
+        return min(vals) if vals else None
+
+    return f | {
+        "best_velocity_nrmse": low("nrmse"), "best_angle_deg": low("angle_deg"),
+        "best_velocity_nrmse_steady": low("nrmse_steady"), "best_angle_deg_steady": low("angle_deg_steady"),
+    }  # fmt: skip
 
 
 def by_category(results) -> dict[str, dict]:
@@ -83,8 +102,8 @@ def objective(f: dict) -> float:
     def term(value, worst=1.0):
         return worst if value is None or not np.isfinite(value) else float(min(max(value, 0.0), worst))
 
-    velocity = min(term(f.get("mcm_nrmse"), 3.0), term(f.get("interval_nrmse"), 3.0))
-    angle = min(term(f.get("mcm_angle_deg"), 90.0), term(f.get("interval_angle_deg"), 90.0)) / 90.0
+    velocity = min(term(f.get(f"{m}_nrmse"), 3.0) for m in VELOCITY_METHOD_NAMES)
+    angle = min(term(f.get(f"{m}_angle_deg"), 90.0) for m in VELOCITY_METHOD_NAMES) / 90.0
     return (
         2.0 * (1.0 - term(f.get("recall"), 1.0)) + 2.0 * (1.0 - term(f.get("precision"), 1.0))
         + term((f.get("tracks_per_object") or 2.0) - 1.0) + term(f.get("position_rel_rmse"))

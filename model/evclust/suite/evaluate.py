@@ -30,6 +30,7 @@ class SceneResult:
     meta: object  # the track file's TrackMeta (palette, colour)
     frames: np.ndarray  # the frame of each sample
     failures: np.ndarray  # per sample, unmatched objects and records by kind (tracking.FAILURES)
+    clusters: "SceneResult | None" = None  # the cluster records' result, when these are object records
 
     @property
     def recall(self) -> float | None:
@@ -42,8 +43,10 @@ class SceneResult:
 
 def evaluate_scene(files: SceneFiles, params: ClustererParams, model: str = "float", cache: dict | None = None,
                    trackeval: bool = True) -> SceneResult:  # fmt: skip
-    """Track one scene and score it. `cache` (a dict) keeps the scene's events and truth for
-    the next call in this process; trackeval=False skips HOTA/MOTA/IDF1 (a tuning loop's speed)."""
+    """Track one scene and score what the run reports (its object records when the parameters
+    have an object layer; its cluster records, scored too, in `.clusters`). `cache` (a dict)
+    keeps the scene's events and truth for the next call in this process; trackeval=False skips
+    HOTA/MOTA/IDF1 (a tuning loop's speed)."""
     if cache is not None and files.name in cache:
         events, meta, truth = cache[files.name]
     else:
@@ -53,9 +56,16 @@ def evaluate_scene(files: SceneFiles, params: ClustererParams, model: str = "flo
     start = time.perf_counter()
     run = track_events(events, meta, params, model=model)
     wall = time.perf_counter() - start
-    pairs = tracking.frame_pairs(run.tracks, run.meta, truth)
-    return SceneResult(
-        name=files.name, facts=files.facts, model=model, events=int(events.size), wall_s=wall, stats=run.stats,
-        trackeval=tracking.evaluate_sequence(pairs) if trackeval else None, n_objects=pairs.n_objects, n_records=pairs.n_records,
-        matches=pairs.matches, objects=pairs.objects, meta=run.meta, frames=pairs.frames, failures=pairs.failures,
-    )  # fmt: skip
+
+    def result(records, records_meta) -> SceneResult:
+        pairs = tracking.frame_pairs(records, records_meta, truth)
+        return SceneResult(
+            name=files.name, facts=files.facts, model=model, events=int(events.size), wall_s=wall, stats=run.stats,
+            trackeval=tracking.evaluate_sequence(pairs) if trackeval else None, n_objects=pairs.n_objects, n_records=pairs.n_records,
+            matches=pairs.matches, objects=pairs.objects, meta=records_meta, frames=pairs.frames, failures=pairs.failures,
+        )  # fmt: skip
+
+    out = result(*run.output)
+    if run.object_meta is not None:
+        out.clusters = result(run.tracks, run.meta)
+    return out

@@ -10,7 +10,7 @@ from pathlib import Path
 
 from evclust.clusterer import ClustererParams, load_params
 from evclust.scenes.generate import SPLITS
-from evclust.suite.aggregate import SCENE_CATEGORIES, SLOW_PX_PER_FRAME, SMALL_PX, by_category, figures
+from evclust.suite.aggregate import SCENE_CATEGORIES, SLOW_PX_PER_FRAME, SMALL_PX, best_velocity, by_category, figures
 from evclust.suite.evaluate import evaluate_scene
 from evclust.suite.figures import failure_grid
 from evclust.suite.prepare import SceneFiles, prepare_scene
@@ -63,16 +63,7 @@ def ablation_configurations() -> list[Configuration]:
     ]
 
 
-def _best(f: dict) -> dict:
-    def low(*keys):
-        vals = [f.get(k) for k in keys if f.get(k) is not None]
-        return min(vals) if vals else None
-
-    return f | {
-        "best_velocity_nrmse": low("mcm_nrmse", "interval_nrmse"), "best_angle_deg": low("mcm_angle_deg", "interval_angle_deg"),
-        "best_velocity_nrmse_steady": low("mcm_nrmse_steady", "interval_nrmse_steady"),
-        "best_angle_deg_steady": low("mcm_angle_deg_steady", "interval_angle_deg_steady"),
-    }  # fmt: skip
+_best = best_velocity
 
 
 def _rule(head: str) -> str:

@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from evclust.errors import EvclustError
-from evclust.tracks.record import TRACK_DTYPE, TRACK_FIELDS, TrackMeta
+from evclust.tracks.record import TrackMeta
 
 META_KEY = b"evclust-tracks"
 
@@ -26,7 +26,8 @@ def _stored(dtype: np.dtype) -> np.dtype:
 def _schema(meta: TrackMeta):
     import pyarrow as pa
 
-    fields = [pa.field(name, pa.from_numpy_dtype(_stored(TRACK_DTYPE[name]))) for name in TRACK_FIELDS]
+    dtype = meta.dtype
+    fields = [pa.field(name, pa.from_numpy_dtype(_stored(dtype[name]))) for name in dtype.names]
     return pa.schema(fields, metadata={META_KEY: meta.to_json().encode()})
 
 
@@ -35,15 +36,16 @@ class ParquetTrackWriter:
         import pyarrow.parquet as pq
 
         self.schema = _schema(meta)
+        self.dtype = meta.dtype
         # Floats split by byte before zstd: their exponents and high bytes then compress well.
-        floats = [name for name in TRACK_FIELDS if TRACK_DTYPE[name].kind == "f"]
+        floats = [name for name in self.dtype.names if self.dtype[name].kind == "f"]
         self.file = pq.ParquetWriter(tmp, self.schema, compression="zstd", use_dictionary=False,
                                      column_encoding={name: "BYTE_STREAM_SPLIT" for name in floats})  # fmt: skip
 
     def write(self, tracks: np.ndarray) -> None:
         import pyarrow as pa
 
-        columns = [pa.array(tracks[name].astype(_stored(TRACK_DTYPE[name]))) for name in TRACK_FIELDS]
+        columns = [pa.array(tracks[name].astype(_stored(self.dtype[name]))) for name in self.dtype.names]
         self.file.write_table(pa.Table.from_arrays(columns, schema=self.schema))
 
     def close(self) -> None:
@@ -65,17 +67,18 @@ def read_parquet_tracks(path: Path) -> tuple[np.ndarray, TrackMeta]:
         meta = TrackMeta.from_dict(json.loads(raw))
     except (ValueError, TypeError) as exc:
         raise EvclustError(f"{path}: unreadable metadata ({exc})") from None
-    missing = [name for name in TRACK_FIELDS if name not in table.column_names]
+    dtype = meta.dtype
+    missing = [name for name in dtype.names if name not in table.column_names]
     if missing:
         raise EvclustError(f"{path}: missing column(s) {', '.join(missing)}")
-    tracks = np.zeros(table.num_rows, TRACK_DTYPE)
-    for name in TRACK_FIELDS:
+    tracks = np.zeros(table.num_rows, dtype)
+    for name in dtype.names:
         column = table.column(name)
         if column.null_count:
             raise EvclustError(f"{path}: column {name} has {column.null_count} missing value(s)")
         values = column.to_numpy()
-        if values.dtype != _stored(TRACK_DTYPE[name]):
-            raise EvclustError(f"{path}: column {name} has type {values.dtype}, expected {_stored(TRACK_DTYPE[name])}")
+        if values.dtype != _stored(dtype[name]):
+            raise EvclustError(f"{path}: column {name} has type {values.dtype}, expected {_stored(dtype[name])}")
         if values.dtype.kind == "f" and not np.isfinite(values).all():
             i = int(np.flatnonzero(~np.isfinite(values))[0])
             raise EvclustError(f"{path}: row {i}: {name} is {values[i]}")

@@ -1,4 +1,9 @@
-"""Track record dtype, its metadata, and track files: CSV here, Parquet in `columnar`."""
+"""The two record kinds, their metadata, and track files: CSV here, Parquet in `columnar`.
+
+Cluster records (TRACK_DTYPE) are the event-rate clusterer's, one per reported cluster per
+filter step; object records (OBJECT_DTYPE) are the object layer's, one per reported object per
+filter step. Columns that mean the same have the same names. A file holds one kind, named in
+its metadata (`TrackMeta.kind`)."""
 
 from __future__ import annotations
 
@@ -37,9 +42,42 @@ TRACK_DTYPE = np.dtype(
     ]
 )
 TRACK_FIELDS = TRACK_DTYPE.names
-_INTEGER_FIELDS = {"t_us", "step", "slot", "id", "class", "flags"}
+OBJECT_DTYPE = np.dtype(
+    [
+        ("t_us", np.uint64),  # time of the filter step
+        ("step", np.uint32),  # filter step index, from 0
+        ("slot", np.uint16),  # object table slot
+        ("id", np.uint32),  # unique, increasing object id
+        ("x", np.float64),  # centre, px (pixel-index coordinates)
+        ("y", np.float64),
+        ("rx", np.float64),  # half-size of the box, px
+        ("ry", np.float64),
+        ("vx", np.float64),  # velocity, px/frame
+        ("vy", np.float64),
+        ("Y", np.float64),  # object colour, 0..255
+        ("Cb", np.float64),
+        ("Cr", np.float64),
+        ("class", np.int16),  # palette index; -1: none
+        ("members", np.uint16),  # clusters that joined it at this step (0: coasting)
+        ("flags", np.uint16),  # ObjectFlags
+    ]
+)
+OBJECT_FIELDS = OBJECT_DTYPE.names
+RECORD_KINDS = ("clusters", "objects")
+RECORD_DTYPES = {"clusters": TRACK_DTYPE, "objects": OBJECT_DTYPE}
+# The velocity estimates of each kind, by method: (name, vx field, vy field).
+VELOCITY_METHODS = {
+    "clusters": (("mcm", "vx_mcm", "vy_mcm"), ("interval", "vx_int", "vy_int")),
+    "objects": (("object", "vx", "vy"),),
+}
+_INTEGER_FIELDS = {"t_us", "step", "slot", "id", "class", "flags", "members"}
 MAGIC = "# evclust-tracks "
 TRACK_SUFFIXES = (".csv", ".parquet")
+
+
+def record_kind(records: np.ndarray) -> str:
+    """"clusters" or "objects", from a record array's fields."""
+    return "objects" if "members" in (np.asarray(records).dtype.names or ()) else "clusters"
 
 
 class TrackFlags(enum.IntFlag):
@@ -47,6 +85,11 @@ class TrackFlags(enum.IntFlag):
     BORDER = 2  # centre within exit_margin of a border
     MOVING_MCM = 4  # uncorrected |V_mcm| >= v_min (the evidence the noise filter weighs)
     MOVING_INT = 8  # |V_int| >= v_min
+
+
+class ObjectFlags(enum.IntFlag):
+    NEW = 1  # first record of this id
+    COASTING = 2  # no cluster joined it at this step: its position is predicted
 
 
 @dataclasses.dataclass(frozen=True)
@@ -66,7 +109,12 @@ class TrackMeta:
     seek_scale: float = 0.0  # ... plus seek_scale·max(rx, ry) (beyond the paper)
     exit_margin: float = 0.0  # M: the border band where exit prediction acts, px
     has_colour: bool = True
-    per_frame: bool = False  # thinned to one record per cluster per frame (evclust.tracks.thin)
+    per_frame: bool = False  # thinned to one record per cluster or object per frame (evclust.tracks.thin)
+    kind: str = "clusters"  # the records: "clusters" (TRACK_DTYPE) or "objects" (OBJECT_DTYPE)
+
+    @property
+    def dtype(self) -> np.dtype:
+        return RECORD_DTYPES[self.kind]
 
     def to_json(self) -> str:
         return json.dumps(dataclasses.asdict(self), sort_keys=True)
@@ -75,6 +123,8 @@ class TrackMeta:
     def from_dict(cls, d: dict) -> "TrackMeta":
         known = {f.name for f in dataclasses.fields(cls)}
         d = {k: v for k, v in d.items() if k in known}
+        if d.get("kind", "clusters") not in RECORD_KINDS:
+            raise ValueError(f"unknown record kind {d['kind']!r} (expected {' or '.join(RECORD_KINDS)})")
         for key in ("palette", "palette_background"):
             if key in d:
                 d[key] = tuple(d[key])
@@ -88,16 +138,17 @@ def _format(value, integer: bool) -> str:
 
 
 class CsvTrackWriter:
-    """Track records as CSV, appended chunk by chunk."""
+    """Records as CSV, appended chunk by chunk."""
 
     def __init__(self, tmp: Path, meta: TrackMeta):
+        self.fields = meta.dtype.names
         self.file = open(tmp, "w", newline="")
         self.file.write(MAGIC + meta.to_json() + "\n")
-        self.file.write(",".join(TRACK_FIELDS) + "\n")
-        self.integer = [name in _INTEGER_FIELDS for name in TRACK_FIELDS]
+        self.file.write(",".join(self.fields) + "\n")
+        self.integer = [name in _INTEGER_FIELDS for name in self.fields]
 
     def write(self, tracks: np.ndarray) -> None:
-        columns = [tracks[name].tolist() for name in TRACK_FIELDS]
+        columns = [tracks[name].tolist() for name in self.fields]
         self.file.writelines(",".join(_format(v, i) for v, i in zip(row, self.integer)) + "\n" for row in zip(*columns))
 
     def close(self) -> None:
@@ -123,19 +174,19 @@ def track_writer(path: str | Path, meta: TrackMeta):
     with atomic_output(path) as tmp:
         writer = cls(tmp, meta)
         try:
-            yield _CheckedTrackWriter(writer, path)
+            yield _CheckedTrackWriter(writer, path, meta.dtype)
         finally:
             writer.close()
 
 
 class _CheckedTrackWriter:
-    def __init__(self, writer, path: Path):
-        self.writer, self.path, self.count = writer, path, 0
+    def __init__(self, writer, path: Path, dtype: np.dtype):
+        self.writer, self.path, self.dtype, self.count = writer, path, dtype, 0
 
     def write(self, tracks: np.ndarray) -> None:
         tracks = np.asarray(tracks)
-        if tracks.dtype != TRACK_DTYPE:
-            raise EvclustError(f"{self.path}: records of dtype {tracks.dtype} are not tracks")
+        if tracks.dtype != self.dtype:
+            raise EvclustError(f"{self.path}: records of dtype {tracks.dtype} are not {'object' if self.dtype == OBJECT_DTYPE else 'cluster'} records")
         if tracks.size:
             self.writer.write(tracks)
             self.count += tracks.size
@@ -147,7 +198,8 @@ def write_tracks(path: str | Path, tracks: np.ndarray, meta: TrackMeta) -> None:
 
 
 def read_tracks(path: str | Path) -> tuple[np.ndarray, TrackMeta]:
-    """Read a track file (.csv or .parquet): (TRACK_DTYPE records, TrackMeta)."""
+    """Read a track file (.csv or .parquet): (records, TrackMeta); the records are TRACK_DTYPE
+    or OBJECT_DTYPE as `TrackMeta.kind` says."""
     path = Path(path)
     if not path.is_file():
         raise EvclustError(f"{path}: no such track file")
@@ -177,23 +229,25 @@ def _read_csv_tracks(path: Path) -> tuple[np.ndarray, TrackMeta]:
     header = next(reader, None)
     if header is None:
         raise EvclustError(f"{path}: no header line")
-    missing = [name for name in TRACK_FIELDS if name not in header]
+    dtype = meta.dtype
+    fields = dtype.names
+    missing = [name for name in fields if name not in header]
     if missing:
         raise EvclustError(f"{path}: missing column(s) {', '.join(missing)}")
-    index = [header.index(name) for name in TRACK_FIELDS]
-    limits = {name: np.iinfo(TRACK_DTYPE[name]) for name in _INTEGER_FIELDS}
+    index = [header.index(name) for name in fields]
+    limits = {name: np.iinfo(dtype[name]) for name in _INTEGER_FIELDS if name in fields}
     rows = []
     for line_no, row in enumerate(reader, start=3):
         if not row:
             continue
         try:
-            values = tuple(float(row[i]) if name not in _INTEGER_FIELDS else int(row[i]) for i, name in zip(index, TRACK_FIELDS))
+            values = tuple(float(row[i]) if name not in _INTEGER_FIELDS else int(row[i]) for i, name in zip(index, fields))
         except (ValueError, IndexError):
             raise EvclustError(f"{path}: line {line_no}: not a track record: {','.join(row)[:80]}") from None
-        for name, value in zip(TRACK_FIELDS, values):
+        for name, value in zip(fields, values):
             if name in limits and not limits[name].min <= value <= limits[name].max:
-                raise EvclustError(f"{path}: line {line_no}: {name}={value} does not fit {TRACK_DTYPE[name]}")
+                raise EvclustError(f"{path}: line {line_no}: {name}={value} does not fit {dtype[name]}")
             if name not in limits and not np.isfinite(value):
                 raise EvclustError(f"{path}: line {line_no}: {name} is {value}")
         rows.append(values)
-    return np.array(rows, dtype=TRACK_DTYPE), meta
+    return np.array(rows, dtype=dtype), meta

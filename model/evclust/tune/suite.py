@@ -45,6 +45,19 @@ SUITE_SPACE = (
     ("exit_margin", 0.0, 20.0, "linear"),
     ("support_window_frames", 0.005, 1.0, "log"),
     ("gamma", 10.0, 2000.0, "log"),
+    # The object layer (clusterer/objects.py).
+    ("object_gate", 0.0, 20.0, "linear"),
+    ("object_link_along", 0.0, 6.0, "linear"),
+    ("object_v_tol", 0.05, 2.0, "log"),
+    ("object_v_rel", 0.0, 1.0, "linear"),
+    ("object_track_frames", 0.1, 10.0, "log"),
+    ("object_rate_frames", 1.0, 50.0, "log"),
+    ("object_velocity_frames", 0.1, 20.0, "log"),
+    ("object_size_frames", 0.1, 10.0, "log"),
+    ("object_colour_frames", 0.1, 20.0, "log"),
+    ("object_birth_frames", 0.0, 5.0, "linear"),
+    ("object_coast_frames", 0.0, 10.0, "linear"),
+    ("object_keep_frames", 1.0, 100.0, "log"),
 )
 # Scales the fixed model holds in steps of 1/64 (formats.SCALE_FRAC_BITS): searched on that grid,
 # so that the float and the fixed model use the same value.
