@@ -1,6 +1,8 @@
-// evclust_axis: the clusterer as it sits in a system. Events in and track records out on
-// AXI4-Stream, the register file (evclust_regs) on AXI4-Lite, an interrupt, and the trace as a
-// monitor port. Each word is the core's, zero-padded to whole bytes (TDATA widths must be).
+// evclust_axis: the clusterer as it sits in a system. Events in, cluster records and object
+// records out on AXI4-Stream, the register file (evclust_regs) on AXI4-Lite, an interrupt, and
+// the trace as a monitor port. Each word is the core's or the object unit's, zero-padded to
+// whole bytes (TDATA widths must be). With OBJECTS = 0 in the header there is no object unit
+// and the object stream stays idle.
 //
 // The event stream's tready depends on the core's state only, never on tvalid, and the record
 // stream's tvalid and tdata come from registers, as AXI4-Stream asks. One clock and one
@@ -14,6 +16,7 @@ module evclust_axis #(
 ,
     parameter integer EV_BYTES = (EV_W + 7) / 8,
     parameter integer REC_BYTES = (REC_W + 7) / 8,
+    parameter integer OBJ_BYTES = (OBJ_W + 7) / 8,
     parameter integer RUNTIME_CONFIG = 1  // 0: the build's parameter set only, in the smaller core
 ) (
     input  wire                   clk,
@@ -22,10 +25,14 @@ module evclust_axis #(
     input  wire [8*EV_BYTES-1:0]  s_axis_event_tdata,
     input  wire                   s_axis_event_tvalid,
     output wire                   s_axis_event_tready,
-    // track records: the word of expected.hex (REC_* fields)
+    // cluster records: the word of expected.hex (REC_* fields); tie tready high if unused
     output wire [8*REC_BYTES-1:0] m_axis_record_tdata,
     output wire                   m_axis_record_tvalid,
     input  wire                   m_axis_record_tready,
+    // object records: the word of objects.hex (OBJ_* fields)
+    output wire [8*OBJ_BYTES-1:0] m_axis_object_tdata,
+    output wire                   m_axis_object_tvalid,
+    input  wire                   m_axis_object_tready,
     // each event's action (TRACE_* fields), one cycle, no back-pressure
     output wire                   trace_valid,
     output wire [TRACE_W-1:0]     trace_data,
@@ -54,18 +61,23 @@ module evclust_axis #(
 `include "evclust_params.vh"
 
     generate
-        if (EV_BYTES * 8 < EV_W || REC_BYTES * 8 < REC_W) begin : stream_too_narrow
-            `EVCLUST_FAIL("evclust_axis: EV_BYTES or REC_BYTES too small for the core's words")
+        if (EV_BYTES * 8 < EV_W || REC_BYTES * 8 < REC_W || OBJ_BYTES * 8 < OBJ_W) begin : stream_too_narrow
+            `EVCLUST_FAIL("evclust_axis: EV_BYTES, REC_BYTES or OBJ_BYTES too small for the words")
         end
     endgenerate
 
     wire [CFG_W-1:0]   cfg;
-    wire               clear, idle;
+    wire               clear, idle, core_idle, objects_idle;
     wire [COUNT_W-1:0] count_inc;
-    wire [REC_W-1:0]   record;
+    wire [REC_W-1:0]   core_record, record;
+    wire               core_rec_valid, core_rec_ready;
+    wire               step_valid, step_ready;
+    wire [31:0]        step_t;
+    wire [OBJ_W-1:0]   object;
     wire               unused_filter_active;
+    assign idle = core_idle && objects_idle;
 
-    evclust_regs #(.N(N), .EV_W(EV_W), .REC_W(REC_W), .TRACE_W(TRACE_W), .CFG_W(CFG_W), .COUNT_W(COUNT_W), .RUNTIME_CONFIG(RUNTIME_CONFIG)) regs (
+    evclust_regs #(.N(N), .EV_W(EV_W), .REC_W(REC_W), .TRACE_W(TRACE_W), .OBJ_W(OBJ_W), .CFG_W(CFG_W), .COUNT_W(COUNT_W), .RUNTIME_CONFIG(RUNTIME_CONFIG)) regs (
         .clk(clk), .rst(rst),
         .s_axil_awaddr(s_axil_awaddr), .s_axil_awprot(s_axil_awprot), .s_axil_awvalid(s_axil_awvalid), .s_axil_awready(s_axil_awready),
         .s_axil_wdata(s_axil_wdata), .s_axil_wstrb(s_axil_wstrb), .s_axil_wvalid(s_axil_wvalid), .s_axil_wready(s_axil_wready),
@@ -75,14 +87,37 @@ module evclust_axis #(
         .cfg(cfg), .clear(clear), .idle(idle), .count_inc(count_inc), .irq(irq)
     );
 
-    evclust_core #(.N(N), .EV_W(EV_W), .REC_W(REC_W), .TRACE_W(TRACE_W), .CFG_W(CFG_W), .COUNT_W(COUNT_W), .RUNTIME_CONFIG(RUNTIME_CONFIG)) core (
+    evclust_core #(.N(N), .EV_W(EV_W), .REC_W(REC_W), .TRACE_W(TRACE_W), .OBJ_W(OBJ_W), .CFG_W(CFG_W), .COUNT_W(COUNT_W), .RUNTIME_CONFIG(RUNTIME_CONFIG)) core (
         .clk(clk), .rst(rst), .clear(clear), .cfg(cfg),
         .ev_valid(s_axis_event_tvalid), .ev_ready(s_axis_event_tready), .ev_data(s_axis_event_tdata[EV_W-1:0]),
-        .rec_valid(m_axis_record_tvalid), .rec_ready(m_axis_record_tready), .rec_data(record),
+        .rec_valid(core_rec_valid), .rec_ready(core_rec_ready), .rec_data(core_record),
         .trace_valid(trace_valid), .trace_data(trace_data),
-        .filter_active(unused_filter_active), .idle(idle), .count_inc(count_inc)
+        .step_valid(step_valid), .step_ready(step_ready), .step_t(step_t),
+        .filter_active(unused_filter_active), .idle(core_idle), .count_inc(count_inc)
     );
+    generate
+        if (OBJECTS != 0) begin : object_unit
+            evclust_objects #(.N(N), .EV_W(EV_W), .REC_W(REC_W), .TRACE_W(TRACE_W), .OBJ_W(OBJ_W), .CFG_W(CFG_W), .COUNT_W(COUNT_W),
+                              .RUNTIME_CONFIG(RUNTIME_CONFIG)) objects (
+                .clk(clk), .rst(rst), .clear(clear), .cfg(cfg),
+                .rec_valid(core_rec_valid), .rec_ready(core_rec_ready), .rec_data(core_record),
+                .out_rec_valid(m_axis_record_tvalid), .out_rec_ready(m_axis_record_tready), .out_rec_data(record),
+                .step_valid(step_valid), .step_ready(step_ready), .step_t(step_t),
+                .obj_valid(m_axis_object_tvalid), .obj_ready(m_axis_object_tready), .obj_data(object), .idle(objects_idle)
+            );
+        end else begin : no_object_unit
+            assign m_axis_record_tvalid = core_rec_valid;
+            assign core_rec_ready = m_axis_record_tready;
+            assign record = core_record;
+            assign step_ready = 1'b1;
+            assign m_axis_object_tvalid = 1'b0;
+            assign object = {OBJ_W{1'b0}};
+            assign objects_idle = 1'b1;
+            wire unused_step = &{1'b0, step_valid, step_t, m_axis_object_tready};
+        end
+    endgenerate
     assign m_axis_record_tdata = {{(8 * REC_BYTES - REC_W){1'b0}}, record};
+    assign m_axis_object_tdata = {{(8 * OBJ_BYTES - OBJ_W){1'b0}}, object};
 
     wire [8*EV_BYTES-1:0] unused_event_padding = s_axis_event_tdata;  // the bits above EV_W are padding
 endmodule

@@ -2,8 +2,10 @@
 // (model/evclust/fixed/fixed_model.py; docs/RTL.md walks through the datapath).
 //
 // Streams: events in (valid/ready, the word of vectors/*/events.hex), track records out
-// (valid/ready, the word of expected.hex) and a trace of each event's action (a monitor port
-// without back-pressure, the word of trace.hex). Reset is synchronous and active high.
+// (valid/ready, the word of expected.hex), the end of each filter step (valid/ready with the
+// step's time, after its last record has been taken: what the object unit, evclust_objects,
+// waits for) and a trace of each event's action (a monitor port without back-pressure, the word
+// of trace.hex). Reset is synchronous and active high.
 //
 // Schedule: one event per clock in steady state. Stage A holds an accepted event while all N
 // slots are searched in parallel; stage B (EXEC) applies it, while stage A searches for the
@@ -41,6 +43,9 @@ module evclust_core #(
     output reg  [REC_W-1:0]   rec_data,
     output reg                trace_valid,
     output reg  [TRACE_W-1:0] trace_data,
+    output wire               step_valid,     // a filter step has ended (all its records taken); tie step_ready high if unused
+    input  wire               step_ready,
+    output reg  [31:0]        step_t,         // its time: the low 32 bits of the event that triggered it
     output wire               filter_active,  // a filter step: its phase cycle(s), sweep, merges and tail
     output wire               idle,           // no event in flight, no filter step, no record waiting
     output reg  [COUNT_W-1:0] count_inc       // what the last cycle adds to each status counter (COUNT_*)
@@ -823,6 +828,12 @@ module evclust_core #(
     wire signed [63:0]    m_evc_full = u64({{(63 - EVENTS_IN_INTERVAL_W){1'b0}}, ev_count[k]}) + u64({{(63 - EVENTS_IN_INTERVAL_W){1'b0}}, ev_count[m_j]});
     wire signed [63:0]    m_evc = saturate(m_evc_full, 0, MAX_EVCOUNT);
 
+    // The end of a filter step, held until the object unit takes it; the next step waits in
+    // PHASE until then, so a step's records never follow the next step's mark.
+    reg  step_pending;
+    assign step_valid = step_pending && !rec_valid;
+    wire phase_hold = step_pending;
+
     // tau boundaries since the last filter step, from the phase counter (33 bits: a 32-bit time
     // difference plus the phase); T_frame/(n tau), nothing once n reaches 2^FRAME_PER_TAU_W.
     wire [32:0] phase = {{(33 - TAU_PHASE_W){1'b0}}, tau_phase} + {1'b0, e_t - t_filter};
@@ -831,7 +842,7 @@ module evclust_core #(
     reg  [32:0] phase_q;     // the phase at the filter step's event
     reg  [1:0]  phase_step;  // PHASE: deciding, dividing the phase, dividing the frame period
     localparam [1:0] PHASE_DECIDE = 2'd0, PHASE_BY_TAU = 2'd1, PHASE_FRAME = 2'd2;
-    wire        phase_start = state == ST_PHASE && phase_step == PHASE_DECIDE && phase_q >= TAU[31:0] * 33'd2;
+    wire        phase_start = state == ST_PHASE && phase_step == PHASE_DECIDE && !phase_hold && phase_q >= TAU[31:0] * 33'd2;
     wire        by_tau_done, frame_done;
     wire [32:0] by_tau_q;
     wire [TAU_PHASE_W:0] by_tau_left;
@@ -960,7 +971,7 @@ module evclust_core #(
             ST_SWEEP: if (sweep_merge) state_next = ST_MERGE;
                       else if (sweep_advance && index == LAST_SWEEP) state_next = ST_IDLE;
             ST_PHASE: case (phase_step)
-                PHASE_DECIDE: if (no_boundary || !phase_start) state_next = ST_SWEEP;
+                PHASE_DECIDE: if (!phase_hold && (no_boundary || !phase_start)) state_next = ST_SWEEP;
                 PHASE_BY_TAU: if (by_tau_done && many_boundaries) state_next = ST_SWEEP;
                 default: if (frame_done) state_next = ST_SWEEP;
             endcase
@@ -1015,7 +1026,7 @@ module evclust_core #(
         inc[COUNT_SAT_V_INT * COUNTER_INC_W +: 2] = stage0 && boundaries != 33'd0 ? outside(f_mx_full, MIN_VI, MAX_VI) + outside(f_my_full, MIN_VI, MAX_VI) : 2'd0;
         inc[COUNT_SAT_V_MCM * COUNTER_INC_W +: 2] = tail_out && t_correct ? {1'b0, t_over_x} + {1'b0, t_over_y} : 2'd0;
     end
-    assign idle = state == ST_IDLE && !a_valid && !rec_valid;
+    assign idle = state == ST_IDLE && !a_valid && !rec_valid && !step_pending;
 
     integer i;
     always @(posedge clk) begin
@@ -1023,7 +1034,11 @@ module evclust_core #(
         trace_valid <= 1'b0;
         if (rec_valid && rec_ready)
             rec_valid <= 1'b0;
+        if (step_valid && step_ready)
+            step_pending <= 1'b0;
         if (dp_rst) begin
+            step_pending <= 1'b0;
+            step_t <= 32'd0;
             index <= {SWEEP_W{1'b0}};
             rec_valid <= 1'b0;
             rec_data <= {REC_W{1'b0}};
@@ -1082,10 +1097,14 @@ module evclust_core #(
                     if (index == LAST_SWEEP) begin
                         step <= step + 32'd1;
                         t_filter <= e_t;
+                        step_pending <= 1'b1;
+                        step_t <= e_t[31:0];
                     end
                 end
                 ST_PHASE: case (phase_step)  // tau boundaries since the last step and T_frame / (n tau)
-                    PHASE_DECIDE: if (no_boundary) begin
+                    PHASE_DECIDE: if (phase_hold) begin
+                        // the last step's end not taken yet
+                    end else if (no_boundary) begin
                         boundaries <= 33'd0;
                         tau_phase <= phase_q[TAU_PHASE_W-1:0];
                         per_frame <= K_FRAME_PER_TAU;  // T_frame / tau: n counts as 1

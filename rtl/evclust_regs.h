@@ -99,77 +99,103 @@
 #define EVCLUST_CFG_NOISE_GATE_WIDTH 1u
 #define EVCLUST_CFG_SUPPORT_WINDOW 0x184u  /* 32 bits, 1 word(s); reset 2200 */
 #define EVCLUST_CFG_SUPPORT_WINDOW_WIDTH 32u
-#define EVCLUST_CFG_FILTER_EVERY 0x188u  /* 7 bits, 1 word(s); reset 64 */
+#define EVCLUST_CFG_INV_T_FRAME 0x188u  /* 32 bits, 1 word(s); reset 85899 */
+#define EVCLUST_CFG_INV_T_FRAME_WIDTH 32u
+#define EVCLUST_CFG_OBJECT_GATE 0x18cu  /* 26 bits, 1 word(s); reset 524288 */
+#define EVCLUST_CFG_OBJECT_GATE_WIDTH 26u
+#define EVCLUST_CFG_OBJECT_LINK_ALONG 0x190u  /* 9 bits, 1 word(s); reset 192 */
+#define EVCLUST_CFG_OBJECT_LINK_ALONG_WIDTH 9u
+#define EVCLUST_CFG_OBJECT_V_TOL 0x194u  /* 24 bits, 1 word(s); reset 19661 */
+#define EVCLUST_CFG_OBJECT_V_TOL_WIDTH 24u
+#define EVCLUST_CFG_OBJECT_V_REL 0x198u  /* 7 bits, 1 word(s); reset 13 */
+#define EVCLUST_CFG_OBJECT_V_REL_WIDTH 7u
+#define EVCLUST_CFG_OBJECT_INV_TRACK 0x19cu  /* 24 bits, 1 word(s); reset 1048576 */
+#define EVCLUST_CFG_OBJECT_INV_TRACK_WIDTH 24u
+#define EVCLUST_CFG_OBJECT_INV_RATE 0x1a0u  /* 24 bits, 1 word(s); reset 131072 */
+#define EVCLUST_CFG_OBJECT_INV_RATE_WIDTH 24u
+#define EVCLUST_CFG_OBJECT_INV_VELOCITY 0x1a4u  /* 24 bits, 1 word(s); reset 524288 */
+#define EVCLUST_CFG_OBJECT_INV_VELOCITY_WIDTH 24u
+#define EVCLUST_CFG_OBJECT_INV_SIZE 0x1a8u  /* 24 bits, 1 word(s); reset 1048576 */
+#define EVCLUST_CFG_OBJECT_INV_SIZE_WIDTH 24u
+#define EVCLUST_CFG_OBJECT_INV_COLOUR 0x1acu  /* 24 bits, 1 word(s); reset 524288 */
+#define EVCLUST_CFG_OBJECT_INV_COLOUR_WIDTH 24u
+#define EVCLUST_CFG_OBJECT_BIRTH_US 0x1b0u  /* 24 bits, 1 word(s); reset 25000 */
+#define EVCLUST_CFG_OBJECT_BIRTH_US_WIDTH 24u
+#define EVCLUST_CFG_OBJECT_COAST_US 0x1b4u  /* 24 bits, 1 word(s); reset 150000 */
+#define EVCLUST_CFG_OBJECT_COAST_US_WIDTH 24u
+#define EVCLUST_CFG_OBJECT_KEEP_US 0x1b8u  /* 24 bits, 1 word(s); reset 1500000 */
+#define EVCLUST_CFG_OBJECT_KEEP_US_WIDTH 24u
+#define EVCLUST_CFG_FILTER_EVERY 0x1bcu  /* 7 bits, 1 word(s); reset 64 */
 #define EVCLUST_CFG_FILTER_EVERY_WIDTH 7u
-#define EVCLUST_CFG_TAU_US 0x18cu  /* 18 bits, 1 word(s); reset 217288 */
+#define EVCLUST_CFG_TAU_US 0x1c0u  /* 18 bits, 1 word(s); reset 217288 */
 #define EVCLUST_CFG_TAU_US_WIDTH 18u
-#define EVCLUST_CFG_GAMMA_MODE 0x190u  /* 2 bits, 1 word(s); reset 1 */
+#define EVCLUST_CFG_GAMMA_MODE 0x1c4u  /* 2 bits, 1 word(s); reset 1 */
 #define EVCLUST_CFG_GAMMA_MODE_WIDTH 2u
-#define EVCLUST_CFG_WARM_START 0x194u  /* 1 bits, 1 word(s); reset 1 */
+#define EVCLUST_CFG_WARM_START 0x1c8u  /* 1 bits, 1 word(s); reset 1 */
 #define EVCLUST_CFG_WARM_START_WIDTH 1u
-#define EVCLUST_CFG_MCM_CORRECT 0x198u  /* 1 bits, 1 word(s); reset 1 */
+#define EVCLUST_CFG_MCM_CORRECT 0x1ccu  /* 1 bits, 1 word(s); reset 1 */
 #define EVCLUST_CFG_MCM_CORRECT_WIDTH 1u
-#define EVCLUST_CFG_VOTE_CONTRAST 0x19cu  /* 1 bits, 1 word(s); reset 1 */
+#define EVCLUST_CFG_VOTE_CONTRAST 0x1d0u  /* 1 bits, 1 word(s); reset 1 */
 #define EVCLUST_CFG_VOTE_CONTRAST_WIDTH 1u
-#define EVCLUST_CFG_MIXING 0x1a0u  /* 1 bits, 1 word(s); reset 1 */
+#define EVCLUST_CFG_MIXING 0x1d4u  /* 1 bits, 1 word(s); reset 1 */
 #define EVCLUST_CFG_MIXING_WIDTH 1u
-#define EVCLUST_CFG_BG_FIXED 0x1a4u  /* 1 bits, 1 word(s); reset 1 */
+#define EVCLUST_CFG_BG_FIXED 0x1d8u  /* 1 bits, 1 word(s); reset 1 */
 #define EVCLUST_CFG_BG_FIXED_WIDTH 1u
-#define EVCLUST_CFG_BACKGROUND_MASK 0x1a8u  /* 8 bits, 1 word(s); reset 192 */
+#define EVCLUST_CFG_BACKGROUND_MASK 0x1dcu  /* 8 bits, 1 word(s); reset 192 */
 #define EVCLUST_CFG_BACKGROUND_MASK_WIDTH 8u
-#define EVCLUST_CFG_BG_INIT_Y 0x1acu  /* 24 bits, 1 word(s); reset 6321603 */
+#define EVCLUST_CFG_BG_INIT_Y 0x1e0u  /* 24 bits, 1 word(s); reset 6321603 */
 #define EVCLUST_CFG_BG_INIT_Y_WIDTH 24u
-#define EVCLUST_CFG_BG_INIT_CB 0x1b0u  /* 24 bits, 1 word(s); reset 8519680 */
+#define EVCLUST_CFG_BG_INIT_CB 0x1e4u  /* 24 bits, 1 word(s); reset 8519680 */
 #define EVCLUST_CFG_BG_INIT_CB_WIDTH 24u
-#define EVCLUST_CFG_BG_INIT_CR 0x1b4u  /* 24 bits, 1 word(s); reset 8366981 */
+#define EVCLUST_CFG_BG_INIT_CR 0x1e8u  /* 24 bits, 1 word(s); reset 8366981 */
 #define EVCLUST_CFG_BG_INIT_CR_WIDTH 24u
-#define EVCLUST_CFG_PALETTE_0_Y 0x1b8u  /* 8 bits, 1 word(s); reset 59 */
+#define EVCLUST_CFG_PALETTE_0_Y 0x1ecu  /* 8 bits, 1 word(s); reset 59 */
 #define EVCLUST_CFG_PALETTE_0_Y_WIDTH 8u
-#define EVCLUST_CFG_PALETTE_0_CB 0x1bcu  /* 8 bits, 1 word(s); reset 109 */
+#define EVCLUST_CFG_PALETTE_0_CB 0x1f0u  /* 8 bits, 1 word(s); reset 109 */
 #define EVCLUST_CFG_PALETTE_0_CB_WIDTH 8u
-#define EVCLUST_CFG_PALETTE_0_CR 0x1c0u  /* 8 bits, 1 word(s); reset 193 */
+#define EVCLUST_CFG_PALETTE_0_CR 0x1f4u  /* 8 bits, 1 word(s); reset 193 */
 #define EVCLUST_CFG_PALETTE_0_CR_WIDTH 8u
-#define EVCLUST_CFG_PALETTE_1_Y 0x1c4u  /* 8 bits, 1 word(s); reset 64 */
+#define EVCLUST_CFG_PALETTE_1_Y 0x1f8u  /* 8 bits, 1 word(s); reset 64 */
 #define EVCLUST_CFG_PALETTE_1_Y_WIDTH 8u
-#define EVCLUST_CFG_PALETTE_1_CB 0x1c8u  /* 8 bits, 1 word(s); reset 188 */
+#define EVCLUST_CFG_PALETTE_1_CB 0x1fcu  /* 8 bits, 1 word(s); reset 188 */
 #define EVCLUST_CFG_PALETTE_1_CB_WIDTH 8u
-#define EVCLUST_CFG_PALETTE_1_CR 0x1ccu  /* 8 bits, 1 word(s); reset 104 */
+#define EVCLUST_CFG_PALETTE_1_CR 0x200u  /* 8 bits, 1 word(s); reset 104 */
 #define EVCLUST_CFG_PALETTE_1_CR_WIDTH 8u
-#define EVCLUST_CFG_PALETTE_2_Y 0x1d0u  /* 8 bits, 1 word(s); reset 191 */
+#define EVCLUST_CFG_PALETTE_2_Y 0x204u  /* 8 bits, 1 word(s); reset 191 */
 #define EVCLUST_CFG_PALETTE_2_Y_WIDTH 8u
-#define EVCLUST_CFG_PALETTE_2_CB 0x1d4u  /* 8 bits, 1 word(s); reset 43 */
+#define EVCLUST_CFG_PALETTE_2_CB 0x208u  /* 8 bits, 1 word(s); reset 43 */
 #define EVCLUST_CFG_PALETTE_2_CB_WIDTH 8u
-#define EVCLUST_CFG_PALETTE_2_CR 0x1d8u  /* 8 bits, 1 word(s); reset 156 */
+#define EVCLUST_CFG_PALETTE_2_CR 0x20cu  /* 8 bits, 1 word(s); reset 156 */
 #define EVCLUST_CFG_PALETTE_2_CR_WIDTH 8u
-#define EVCLUST_CFG_PALETTE_3_Y 0x1dcu  /* 8 bits, 1 word(s); reset 233 */
+#define EVCLUST_CFG_PALETTE_3_Y 0x210u  /* 8 bits, 1 word(s); reset 233 */
 #define EVCLUST_CFG_PALETTE_3_Y_WIDTH 8u
-#define EVCLUST_CFG_PALETTE_3_CB 0x1e0u  /* 8 bits, 1 word(s); reset 128 */
+#define EVCLUST_CFG_PALETTE_3_CB 0x214u  /* 8 bits, 1 word(s); reset 128 */
 #define EVCLUST_CFG_PALETTE_3_CB_WIDTH 8u
-#define EVCLUST_CFG_PALETTE_3_CR 0x1e4u  /* 8 bits, 1 word(s); reset 128 */
+#define EVCLUST_CFG_PALETTE_3_CR 0x218u  /* 8 bits, 1 word(s); reset 128 */
 #define EVCLUST_CFG_PALETTE_3_CR_WIDTH 8u
-#define EVCLUST_CFG_PALETTE_4_Y 0x1e8u  /* 8 bits, 1 word(s); reset 144 */
+#define EVCLUST_CFG_PALETTE_4_Y 0x21cu  /* 8 bits, 1 word(s); reset 144 */
 #define EVCLUST_CFG_PALETTE_4_Y_WIDTH 8u
-#define EVCLUST_CFG_PALETTE_4_CB 0x1ecu  /* 8 bits, 1 word(s); reset 130 */
+#define EVCLUST_CFG_PALETTE_4_CB 0x220u  /* 8 bits, 1 word(s); reset 130 */
 #define EVCLUST_CFG_PALETTE_4_CB_WIDTH 8u
-#define EVCLUST_CFG_PALETTE_4_CR 0x1f0u  /* 8 bits, 1 word(s); reset 127 */
+#define EVCLUST_CFG_PALETTE_4_CR 0x224u  /* 8 bits, 1 word(s); reset 127 */
 #define EVCLUST_CFG_PALETTE_4_CR_WIDTH 8u
-#define EVCLUST_CFG_PALETTE_5_Y 0x1f4u  /* 8 bits, 1 word(s); reset 32 */
+#define EVCLUST_CFG_PALETTE_5_Y 0x228u  /* 8 bits, 1 word(s); reset 32 */
 #define EVCLUST_CFG_PALETTE_5_Y_WIDTH 8u
-#define EVCLUST_CFG_PALETTE_5_CB 0x1f8u  /* 8 bits, 1 word(s); reset 130 */
+#define EVCLUST_CFG_PALETTE_5_CB 0x22cu  /* 8 bits, 1 word(s); reset 130 */
 #define EVCLUST_CFG_PALETTE_5_CB_WIDTH 8u
-#define EVCLUST_CFG_PALETTE_5_CR 0x1fcu  /* 8 bits, 1 word(s); reset 128 */
+#define EVCLUST_CFG_PALETTE_5_CR 0x230u  /* 8 bits, 1 word(s); reset 128 */
 #define EVCLUST_CFG_PALETTE_5_CR_WIDTH 8u
-#define EVCLUST_CFG_PALETTE_6_Y 0x200u  /* 8 bits, 1 word(s); reset 96 */
+#define EVCLUST_CFG_PALETTE_6_Y 0x234u  /* 8 bits, 1 word(s); reset 96 */
 #define EVCLUST_CFG_PALETTE_6_Y_WIDTH 8u
-#define EVCLUST_CFG_PALETTE_6_CB 0x204u  /* 8 bits, 1 word(s); reset 130 */
+#define EVCLUST_CFG_PALETTE_6_CB 0x238u  /* 8 bits, 1 word(s); reset 130 */
 #define EVCLUST_CFG_PALETTE_6_CB_WIDTH 8u
-#define EVCLUST_CFG_PALETTE_6_CR 0x208u  /* 8 bits, 1 word(s); reset 128 */
+#define EVCLUST_CFG_PALETTE_6_CR 0x23cu  /* 8 bits, 1 word(s); reset 128 */
 #define EVCLUST_CFG_PALETTE_6_CR_WIDTH 8u
-#define EVCLUST_CFG_PALETTE_7_Y 0x20cu  /* 8 bits, 1 word(s); reset 62 */
+#define EVCLUST_CFG_PALETTE_7_Y 0x240u  /* 8 bits, 1 word(s); reset 62 */
 #define EVCLUST_CFG_PALETTE_7_Y_WIDTH 8u
-#define EVCLUST_CFG_PALETTE_7_CB 0x210u  /* 8 bits, 1 word(s); reset 135 */
+#define EVCLUST_CFG_PALETTE_7_CB 0x244u  /* 8 bits, 1 word(s); reset 135 */
 #define EVCLUST_CFG_PALETTE_7_CB_WIDTH 8u
-#define EVCLUST_CFG_PALETTE_7_CR 0x214u  /* 8 bits, 1 word(s); reset 124 */
+#define EVCLUST_CFG_PALETTE_7_CR 0x248u  /* 8 bits, 1 word(s); reset 124 */
 #define EVCLUST_CFG_PALETTE_7_CR_WIDTH 8u
 
 #endif /* EVCLUST_REGS_H */

@@ -8,7 +8,10 @@
 //  - every accepted event gives exactly one trace pulse: the events accepted and not yet
 //    traced are exactly those in stage A, in stage B and on the trace port, so none is lost or
 //    traced twice (a reset or clear discards those in flight, as documented);
-//  - a filter step ends within F_FILTER_BOUND cycles in which no record waits for its consumer
+//  - the end of a filter step (step_valid, step_t) holds until it is taken, and never comes
+//    while a record waits (the object unit sees every record of a step before its end);
+//  - a filter step ends within F_FILTER_BOUND cycles in which neither a record nor the last
+//    step's end waits for its consumer
 //    (80 in the reference build, which has no merges; with MERGE = 1, up to N - 1 merges of
 //    MERGE_MOMENT_W + 3 cycles more: 227 in the merge job's build), and the core, IDLE again,
 //    takes the next event;
@@ -42,6 +45,10 @@
     end
     always @(posedge clk) if (f_past_valid && !$past(dp_rst) && $past(rec_valid && !rec_ready))
         assert (rec_valid && rec_data == $past(rec_data));
+    // A filter step's end holds, time and all, until it is taken, and never comes while a record waits.
+    always @(posedge clk) if (f_past_valid && !$past(dp_rst) && $past(step_valid && !step_ready))
+        assert (step_valid && step_t == $past(step_t));
+    always @* assert (!(step_valid && rec_valid));
 
     // ---------------------------------------------------------------- the filter step ends
     // Bounded liveness: a filter step (PHASE, SWEEP, MERGE) ends within F_FILTER_BOUND cycles
@@ -63,7 +70,7 @@
     always @(posedge clk)
         if (dp_rst || !f_filter)
             f_filter_cycles <= {F_CYCLES_W{1'b0}};
-        else if (!(rec_valid && !rec_ready))
+        else if (!(rec_valid && !rec_ready) && !phase_hold)  // neither a record nor the last step's end waits
             f_filter_cycles <= f_filter_cycles + 1'b1;
 
     // The slots this sweep's merges have absorbed, and how many.

@@ -1,14 +1,16 @@
 // Harness for the cocotb testbench (test_evclust_core.py): cocotb loads a batch of events into
 // ev_mem and pulses start; the harness streams them into evclust_core at full speed, with random
 // input gaps and random output back-pressure from a xorshift generator, and captures every
-// record (tagged with the number of events traced before it) and every trace word. Python thus
+// record (tagged with the number of events traced before it), every object record of the
+// object unit behind the core (evclust_objects, when the header has OBJECTS = 1; same tags) and
+// every trace word. Python thus
 // touches each event twice, not each clock cycle, which keeps co-simulation fast. The register
 // file's AXI4-Lite port is the harness's own (cocotbext-axi drives it); it holds the build's
 // parameter set from reset.
 `default_nettype none
 module evclust_tb #(
     parameter integer DEPTH = 4096,      // events per batch
-    parameter integer REC_DEPTH = 16384, // records per batch
+    parameter integer REC_DEPTH = 16384, // records per batch (and object records)
     parameter integer RUNTIME_CONFIG = 1 // the core's: 0 folds the build's constants in
 ) (
     input  wire        clk,
@@ -22,6 +24,7 @@ module evclust_tb #(
     output reg  [31:0] accepted,
     output reg  [31:0] traced,
     output reg  [31:0] captured,
+    output reg  [31:0] objects_captured,
     output reg         overflow,
     output reg  [31:0] cycles,
     output reg  [31:0] filter_cycles,
@@ -51,11 +54,13 @@ module evclust_tb #(
 );
 `include "evclust_params.vh"
 
-    localparam integer EV_W = IN_WORD_W, REC_W = REC_WORD_W;  // the layouts of vectors/pack.py
+    localparam integer EV_W = IN_WORD_W, REC_W = REC_WORD_W, OBJ_W = OBJ_WORD_W;  // the layouts of vectors/pack.py
 
     reg [EV_W-1:0]  ev_mem    [0:DEPTH-1];
     reg [REC_W-1:0] rec_mem   [0:REC_DEPTH-1];
     reg [31:0]      rec_tag   [0:REC_DEPTH-1];  // events traced when the record left
+    reg [OBJ_W-1:0] obj_mem   [0:REC_DEPTH-1];
+    reg [31:0]      obj_tag   [0:REC_DEPTH-1];
     reg [TRACE_WORD_W-1:0] trace_mem [0:DEPTH-1];
 
     reg              running;
@@ -65,6 +70,14 @@ module evclust_tb #(
     wire             ev_ready;
     wire             rec_valid;
     wire [REC_W-1:0] rec_data;
+    wire             core_rec_valid, core_rec_ready;
+    wire [REC_W-1:0] core_rec_data;
+    wire             step_valid, step_ready;
+    wire [31:0]      step_t;
+    wire             obj_valid;
+    wire [OBJ_W-1:0] obj_data;
+    wire             core_idle, objects_idle;
+    wire             obj_ready = running && random[23:16] >= stall_threshold;
     wire             trace_valid;
     wire [TRACE_WORD_W-1:0] trace_data;
     wire [32*CFG_WORDS-1:0] cfg;
@@ -87,6 +100,7 @@ module evclust_tb #(
         .s_axil_rdata(s_axil_rdata), .s_axil_rresp(s_axil_rresp), .s_axil_rvalid(s_axil_rvalid), .s_axil_rready(s_axil_rready),
         .cfg(cfg), .clear(clear), .idle(idle), .count_inc(count_inc), .irq(irq)
     );
+    assign idle = core_idle && objects_idle;
 
     evclust_core #(.RUNTIME_CONFIG(RUNTIME_CONFIG)) core (
         .clk(clk),
@@ -96,15 +110,39 @@ module evclust_tb #(
         .ev_valid(ev_valid),
         .ev_ready(ev_ready),
         .ev_data(ev_data),
-        .rec_valid(rec_valid),
-        .rec_ready(rec_ready),
-        .rec_data(rec_data),
+        .rec_valid(core_rec_valid),
+        .rec_ready(core_rec_ready),
+        .rec_data(core_rec_data),
         .trace_valid(trace_valid),
         .trace_data(trace_data),
+        .step_valid(step_valid),
+        .step_ready(step_ready),
+        .step_t(step_t),
         .filter_active(filter_active),
-        .idle(idle),
+        .idle(core_idle),
         .count_inc(count_inc)
     );
+
+    // The object unit behind the core's record port, passing the records on to the harness.
+    generate
+        if (OBJECTS != 0) begin : object_unit
+            evclust_objects #(.RUNTIME_CONFIG(RUNTIME_CONFIG)) objects (
+                .clk(clk), .rst(rst), .clear(clear), .cfg(cfg),
+                .rec_valid(core_rec_valid), .rec_ready(core_rec_ready), .rec_data(core_rec_data),
+                .out_rec_valid(rec_valid), .out_rec_ready(rec_ready), .out_rec_data(rec_data),
+                .step_valid(step_valid), .step_ready(step_ready), .step_t(step_t),
+                .obj_valid(obj_valid), .obj_ready(obj_ready), .obj_data(obj_data), .idle(objects_idle)
+            );
+        end else begin : no_object_unit
+            assign rec_valid = core_rec_valid;
+            assign core_rec_ready = rec_ready;
+            assign rec_data = core_rec_data;
+            assign step_ready = 1'b1;
+            assign obj_valid = 1'b0;
+            assign obj_data = {OBJ_W{1'b0}};
+            assign objects_idle = 1'b1;
+        end
+    endgenerate
 
     // Functional coverage (evclust.rtl.coverage reads it at the end of a run): cycles in each FSM
     // state, each state change, the filter step's division paths, and the stream conditions
@@ -161,6 +199,7 @@ module evclust_tb #(
             accepted <= 32'd0;
             traced <= 32'd0;
             captured <= 32'd0;
+            objects_captured <= 32'd0;
             overflow <= 1'b0;
             cycles <= 32'd0;
             filter_cycles <= 32'd0;
@@ -195,8 +234,17 @@ module evclust_tb #(
                 end
                 captured <= captured + 32'd1;
             end
-            // Done: every event taken and traced, the core idle again, no record waiting.
-            if (accepted == count && traced == count && ev_ready && !ev_valid && !rec_valid && !filter_active) begin
+            if (obj_valid && obj_ready) begin
+                if (objects_captured < REC_DEPTH) begin
+                    obj_mem[objects_captured[$clog2(REC_DEPTH)-1:0]] <= obj_data;
+                    obj_tag[objects_captured[$clog2(REC_DEPTH)-1:0]] <= traced;
+                end else begin
+                    overflow <= 1'b1;
+                end
+                objects_captured <= objects_captured + 32'd1;
+            end
+            // Done: every event taken and traced, the core and the object unit idle again, no record waiting.
+            if (accepted == count && traced == count && ev_ready && !ev_valid && !rec_valid && !filter_active && core_idle && objects_idle) begin
                 running <= 1'b0;
                 done <= 1'b1;
             end

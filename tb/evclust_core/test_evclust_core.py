@@ -63,8 +63,10 @@ class Harness:
         await ClockCycles(self.dut.clk, 2)  # the harness holds events until the core is ready
 
     async def stream(self, words: list[int], seed: int, gap: int, stall: int, n_clusters: int):
-        """All words through the core in batches: (trace words, record words, record tags)."""
+        """All words through the core in batches: (trace words, record words, record tags); the
+        object unit's record words and their tags in `self.objects`, `self.object_tags`."""
         trace, records, tags = [], [], []
+        self.objects, self.object_tags = [], []
         dut = self.dut
         start = time.perf_counter()
         for lo in range(0, len(words), self.batch):
@@ -79,9 +81,11 @@ class Harness:
             await RisingEdge(dut.clk)
             dut.start.value = 0
             # Bound: every event, eviction scan and filter step at its worst (with every slot merging,
-            # each merge a division of up to 128 cycles), slowed by the gaps and stalls.
+            # each merge a division of up to 128 cycles, and the object unit's step: its scans of
+            # K slots per group and per merge), slowed by the gaps and stalls.
             merges = n_clusters * 130 // self.filter_every + 1
-            bound = 1000 + len(batch) * (8 + 2 * n_clusters + merges) * 256 // max(1, 256 - max(gap, stall))
+            objects = (n_clusters * n_clusters * 8 + 64 * n_clusters + 200) // self.filter_every + 1
+            bound = 1000 + len(batch) * (8 + 2 * n_clusters + merges + objects) * 256 // max(1, 256 - max(gap, stall))
             try:
                 await with_timeout(RisingEdge(dut.done), bound * CLOCK_NS, "ns")
             except SimTimeoutError:
@@ -96,6 +100,9 @@ class Harness:
             trace += [int(dut.trace_mem[i].value) for i in range(traced)]
             records += [int(dut.rec_mem[i].value) for i in range(captured)]
             tags += [lo + int(dut.rec_tag[i].value) for i in range(captured)]
+            objects = int(dut.objects_captured.value)
+            self.objects += [int(dut.obj_mem[i].value) for i in range(objects)]
+            self.object_tags += [lo + int(dut.obj_tag[i].value) for i in range(objects)]
             for name in ("cycles", "filter_cycles", "filter_steps"):
                 self.stats[name] += int(getattr(dut, name).value)
             self.stats["events"] += len(batch)
@@ -166,11 +173,15 @@ def _seed(*parts) -> int:
     return int.from_bytes(hashlib.sha256(repr(parts).encode()).digest()[:4], "little") or 1
 
 
-def _compare(name, events, expected_trace, trace, expected, records, tags, table):
-    from evclust.vectors.pack import event_fields, record_fields
-    from evclust.vectors.scoreboard import first_mismatch
+def _compare(name, events, expected_trace, trace, expected, records, tags, table, expected_objects=(), harness=None):
+    """The first mismatch of the trace and the cluster records, else of the object records."""
+    from evclust.vectors.pack import event_fields, object_fields, record_fields
+    from evclust.vectors.scoreboard import first_mismatch, first_object_mismatch
 
-    return first_mismatch(name, events, event_fields(table), expected_trace, trace, record_fields(table), expected, records, tags)
+    error = first_mismatch(name, events, event_fields(table), expected_trace, trace, record_fields(table), expected, records, tags)
+    if error or harness is None:
+        return error
+    return first_object_mismatch(name, object_fields(table), list(expected_objects), harness.objects, harness.object_tags)
 
 
 if cocotb is not None:
@@ -197,11 +208,11 @@ if cocotb is not None:
             harness = Harness(dut, case.table.n_clusters, case.params.filter_every)
             await harness.reset()
             trace, records, tags = await harness.stream(case.events, _seed(case.name, config["seed"]), config["gap"], config["stall"], case.table.n_clusters)
-            error = _compare(case.name, case.events, case.trace, trace, case.expected, records, tags, case.table)
+            error = _compare(case.name, case.events, case.trace, trace, case.expected, records, tags, case.table, case.objects, harness)
             counters = await registers.counters()
             # The manifest's counts, saturations of every signal included, against the RTL's status counters.
             error = error or _counter_mismatch(model_counters(case.manifest["counts"], len(case.expected)), counters)
-            result["cases"][case.name] = harness.stats | {"records": len(records), "counters": counters}
+            result["cases"][case.name] = harness.stats | {"records": len(records), "objects": len(harness.objects), "counters": counters}
             summed, seen = _add(summed, counters), seen + _records_seen(records, case.table)
             if error:
                 result["error"] = error
@@ -246,7 +257,7 @@ if cocotb is not None:
         if config.get("reset_at"):
             # Part of the stream, with the same gaps and stalls, cut off by a reset while it flows.
             part = events[: config["reset_at"]]
-            words, _, _ = model_words(FixedClusterer(params, width, height, t_frame, **formats), part)
+            words = model_words(FixedClusterer(params, width, height, t_frame, **formats), part).events
             for handle, word in zip(harness.ev_mem, words):
                 handle.value = word
             dut.count.value, dut.seed.value = len(words), 7
@@ -258,15 +269,15 @@ if cocotb is not None:
             if int(dut.done.value):
                 return "the stream ended before the reset: choose an earlier reset_cycle", {}
             await harness.reset(cycles=1)
-        event_list, expected, expected_trace = model_words(model, events)
+        event_list, expected, expected_trace, expected_objects = model_words(model, events)
         trace, records, tags = await harness.stream(event_list, config["seed"], config["gap"], config["stall"], params.n_clusters)
         name = Path(config["events"]).stem if config.get("events") else f"random stream {config['seed']}"
-        error = _compare(name, event_list, expected_trace, trace, expected, records, tags, model.table)
+        error = _compare(name, event_list, expected_trace, trace, expected, records, tags, model.table, expected_objects, harness)
         counters = await registers.counters()
         if not error:
             error = _counter_mismatch(model_counters(model.stats(), len(expected)), counters)
         coverage = await _coverage(dut, counters, _records_seen(records, model.table))
-        return error, harness.stats | {"records": len(records), "counters": counters, "coverage": coverage}
+        return error, harness.stats | {"records": len(records), "objects": len(harness.objects), "counters": counters, "coverage": coverage}
 
     @cocotb.test()
     async def serve(dut):
@@ -333,14 +344,15 @@ if cocotb is not None:
                 model = FixedClusterer(params, width, height, t_frame)
             harness = Harness(dut, params.n_clusters, params.filter_every)  # its batch follows the filter period
             events = random_stream(seed, config["count"], width, height, t_frame)
-            event_list, expected, expected_trace = model_words(model, events)
+            event_list, expected, expected_trace, expected_objects = model_words(model, events)
             trace, records, tags = await harness.stream(event_list, seed, config["gap"], config["stall"], params.n_clusters)
-            error = _compare(f"stream {step + 1}", event_list, expected_trace, trace, expected, records, tags, model.table)
+            error = _compare(f"stream {step + 1}", event_list, expected_trace, trace, expected, records, tags, model.table,
+                             expected_objects, harness)
             counters = await registers.counters()
             error = error or _counter_mismatch(model_counters(model.stats(), len(expected)), counters)
             if error:
                 return f"stream {step + 1}: {error}", out
-            out[f"stream {step + 1}"] = {"records": len(records), "counters": counters}
+            out[f"stream {step + 1}"] = {"records": len(records), "objects": len(harness.objects), "counters": counters}
             summed, seen = _add(summed, counters), seen + _records_seen(records, model.table)
         return None, out | {"coverage": await _coverage(dut, summed, seen)}
 

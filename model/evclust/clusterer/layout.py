@@ -58,19 +58,32 @@ def support_shape(width: int, height: int, cell_bits: int) -> tuple[int, int]:
 ) = range(RECORD_COLUMNS)  # fmt: skip
 
 # The object layer (beyond the paper): one row per object slot. The first block is the object's
-# state; the second is what its member clusters of the current filter step add up to.
+# state; the second what the current filter step's member clusters add up to.
 (
     O_VALID, O_ID, O_X, O_Y, O_RX, O_RY, O_VX, O_VY, O_LUM, O_CB, O_CR, O_CLASS, O_T_BORN, O_T_SEEN,
-    O_CONFIRMED, O_EVER_REPORTED,
-    O_MEMBERS, O_LO_X, O_HI_X, O_LO_Y, O_HI_Y, O_W, O_WVX, O_WVY, O_BEST_W, O_BEST_CLASS, O_LUM_M, O_CB_M, O_CR_M,
-    O_OWNER_W,
-) = range(30)  # fmt: skip
+    O_CONFIRMED, O_EVER_REPORTED, O_TOL,
+    O_MEMBERS, O_CLAIMED, O_OWNER_W, O_LO_X, O_HI_X, O_LO_Y, O_HI_Y, O_V_WEIGHT, O_MEMBER_VX, O_MEMBER_VY,
+    O_COLOUR_WEIGHT, O_MEMBER_CLASS, O_MEMBER_LUM, O_MEMBER_CB, O_MEMBER_CR,
+) = range(32)  # fmt: skip
 OBJECT_COLUMNS = (
     "valid", "id", "x", "y", "rx", "ry", "vx", "vy", "Y", "Cb", "Cr", "class", "t_born", "t_seen",
-    "confirmed", "ever_reported",
-    "members", "lo_x", "hi_x", "lo_y", "hi_y", "velocity_weight", "member_vx", "member_vy", "colour_weight", "member_class",
-    "member_Y", "member_Cb", "member_Cr", "owner_weight",
+    "confirmed", "ever_reported", "tolerance",
+    "members", "claimed", "owner_weight", "lo_x", "hi_x", "lo_y", "hi_y", "velocity_weight", "member_vx", "member_vy",
+    "colour_weight", "member_class", "member_Y", "member_Cb", "member_Cr",
 )  # fmt: skip
+# Per cluster of a filter step: its velocity as the object layer takes it, whether it is measured,
+# its velocity tolerance, its link reaches along x and y, and its group.
+CL_VX, CL_VY, CL_MEASURED, CL_TOL, CL_REACH_X, CL_REACH_Y, CL_GROUP = range(7)
+CLUSTER_SCRATCH_COLUMNS = 7
+# Per group of linked clusters (indexed by its lowest member): its box, activity, the velocity of
+# its most active member (with that member's activity, whether it is measured and its tolerance),
+# the object its most active member with one joined last step (and that member's activity), and
+# the object it joins now.
+(
+    GR_LO_X, GR_HI_X, GR_LO_Y, GR_HI_Y, GR_WEIGHT, GR_VX, GR_VY, GR_V_WEIGHT, GR_MEASURED, GR_TOL, GR_PREFERRED,
+    GR_PREFERRED_WEIGHT, GR_OBJECT,
+) = range(13)  # fmt: skip
+GROUP_SCRATCH_COLUMNS = 13
 # Object-layer globals.
 OG_NEXT_ID, OG_T_PREV, OG_STARTED, OG_STEPS, OG_CREATED, OG_CONFIRMED, OG_FREED, OG_UNASSIGNED, OG_MERGED = range(9)
 OBJECT_GLOBAL_COLUMNS = ("next_id", "t_prev", "started", "steps", "created", "confirmed", "freed", "unassigned", "merged")

@@ -34,6 +34,16 @@ DECAY_TABLE_BITS = 6  # 2^-f for f in [0, 1) in 64 steps
 DECAY_FRAC_BITS = 16
 SCALE_FRAC_BITS = 6  # seek, merge and velocity-agreement scales: steps of 1/64
 NOISE_GATE_FRAC_BITS = 4
+# The object layer (beyond the paper; fixed/objects.py).
+OBJECT_DT_BITS = 24  # the time between filter steps, µs, saturated at 2^24 - 1 (16.8 s: beyond it every gain is 1)
+OBJECT_DT_FRAMES_FRAC = 24  # Δt in frames: 2^-24 frame steps,
+OBJECT_DT_FRAMES_INT = 10  # saturated below 1024 frames
+OBJECT_GAIN_FRAC = 24  # the filters' gains Δt/T, at most 1
+OBJECT_VELOCITY_FRAC = 16  # an object's velocity, px/frame
+OBJECT_INV_T_FRAC = 20  # 1/T of the object filters' time constants, per frame
+OBJECT_INV_T_INT = 4  # ... at most 15: every time constant is at least 1/15 frame
+OBJECT_TIME_BITS = 24  # birth, coast and keep times, µs
+INV_T_FRAME_SIGNIFICANT = 16  # bits of 1/T_frame kept below its leading one
 
 
 @dataclasses.dataclass(frozen=True)
@@ -185,6 +195,7 @@ def build_formats(
 
     # The centre keeps at least R's fraction bits: the seek shifts R up to P's, never down.
     pos_frac = max(guard("beta_pos"), guard("beta_size"))
+    _half_frac = guard("beta_size")
     v_full = 2.0 ** _bits_for(max(p.r_max, 64.0))  # px/frame: a speed above this is not an object
     v_mcm_int = max(12, min(16, MAX_WORD_BITS - 1 - guard("beta_vel_mcm") - beta_bits["beta_vel_mcm"]))
     f = [
@@ -228,6 +239,16 @@ def build_formats(
                "A_s·P_s + A_j·P_j of a merge (activity × centre)"),
         # A·W·H << 4 against gate·A_bg·(2⌊R⌋ + 1)², the raw words with the activity's 8 fraction bits.
         Format("noise_count", False, noise_int, 8, "intermediate", "A·W·H against γ_n·A_bg·box (activity × px²)"),
+        # The object layer: once per filter step, over the step's cluster records.
+        Format("obj_centre", True, coord + 1, pos_frac, "state", "object centre and box edges, px (outside the sensor while it coasts out)"),
+        Format("obj_half", False, coord, _half_frac, "state", "object half-size, px"),
+        Format("obj_velocity", True, _bits_for(v_full), OBJECT_VELOCITY_FRAC, "state", "object and cluster velocities, px/frame"),
+        Format("obj_weight", False, activity_bits + _bits_for(max(p.n_clusters - 1, 1)), 8, "intermediate", "activity of a group of clusters"),
+        Format("obj_dt", False, OBJECT_DT_BITS, 0, "intermediate", "µs since the last filter step, saturated"),
+        Format("obj_dt_frames", False, OBJECT_DT_FRAMES_INT, OBJECT_DT_FRAMES_FRAC, "intermediate", "Δt in frames, saturated (every gain is 1 long before)"),
+        Format("obj_gain", False, 1, OBJECT_GAIN_FRAC, "intermediate", "min(Δt/T, 1): a filter's gain over one step"),
+        # v_tol + v_rel·|V|₁ with |V|₁ at most twice full scale and v_rel below 2.
+        Format("obj_tolerance", False, _bits_for(v_full) + 3, OBJECT_VELOCITY_FRAC, "intermediate", "velocity tolerance, px/frame"),
     ]
     formats = {fmt.name: fmt for fmt in f}
     # |V|^2 squares a full-scale velocity in the speed's fraction bits: it must fit an int64.
@@ -286,6 +307,7 @@ def build_formats(
     const("noise_gate", p.noise_gate, False, _bits_for(p.noise_gate), NOISE_GATE_FRAC_BITS, "clusterer.noise_gate", "activity over the background's, per box") if p.noise_gate > 0 else None
     # t - T <= window for whole µs differences is t - T <= floor(window): the floor is exact.
     const("support_window", math.floor(p.support_window_us), False, 32, 0, "clusterer.support_window_us", "creation support window, µs") if p.support_window_us >= 1 else None
+    _object_constants(p, t_frame_us, formats, const)
     for i, (name, ycc) in enumerate(zip(p.palette_names, p.palette_ycbcr())):
         for channel, value in zip(("Y", "CB", "CR"), ycc):
             const(f"palette_{i}_{channel.lower()}", value, False, 8, 0, f"clusterer.palette.{name}", f"palette entry {name} {channel}")
@@ -297,6 +319,32 @@ def build_formats(
     gains = (0, 0) + tuple(int(round((1 << vi_frac) / n)) for n in range(2, max(p.interval_warmup(), 2)))
     return FormatTable(formats, table, p.n_clusters, len(p.palette), width, height, beta_shift_only,
                        _options(p, formats["background"]), gains)  # fmt: skip
+
+
+def _object_constants(p: ClustererParams, t_frame_us: float, formats: dict, const) -> None:
+    """The object layer's constants, in formats that do not depend on their values (so any
+    value of the searched ranges can be written at run time)."""
+    centre, velocity = formats["centre"], formats["obj_velocity"]
+    inv_t_frame_frac = max(0, math.ceil(math.log2(t_frame_us))) + INV_T_FRAME_SIGNIFICANT
+    if inv_t_frame_frac < OBJECT_DT_FRAMES_FRAC:
+        raise EvclustError(f"clusterer.t_frame_us: {t_frame_us:g} µs; the object layer needs a frame period of at least 256 µs")
+    const("inv_t_frame", 1.0 / t_frame_us, False, 0, inv_t_frame_frac, "clusterer.t_frame_us", "1/T_frame, per µs")
+    const("object_gate", p.object_gate, False, centre.int_bits, centre.frac_bits, "clusterer.object_gate", "gate margin, px")
+    const("object_link_along", p.object_link_along, False, 3, SCALE_FRAC_BITS, "clusterer.object_link_along",
+          "link reach along the motion per px of half-size across it")
+    const("object_v_tol", p.object_v_tol, False, velocity.int_bits, velocity.frac_bits, "clusterer.object_v_tol", "velocity agreement, px/frame")
+    const("object_v_rel", p.object_v_rel, False, 1, SCALE_FRAC_BITS, "clusterer.object_v_rel", "velocity agreement per px/frame of speed")
+    for name in ("track", "rate", "velocity", "size", "colour"):
+        frames = getattr(p, f"object_{name}_frames")
+        if frames < 1.0 / (2**OBJECT_INV_T_INT - 1):
+            raise EvclustError(f"clusterer.object_{name}_frames: {frames:g}; the object filters' time constants are at least 1/{2**OBJECT_INV_T_INT - 1} frame")
+        const(f"object_inv_{name}", 1.0 / frames, False, OBJECT_INV_T_INT, OBJECT_INV_T_FRAC, f"clusterer.object_{name}_frames", f"1/T of the object's {name} filter, per frame")
+    for name in ("birth", "coast", "keep"):
+        frames = getattr(p, f"object_{name}_frames") if name != "keep" else max(p.object_keep_frames, p.object_coast_frames)
+        us = round(frames * t_frame_us)
+        if us >= 2**OBJECT_TIME_BITS:
+            raise EvclustError(f"clusterer.object_{name}_frames: {frames:g} frames is {us} µs, over the {2**OBJECT_TIME_BITS - 1} µs the object layer counts")
+        const(f"object_{name}_us", us, False, OBJECT_TIME_BITS, 0, f"clusterer.object_{name}_frames", f"object {name} time, µs")
 
 
 # Constants a parameter set may leave out (a zero margin, no luminance weight, ...): the RTL
@@ -322,7 +370,7 @@ def _options(p: ClustererParams, background: Format) -> tuple[tuple[str, int], .
         ("VOTE_CONTRAST", int(p.palette_vote == "contrast")), ("MIXING", int(p.palette_assign == "mixing")),
         ("BG_FIXED", int(p.background is not None)), ("BACKGROUND_MASK", mask),
         ("MERGE", int(p.merge)), ("CREATE_SUPPORT", int(p.create_support)), ("SUPPORT_CELL_BITS", p.support_cell_bits),
-        ("VI_CAP", p.interval_warmup()),
+        ("VI_CAP", p.interval_warmup()), ("OBJECTS", int(p.objects)), ("N_OBJECTS", p.n_objects),
         *((f"BG_INIT_{c}", int(round(v * 2**background.frac_bits))) for c, v in zip(("Y", "CB", "CR"), bg)),
     )  # fmt: skip
 
@@ -462,9 +510,9 @@ def _verilog_lines(table: FormatTable) -> str:
 
 
 def _layouts(table: FormatTable):
-    from evclust.vectors.pack import TRACE_FIELDS, event_fields, record_fields
+    from evclust.vectors.pack import TRACE_FIELDS, event_fields, object_fields, record_fields
 
-    return (("IN", event_fields(table)), ("REC", record_fields(table)), ("TRACE", TRACE_FIELDS))
+    return (("IN", event_fields(table)), ("REC", record_fields(table)), ("TRACE", TRACE_FIELDS), ("OBJ", object_fields(table)))
 
 
 # Verilog names of the fields whose upper-case names would collide (y and Y).
@@ -499,6 +547,7 @@ def _port_parameter_lines(table: FormatTable) -> list[str]:
         f"parameter integer EV_W = {widths['IN']},  // event word",
         f"parameter integer REC_W = {widths['REC']},  // record word",
         f"parameter integer TRACE_W = {widths['TRACE']},  // trace word",
+        f"parameter integer OBJ_W = {widths['OBJ']},  // object record word",
         f"parameter integer CFG_W = {32 * registers.config_words(table)},  // configuration block",
         f"parameter integer COUNT_W = {len(registers.COUNTERS) * registers.COUNTER_INC_BITS}  // counter increments",
         "// verilator lint_on UNUSEDPARAM",

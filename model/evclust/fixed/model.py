@@ -77,6 +77,12 @@ class FixedClusterer:
         self.steps = steps[: int(self.globals[STEP] - first)]
         return out[:n]
 
+    def object_layer(self):
+        """The object layer that follows this model: bit-accurate, in this model's formats."""
+        from evclust.fixed.objects import FixedObjects
+
+        return FixedObjects(self.table, self.params)
+
     def stats(self) -> dict:
         saturations = {name: int(c) for name, c in zip(fixed_model.SIGNALS, self.overflow) if c}
         return run_stats(self.globals) | {"saturations": saturations}

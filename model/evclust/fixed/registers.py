@@ -41,11 +41,14 @@ CONSTANT_ORDER = (
     "r_init", "r_min", "r_max", "seek_margin", "exit_margin", "a_min", "a_valid", "v_min_sq", "v_exit_sq",
     "cos_sq_exit", "mixing_tolerance", "seek_scale", "merge_scale", "merge_v_tol", "merge_v_rel", "noise_gate",
     "support_window",
+    # The object layer.
+    "inv_t_frame", "object_gate", "object_link_along", "object_v_tol", "object_v_rel", "object_inv_track", "object_inv_rate",
+    "object_inv_velocity", "object_inv_size", "object_inv_colour", "object_birth_us", "object_coast_us", "object_keep_us",
 )  # fmt: skip
 # Options (formats.py `_options`) that are run-time: mux selects and values. The others are structural.
 RUNTIME_OPTIONS = ("FILTER_EVERY", "TAU_US", "GAMMA_MODE", "WARM_START", "MCM_CORRECT", "VOTE_CONTRAST", "MIXING", "BG_FIXED",
                    "BACKGROUND_MASK", "BG_INIT_Y", "BG_INIT_CB", "BG_INIT_CR")  # fmt: skip
-BUILD_OPTIONS = ("MERGE", "CREATE_SUPPORT", "SUPPORT_CELL_BITS", "VI_CAP")
+BUILD_OPTIONS = ("MERGE", "CREATE_SUPPORT", "SUPPORT_CELL_BITS", "VI_CAP", "OBJECTS", "N_OBJECTS")
 OPTION_DOCS = {
     "FILTER_EVERY": "events between filter steps", "TAU_US": "τ, µs", "GAMMA_MODE": "γ: 0 global, 1 from activity, 2 counted",
     "WARM_START": "interval velocity warm start", "MCM_CORRECT": "MCM bias correction", "VOTE_CONTRAST": "palette votes weighted by contrast",

@@ -115,8 +115,8 @@ def split_objective(folder: str, seeds: tuple[int, ...], params: ClustererParams
     from evclust.suite.prepare import SceneFiles
     from evclust.scenes.generate import scene_name
 
-    results = [evaluate_scene(SceneFiles(scene_name(s), Path(folder)), params, cache=_EVENTS_CACHE, trackeval=False) for s in seeds]
-    f = figures(results, trackeval=False)
+    results = [evaluate_scene(SceneFiles(scene_name(s), Path(folder)), params, cache=_EVENTS_CACHE) for s in seeds]
+    f = figures(results)
     return objective(f), f
 
 
@@ -131,7 +131,7 @@ def _worker(storage: str, study_name: str, folder: str, seeds, base: ClustererPa
 
     def objective(trial):
         value, f = split_objective(folder, seeds, suggest(trial, base))
-        for key in ("recall", "precision", "tracks_per_object", "position_rel_rmse", "interval_nrmse", "mcm_nrmse"):
+        for key in ("HOTA", "IDF1", "recall", "precision", "tracks_per_object", "position_rel_rmse", "interval_nrmse", "mcm_nrmse", "object_nrmse"):
             trial.set_user_attr(key, f.get(key))
         return value if math.isfinite(value) else 1e9
 

@@ -7,7 +7,7 @@ import math
 import numpy as np
 
 from evclust.fixed.formats import FormatTable
-from evclust.tracks import TRACK_DTYPE
+from evclust.tracks import OBJECT_DTYPE, TRACK_DTYPE
 
 # (name, width, signed) per field; events and trace have fixed layouts apart from the coordinates.
 TRACE_FIELDS = (("action", 3, False), ("slot", 8, False))  # action: 0 update, 1 create, 2 evict, 3 drop, 4 unsupported
@@ -32,6 +32,23 @@ def record_fields(table: FormatTable):
         ("Y", f["colour"].word_bits, False, f["colour"].frac_bits), ("Cb", f["colour"].word_bits, False, f["colour"].frac_bits),
         ("Cr", f["colour"].word_bits, False, f["colour"].frac_bits),
         ("class", 8, True, 0), ("flags", 4, False, 0),
+    )  # fmt: skip
+
+
+def object_fields(table: FormatTable):
+    """The object record as the RTL's object unit emits it: raw values in their formats."""
+    f = table.formats
+    options = dict(table.options)
+    slot_bits = max(1, math.ceil(math.log2(options["N_OBJECTS"])))
+    members_bits = max(1, table.n_clusters.bit_length())
+    return (
+        ("t_us", 32, False, 0), ("step", 32, False, 0), ("slot", slot_bits, False, 0), ("id", 32, False, 0),
+        ("x", f["obj_centre"].word_bits, True, f["obj_centre"].frac_bits), ("y", f["obj_centre"].word_bits, True, f["obj_centre"].frac_bits),
+        ("rx", f["obj_half"].word_bits, False, f["obj_half"].frac_bits), ("ry", f["obj_half"].word_bits, False, f["obj_half"].frac_bits),
+        ("vx", f["obj_velocity"].word_bits, True, f["obj_velocity"].frac_bits), ("vy", f["obj_velocity"].word_bits, True, f["obj_velocity"].frac_bits),
+        ("Y", f["colour"].word_bits, False, f["colour"].frac_bits), ("Cb", f["colour"].word_bits, False, f["colour"].frac_bits),
+        ("Cr", f["colour"].word_bits, False, f["colour"].frac_bits),
+        ("class", 8, True, 0), ("members", members_bits, False, 0), ("flags", 2, False, 0),
     )  # fmt: skip
 
 
@@ -79,10 +96,26 @@ def record_rows(words, table: FormatTable) -> np.ndarray:
     return rows * scale
 
 
+def object_rows(words, table: FormatTable) -> np.ndarray:
+    """Object record words (the RTL's) as the fixed model's object record rows, in real units."""
+    fields = object_fields(table)
+    scale = np.array([2.0**-frac for *_, frac in fields])
+    rows = np.array([unpack(int(word), fields) for word in words], dtype=np.float64).reshape(-1, len(fields))
+    return rows * scale
+
+
 def record_words(tracks: np.ndarray, table: FormatTable) -> list[int]:
-    """Track records (values converted from their formats) back to raw integers, exactly."""
-    fields = record_fields(table)
-    assert tuple(f[0] for f in fields) == TRACK_DTYPE.names
+    """Cluster records (values converted from their formats) back to raw integers, exactly."""
+    return _words(tracks, record_fields(table), TRACK_DTYPE)
+
+
+def object_words(objects: np.ndarray, table: FormatTable) -> list[int]:
+    """Object records back to the raw integers of the object unit's words, exactly."""
+    return _words(objects, object_fields(table), OBJECT_DTYPE)
+
+
+def _words(tracks: np.ndarray, fields, dtype: np.dtype) -> list[int]:
+    assert tuple(f[0] for f in fields) == dtype.names
     raws = []
     for name, _, _, frac in fields:
         column = tracks[name].astype(np.float64) * 2.0**frac

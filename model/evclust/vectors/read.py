@@ -12,7 +12,7 @@ from pathlib import Path
 from evclust.clusterer import ClustererParams
 from evclust.errors import EvclustError
 from evclust.fixed.formats import FormatTable, build_formats, verilog_header
-from evclust.vectors.pack import TRACE_FIELDS, event_fields, record_fields
+from evclust.vectors.pack import TRACE_FIELDS, event_fields, object_fields, record_fields
 from evclust.vectors.write import FILES
 
 
@@ -26,6 +26,7 @@ class VectorCase:
     events: list[int]
     expected: list[int]
     trace: list[int]
+    objects: list[int]  # the object records (none without an object layer)
 
     @property
     def header(self) -> str:
@@ -89,6 +90,7 @@ def load_case(folder: str | Path, rtl_header: str | None = None) -> VectorCase:
         _words(folder / "events.hex", event_fields(own), counts["events"]),
         _words(folder / "expected.hex", record_fields(own), counts["records"]),
         _words(folder / "trace.hex", TRACE_FIELDS, counts["events"]),
+        _words(folder / "objects.hex", object_fields(own), counts["objects"]),
     )  # fmt: skip
 
 

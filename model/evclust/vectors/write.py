@@ -6,18 +6,22 @@ import hashlib
 import json
 import tempfile
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 
 from evclust import __version__
-from evclust.clusterer.run import records_to_tracks
+from evclust.clusterer.run import records_to_tracks, rows_to_records
 from evclust.errors import atomic_folder
 from evclust.fixed.model import FixedClusterer
 from evclust.fixed.registers import SATURATING_SIGNALS
 from evclust.vectors.cases import CASES, Case
-from evclust.vectors.pack import TRACE_FIELDS, event_fields, event_words, hex_lines, pack, record_fields, record_words
+from evclust.tracks import OBJECT_DTYPE
+from evclust.vectors.pack import (
+    TRACE_FIELDS, event_fields, event_words, hex_lines, object_fields, object_words, pack, record_fields, record_words,
+)  # fmt: skip
 
-FILES = ("events.hex", "expected.hex", "trace.hex")
+FILES = ("events.hex", "expected.hex", "trace.hex", "objects.hex")
 
 
 def _layout(fields) -> list[dict]:
@@ -29,13 +33,26 @@ def _layout(fields) -> list[dict]:
     return out
 
 
-def model_words(model: FixedClusterer, events: np.ndarray) -> tuple[list[int], list[int], list[int]]:
-    """Feed events to the fixed model: (event words, record words, trace words), packed as the
-    RTL's streams carry them. The model keeps its state, so a stream can be fed in pieces."""
+class ModelWords(NamedTuple):
+    """A stream's words as the RTL's ports carry them."""
+
+    events: list[int]
+    records: list[int]  # cluster records
+    trace: list[int]
+    objects: list[int]  # object records (none without an object layer)
+
+
+def model_words(model: FixedClusterer, events: np.ndarray, objects=None) -> ModelWords:
+    """Feed events to the fixed model and, when its parameters have one, its object layer
+    (`objects`, made on the first call if None: pass the same one to feed a stream in pieces)."""
     trace = np.zeros(events.size, np.int64)
-    tracks = records_to_tracks(model.feed(events, trace))
+    rows = model.feed(events, trace)
     words = [pack((int(v) >> 16, int(v) & 0xFFFF), TRACE_FIELDS) for v in trace]
-    return event_words(events, model.table), record_words(tracks, model.table), words
+    object_list = []
+    if model.params.objects:
+        layer = objects if objects is not None else model.object_layer()
+        object_list = object_words(rows_to_records(layer.feed(rows, model.steps), OBJECT_DTYPE), model.table)
+    return ModelWords(event_words(events, model.table), record_words(records_to_tracks(rows), model.table), words, object_list)
 
 
 def _counts(model: FixedClusterer) -> dict:
@@ -48,12 +65,14 @@ def write_case(name: str, folder: Path, case: Case | None = None) -> dict:
     """Write one case: a built-in one by name, or `case` (e.g. from an event file) under `name`."""
     case = case or CASES[name]()
     model = FixedClusterer(case.params, case.width, case.height, case.t_frame_us, **case.formats)
-    event_list, record_list, trace_list = model_words(model, case.events)
+    layer = model.object_layer() if case.params.objects else None
+    event_list, record_list, trace_list, object_list = model_words(model, case.events, layer)
     table = model.table
     contents = {
         "events.hex": hex_lines(event_list, event_fields(table)),
         "expected.hex": hex_lines(record_list, record_fields(table)),
         "trace.hex": hex_lines(trace_list, TRACE_FIELDS),
+        "objects.hex": hex_lines(object_list, object_fields(table)),
     }
     manifest = {
         "case": name,
@@ -71,8 +90,9 @@ def write_case(name: str, folder: Path, case: Case | None = None) -> dict:
         "formats": {f.name: {"q": f.q, "signed": f.signed, "int_bits": f.int_bits, "frac_bits": f.frac_bits,
                              "rounding": f.rounding, "overflow": f.overflow} for f in table.formats.values()},  # fmt: skip
         "layouts": {"events.hex": _layout(event_fields(table)), "expected.hex": _layout(record_fields(table)),
-                    "trace.hex": _layout(TRACE_FIELDS)},  # fmt: skip
-        "counts": {"events": int(case.events.size), "records": len(record_list), **_counts(model)},
+                    "trace.hex": _layout(TRACE_FIELDS), "objects.hex": _layout(object_fields(table))},  # fmt: skip
+        "counts": {"events": int(case.events.size), "records": len(record_list), "objects": len(object_list), **_counts(model),
+                   **({"object_layer": layer.stats()} if layer is not None else {})},
         "sha256": {file: hashlib.sha256(text.encode()).hexdigest() for file, text in contents.items()},
     }
     with atomic_folder(folder) as tmp:  # a case is whole or absent, even if interrupted
