@@ -5,11 +5,11 @@ are formed at record rate, once per filter step, from the step's reported cluste
 
 1. **Predict.** Every object moves by its velocity over the time Δt since the last step.
 2. **Group.** Two clusters belong together (common fate) when both have measured velocities
-   that agree and their boxes overlap once grown by `object_gate` px, and along their motion by
-   `object_link_along` times their larger half-size across it (the leading and trailing edges
-   of a uniform object lie along its motion, an object length apart); or, with a velocity not yet
-   measured, when their boxes overlap once grown by the gate. Groups are the links' transitive
-   closure.
+   that agree and their boxes overlap once grown by `object_gate` px, and along their motion
+   (once it is known: their speed above their velocity tolerance) by `object_link_along` times
+   their larger half-size across it (the leading and trailing edges of a uniform object lie along
+   its motion, an object length apart); or, with a velocity not yet measured, when their boxes
+   overlap once grown by the gate. Groups are the links' transitive closure.
 3. **Associate.** A group continues the object its most active member joined last step (same
    slot, same cluster id) when that object's box grown by the gate still meets the group's box;
    when several groups claim one object, the most active keeps it. Any other group joins the
@@ -17,10 +17,12 @@ are formed at record rate, once per filter step, from the step's reported cluste
    object whose grown box meets it, velocities agreeing; else it starts a tentative object.
 4. **Update.** An object with members measures the extent of their boxes; its centre follows
    that box's centre through a constant-velocity α-β filter, and its velocity follows both the
-   centre's residual and its most active member's velocity. Each gain is min(Δt/T, 1) with T in
-   frames, so the filters' memory is in time, whatever the event rate. Its half-size, colour and
-   class follow its members' (colour and class from its most active member that has a class: an
-   edge mixture with the background has none).
+   centre's residual and its most active member's measured velocity (an interval estimate; the
+   MCM guess of a young cluster is no measurement). Each gain is min(Δ/T, 1), Δ the time since
+   the object was last seen and T in frames, so the filters' memory is in time, whatever the event
+   rate and however long it coasted; the residual's gain on the velocity is Δ/T², at most 1/Δ.
+   Its half-size, colour and class follow its members' (colour and class from its most active
+   member that has a class: an edge mixture with the background has none).
 5. **Merge.** An object whose centre lies in an older object's box, velocities agreeing, is a
    fragment of it: the older absorbs it and its clusters follow.
 6. **Birth and death.** An object is tentative until it has had members for
@@ -37,6 +39,7 @@ same steps in the same order in integer arithmetic; the RTL (rtl/evclust_objects
 
 from __future__ import annotations
 
+import math
 from collections import namedtuple
 
 import numpy as np
@@ -116,10 +119,13 @@ def _linked(rows, i, j, C, k):
     if C[i, CL_MEASURED] != 0.0 and C[j, CL_MEASURED] != 0.0:
         if not _agree(C[i, CL_VX], C[i, CL_VY], C[i, CL_TOL], C[j, CL_VX], C[j, CL_VY], C[j, CL_TOL]):
             return False
-        if abs(C[i, CL_VX] + C[j, CL_VX]) >= abs(C[i, CL_VY] + C[j, CL_VY]):  # along x: the edges are apart in x
-            sx += max(C[i, CL_REACH_Y], C[j, CL_REACH_Y])
-        else:
-            sy += max(C[i, CL_REACH_X], C[j, CL_REACH_X])
+        # Along their motion, once it is known: their speeds (summed) above their tolerance (doubled).
+        along_x, along_y = abs(C[i, CL_VX] + C[j, CL_VX]), abs(C[i, CL_VY] + C[j, CL_VY])
+        if along_x + along_y > 2.0 * max(C[i, CL_TOL], C[j, CL_TOL]):
+            if along_x >= along_y:  # along x: the edges are apart in x
+                sx += max(C[i, CL_REACH_Y], C[j, CL_REACH_Y])
+            else:
+                sy += max(C[i, CL_REACH_X], C[j, CL_REACH_X])
     return dx <= sx and dy <= sy
 
 
@@ -187,37 +193,50 @@ def _join(O, o, rows, r, C, c):
     O[o, O_HI_X] = max(O[o, O_HI_X], rows[r, R_X] + rows[r, R_RX])
     O[o, O_LO_Y] = min(O[o, O_LO_Y], rows[r, R_Y] - rows[r, R_RY])
     O[o, O_HI_Y] = max(O[o, O_HI_Y], rows[r, R_Y] + rows[r, R_RY])
-    if a > O[o, O_V_WEIGHT]:
+    if C[c, CL_MEASURED] != 0.0 and a > O[o, O_V_WEIGHT]:  # (the velocity of one not measured is MCM's early guess)
         O[o, O_V_WEIGHT], O[o, O_MEMBER_VX], O[o, O_MEMBER_VY] = a, C[c, CL_VX], C[c, CL_VY]
     if rows[r, R_CLASS] >= 0.0 and a > O[o, O_COLOUR_WEIGHT]:
         O[o, O_COLOUR_WEIGHT], O[o, O_MEMBER_CLASS] = a, rows[r, R_CLASS]
         O[o, O_MEMBER_LUM], O[o, O_MEMBER_CB], O[o, O_MEMBER_CR] = rows[r, R_LUM], rows[r, R_CB], rows[r, R_CR]
 
 
+@njit(cache=True, nogil=True, inline="always")
+def rate_gain(seen_frames, rate_frames):
+    """The velocity's gain on the centre's residual after Δ frames, per frame: Δ/T², but no more
+    than the residual over Δ itself (1/Δ, rounded down to a power of two, as the hardware shifts)."""
+    if seen_frames <= 0.0:
+        return 0.0
+    return min(seen_frames / (rate_frames * rate_frames), 2.0 ** -math.ceil(math.log2(seen_frames)))
+
+
 @njit(cache=True, nogil=True)
-def _update(O, o, t, dt_frames, k):
-    """Step 4 for one object with members."""
+def _update(O, o, t, k):
+    """Step 4 for one object with members. The gains run over Δ, the time since the object was
+    last seen (one step, unless it coasted): its residual has built up over all of it."""
     zx, zy = 0.5 * (O[o, O_LO_X] + O[o, O_HI_X]), 0.5 * (O[o, O_LO_Y] + O[o, O_HI_Y])
     hx, hy = 0.5 * (O[o, O_HI_X] - O[o, O_LO_X]), 0.5 * (O[o, O_HI_Y] - O[o, O_LO_Y])
+    seen = min(min(t - O[o, O_T_SEEN], DT_MAX_US) / k.t_frame_us, DT_FRAMES_MAX)
+    measured = O[o, O_V_WEIGHT] >= 0.0  # a member with a measured velocity
     if O[o, O_T_BORN] == t:  # born this step: the measurement as it is
         O[o, O_X], O[o, O_Y], O[o, O_RX], O[o, O_RY] = zx, zy, hx, hy
-        O[o, O_VX], O[o, O_VY] = O[o, O_MEMBER_VX], O[o, O_MEMBER_VY]
+        if measured:
+            O[o, O_VX], O[o, O_VY] = O[o, O_MEMBER_VX], O[o, O_MEMBER_VY]
     else:
         # α-β: the centre moves towards the measurement, the velocity by the residual's rate,
-        # and the velocity towards the most active member's.
+        # and towards its most active member's measured velocity.
         ex, ey = zx - O[o, O_X], zy - O[o, O_Y]
-        g_pos = _gain(dt_frames, k.track_frames)
-        g_rate = _gain(dt_frames, k.rate_frames) / k.rate_frames  # per frame
-        g_vel = _gain(dt_frames, k.velocity_frames)
+        g_pos = _gain(seen, k.track_frames)
+        g_rate = rate_gain(seen, k.rate_frames)
+        g_vel = _gain(seen, k.velocity_frames) if measured else 0.0
+        g_size = _gain(seen, k.size_frames)
         O[o, O_X] += g_pos * ex
         O[o, O_Y] += g_pos * ey
         O[o, O_VX] += g_rate * ex + g_vel * (O[o, O_MEMBER_VX] - O[o, O_VX])
         O[o, O_VY] += g_rate * ey + g_vel * (O[o, O_MEMBER_VY] - O[o, O_VY])
-        g_size = _gain(dt_frames, k.size_frames)
         O[o, O_RX] += g_size * (hx - O[o, O_RX])
         O[o, O_RY] += g_size * (hy - O[o, O_RY])
     if O[o, O_COLOUR_WEIGHT] > 0.0:
-        g_col = 1.0 if O[o, O_CLASS] < 0.0 else _gain(dt_frames, k.colour_frames)  # the first colour as it is
+        g_col = 1.0 if O[o, O_CLASS] < 0.0 else _gain(seen, k.colour_frames)  # the first colour as it is
         O[o, O_LUM] += g_col * (O[o, O_MEMBER_LUM] - O[o, O_LUM])
         O[o, O_CB] += g_col * (O[o, O_MEMBER_CB] - O[o, O_CB])
         O[o, O_CR] += g_col * (O[o, O_MEMBER_CR] - O[o, O_CR])
@@ -322,7 +341,7 @@ def object_step(O, OG, slot_obj, slot_id, rows, lo, hi, t, step, k, out, n_out, 
         slot_obj[s], slot_id[s] = o, rows[r, R_ID]
     for o in range(n_objects):  # 4. update
         if O[o, O_VALID] != 0.0 and O[o, O_MEMBERS] > 0.0:
-            _update(O, o, t, dt_frames, k)
+            _update(O, o, t, k)
     for o in range(n_objects):  # 5. merge: an object inside an older one is a fragment of it
         if O[o, O_VALID] == 0.0 or O[o, O_MEMBERS] == 0.0:
             continue

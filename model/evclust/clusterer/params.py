@@ -52,40 +52,40 @@ class ClustererParams(BaseModel):
     n_clusters: Annotated[int, Field(ge=1, le=1024)] = 16  # N slots
     # The defaults hold across the generalization suite: they were tuned on its tuning split
     # (evclust tune --suite tuning, docs/TUNING.md), never on its test split.
-    seek_margin: NonNegative = 2.0  # S, px: a cluster catches events within its box grown by S (+ seek_scale·max R)
-    r_init: Positive = 14.0  # half-size of a new cluster, px
+    seek_margin: NonNegative = 2.7  # S, px: a cluster catches events within its box grown by S (+ seek_scale·max R)
+    r_init: Positive = 18.4  # half-size of a new cluster, px
     r_min: Positive = 1.0  # half-size clamp, px
     r_max: Positive = 80.0
-    size_gain: Positive = 1.5  # g_R: R tracks g_R · |e - P|
+    size_gain: Positive = 1.94  # g_R: R tracks g_R · |e - P|
     alpha_pos: Alpha = 0.9843  # centre
-    alpha_size: Alpha = 0.9974  # half-size
+    alpha_size: Alpha = 0.9847  # half-size
     # Activity: an event count decaying with half-life T_half. Times are given in µs, or in frame
     # periods of the event stream when the µs value is not set (the defaults).
     t_half_us: Positive | None = None
-    t_half_frames: Positive = 1.8
-    a_min: NonNegative = 1.17  # below: the slot is freed at a filter step
-    a_valid: NonNegative = 6.6  # at or above (and not noise): the cluster is reported
+    t_half_frames: Positive = 1.4
+    a_min: NonNegative = 0.31  # below: the slot is freed at a filter step
+    a_valid: NonNegative = 2.25  # at or above (and not noise): the cluster is reported
     filter_every: Annotated[int, Field(ge=1, le=1 << 20)] = 64  # N_f events between filter steps
     # Velocity (§6.2): mean centre motion, every event, and regular interval, every τ.
-    alpha_vel_mcm: Alpha = 0.99998  # close to 1, as in the paper: one event says little about motion
-    gamma: Positive = 60.0  # events per frame, the paper's global scale factor of eq. (5)
+    alpha_vel_mcm: Alpha = 0.9922  # close to 1, as in the paper: one event says little about motion
+    gamma: Positive = 37.0  # events per frame, the paper's global scale factor of eq. (5)
     # global: the paper's γ. activity: γ_i = A_i·ln2·T_frame/T_half, refreshed at filter steps.
     # count (beyond the paper): γ_i = the cluster's events in the last τ · T_frame/τ, which does not
     # follow the bursts inside a frame (activity with a short T_half does, and biases V_MCM).
     gamma_mode: Literal["global", "activity", "count"] = "count"
-    alpha_vel_int: Alpha = 0.874
+    alpha_vel_int: Alpha = 0.583
     tau_us: Positive | None = None  # τ in µs; when not set, tau_frames frame periods (rounded to whole µs)
-    tau_frames: Positive = 5.3
+    tau_frames: Positive = 4.25
     # Beyond the paper: both filters otherwise start at V = 0 and need ~1/β samples to forget it,
     # often longer than an object stays in view.
     velocity_warm_start: bool = True  # interval: skip the partial first τ, seed V_RI with the first full one
     mcm_bias_correction: bool = True  # MCM: report V / (1 - α^n), n = events since creation
     t_frame_us: Positive | None = None  # frame period; default: the event file's
     # Colour (§7.2).
-    alpha_lum: Alpha = 0.9859
-    alpha_chro: Alpha = 0.9914
+    alpha_lum: Alpha = 0.9931
+    alpha_chro: Alpha = 0.9851
     alpha_bg: Alpha = 0.999
-    p_correction: Annotated[float, Field(gt=0.0, le=1.0)] = 0.41  # p of eq. (11)
+    p_correction: Annotated[float, Field(gt=0.0, le=1.0)] = 0.59  # p of eq. (11)
     background: tuple[Byte, Byte, Byte] | None = None  # fixed background YCbCr; default: estimated
     palette: Annotated[tuple[PaletteEntry, ...], Field(min_length=1, max_length=64)] = DEFAULT_PALETTE
     palette_background: tuple[str, ...] = ()  # palette names that are background, never a class
@@ -93,7 +93,7 @@ class ClustererParams(BaseModel):
     hist_bits: Annotated[int, Field(ge=2, le=24)] = 16  # saturating histogram counters
     # count: each event adds 1 (§7.2.2). contrast (beyond the paper): each event adds its L1 distance
     # from the background colour, so edge events that are mostly background weigh little.
-    palette_vote: Literal["count", "contrast"] = "contrast"
+    palette_vote: Literal["count", "contrast"] = "count"
     # nearest: the event's class is the nearest entry (§7.2.2). mixing (beyond the paper): an edge
     # event is a mixture q·object + (1-q)·background (§7.2.1); its class is the nearest entry among
     # those whose background-to-entry segment passes within mixing_tolerance of it.
@@ -101,21 +101,21 @@ class ClustererParams(BaseModel):
     mixing_tolerance: NonNegative = 12.0  # L1 (luma weighted) distance to a mixing segment
     # Beyond the paper: one cluster per object (docs/TUNING.md, "One cluster per object").
     # Scales are in steps of 1/64 in the fixed model and the RTL.
-    seek_scale: NonNegative = 0.09375  # the seek margin grows by seek_scale·max(Rx, Ry): a large object's far edge is in reach
+    seek_scale: NonNegative = 0.234375  # the seek margin grows by seek_scale·max(Rx, Ry): a large object's far edge is in reach
     merge: bool = True  # filter step: merge two clusters whose grown boxes overlap and whose velocities agree
-    merge_scale: NonNegative = 1.234375  # for merging, each box grows by merge_scale·max(Rx, Ry)
-    merge_v_tol: NonNegative = 0.48  # px/frame: the L1 velocity difference two merging clusters may have,
-    merge_v_rel: NonNegative = 0.078125  # plus this fraction of the faster one's L1 speed
-    noise_gate: NonNegative = 12.7  # report a cluster only if its activity is noise_gate times what the background's events give its box
+    merge_scale: NonNegative = 0.390625  # for merging, each box grows by merge_scale·max(Rx, Ry)
+    merge_v_tol: NonNegative = 0.32  # px/frame: the L1 velocity difference two merging clusters may have,
+    merge_v_rel: NonNegative = 0.15625  # plus this fraction of the faster one's L1 speed
+    noise_gate: NonNegative = 9.2  # report a cluster only if its activity is noise_gate times what the background's events give its box
     # A new cluster needs support: another event in its 3x3 neighbourhood of cells (2^support_cell_bits
     # px square) within the support window; isolated noise events then create nothing.
     create_support: bool = True
     support_cell_bits: Annotated[int, Field(ge=0, le=4)] = 0
     support_window_us: Positive | None = None  # the window in µs; when not set, support_window_frames frame periods
-    support_window_frames: Positive = 0.044
+    support_window_frames: Positive = 0.127
     # Decisions from velocity (§6.3).
-    v_min: NonNegative = 0.022  # px/frame: a cluster whose MCM and interval speeds are both below is noise
-    exit_margin: NonNegative = 5.4  # M, px: the border band where exit prediction acts
+    v_min: NonNegative = 0.0114  # px/frame: a cluster whose MCM and interval speeds are both below is noise
+    exit_margin: NonNegative = 10.9  # M, px: the border band where exit prediction acts
     v_exit: NonNegative = 1.0  # px/frame: minimum speed to predict an exit
     theta_exit_deg: Annotated[float, Field(gt=0.0, le=90.0)] = 45.0  # max angle to the border normal
     # The object layer (beyond the paper; clusterer/objects.py): once per filter step, the reported
@@ -123,18 +123,18 @@ class ClustererParams(BaseModel):
     # gated association. Times in frames of the event stream.
     objects: bool = True
     n_objects: Annotated[int, Field(ge=1, le=256)] = 16  # object slots
-    object_gate: NonNegative = 4.0  # px: the margin of the overlap tests (cluster with cluster, group with object)
-    object_link_along: NonNegative = 3.0  # along their motion, clusters link this many of their half-sizes across it apart
-    object_v_tol: NonNegative = 0.3  # px/frame: common fate, velocities within this (L1)
-    object_v_rel: NonNegative = 0.2  # plus this fraction of the faster L1 speed
-    object_track_frames: Positive = 1.0  # the centre's α-β filter: time constant, frames
-    object_rate_frames: Positive = 8.0  # ... and of the velocity's pull by the centre's residual
-    object_velocity_frames: Positive = 2.0  # the velocity's pull towards its clusters' velocities
-    object_size_frames: Positive = 1.0
-    object_colour_frames: Positive = 2.0
-    object_birth_frames: NonNegative = 0.5  # members for this long before an object is reported
-    object_coast_frames: NonNegative = 3.0  # an object without members is predicted and reported this long,
-    object_keep_frames: NonNegative = 30.0  # and kept, unreported, this long for its clusters to return
+    object_gate: NonNegative = 0.56  # px: the margin of the overlap tests (cluster with cluster, group with object)
+    object_link_along: NonNegative = 5.06  # along their motion, clusters link this many of their half-sizes across it apart
+    object_v_tol: NonNegative = 0.275  # px/frame: common fate, velocities within this (L1)
+    object_v_rel: NonNegative = 0.29  # plus this fraction of the faster L1 speed
+    object_track_frames: Positive = 0.83  # the centre's α-β filter: time constant, frames
+    object_rate_frames: Positive = 1.48  # ... and of the velocity's pull by the centre's residual
+    object_velocity_frames: Positive = 4.9  # the velocity's pull towards its clusters' velocities
+    object_size_frames: Positive = 2.2
+    object_colour_frames: Positive = 0.45
+    object_birth_frames: NonNegative = 1.18  # members for this long before an object is reported
+    object_coast_frames: NonNegative = 1.93  # an object without members is predicted and reported this long,
+    object_keep_frames: NonNegative = 50.0  # and kept, unreported, this long for its clusters to return
 
     @model_validator(mode="after")
     def _consistent(self):
