@@ -100,16 +100,17 @@ module evclust_objects #(
     wire signed [63:0] product = mul_full[63:0];
 
     // ---------------------------------------------------------------- state
-    localparam [3:0] S_COLLECT = 4'd0, S_DT = 4'd1, S_GAIN = 4'd2, S_PREDICT = 4'd3, S_PREP = 4'd4, S_LINK = 4'd5,
+    localparam [3:0] S_COLLECT = 4'd0, S_DT = 4'd1, S_PREDICT = 4'd3, S_PREP = 4'd4, S_LINK = 4'd5,
                      S_GROUP = 4'd6, S_OWNER = 4'd7, S_CLAIM = 4'd8, S_ASSOC = 4'd9, S_JOIN = 4'd10, S_UPDATE = 4'd11,
                      S_MERGE = 4'd12, S_OUT = 4'd13;
     reg [3:0]  state;
-    reg [3:0]  sub;            // the operation within an item (a multiply per cycle)
+    reg [4:0]  sub;            // the operation within an item (a multiply per cycle)
     reg [8:0]  i, j;           // cluster indices, or an object slot and a scan position
     reg [M_W-1:0] m;           // the step's clusters
     reg [31:0] t, t_prev, step_count, next_id;
     reg        started;
-    reg signed [63:0] dt, dtf, g_pos, g_rate, g_vel, g_size, g_col;
+    reg signed [63:0] dt, dtf;                                  // Δt since the last step (µs, frames): the prediction's
+    reg signed [63:0] seen, g_pos, g_rate, g_vel, g_size, g_col;  // UPDATE: Δ since the object was last seen (frames), the gains
 
     // The step's clusters (index = arrival order = slot order).
     reg [SLOT_W-1:0]      c_slot   [0:N-1];
@@ -264,9 +265,11 @@ module evclust_objects #(
     wire signed [63:0] l_sy0 = {{(64 - RW){1'b0}}, c_ry[ci]} + {{(64 - RW){1'b0}}, c_ry[cj]} + K_GATE;
     wire               l_both = c_meas[ci] && c_meas[cj];
     wire               l_agree = agree(l_vxi, l_vyi, l_toli, l_vxj, l_vyj, l_tolj);
-    wire               l_along_x = abs64(l_vxi + l_vxj) >= abs64(l_vyi + l_vyj);
-    wire signed [63:0] l_sx = l_sx0 + (l_both && l_along_x ? (l_rchyi > l_rchyj ? l_rchyi : l_rchyj) : 64'sd0);
-    wire signed [63:0] l_sy = l_sy0 + (l_both && !l_along_x ? (l_rchxi > l_rchxj ? l_rchxi : l_rchxj) : 64'sd0);
+    wire signed [63:0] l_sum_x = abs64(l_vxi + l_vxj), l_sum_y = abs64(l_vyi + l_vyj);
+    wire               l_moving = l_sum_x + l_sum_y > 64'sd2 * (l_toli > l_tolj ? l_toli : l_tolj);  // the motion is known
+    wire               l_along_x = l_sum_x >= l_sum_y;
+    wire signed [63:0] l_sx = l_sx0 + (l_both && l_moving && l_along_x ? (l_rchyi > l_rchyj ? l_rchyi : l_rchyj) : 64'sd0);
+    wire signed [63:0] l_sy = l_sy0 + (l_both && l_moving && !l_along_x ? (l_rchxi > l_rchxj ? l_rchxi : l_rchxj) : 64'sd0);
     wire               linked = (!l_both || l_agree) && l_dx <= l_sx && l_dy <= l_sy;
     wire [SLOT_W-1:0]  keep_label = c_group[ci] < c_group[cj] ? c_group[ci] : c_group[cj];
     wire [SLOT_W-1:0]  drop_label = c_group[ci] < c_group[cj] ? c_group[cj] : c_group[ci];
@@ -328,6 +331,22 @@ module evclust_objects #(
     wire               u_born = o_t_born[oi] == t;
     wire               u_colour = o_cw[oi] != {AW{1'b0}};
     wire signed [63:0] u_gcol = o_class[oi][7] ? ONE_G : g_col;  // the first colour as it is
+    wire [31:0]        u_unseen = t - o_t_seen[oi];
+    wire signed [63:0] u_seen_us = $signed({32'd0, u_unseen}) > DT_MAX ? DT_MAX : $signed({32'd0, u_unseen});
+    // 2^-ceil(log2 Δ) in the gains' format, from the bit length of Δ's raw value minus one.
+    function automatic signed [63:0] rate_bound;
+        input signed [63:0] v;  // Δ, raw, >= 1
+        integer b, n;
+        reg [63:0] x;
+        begin
+            x = v - 64'sd1;
+            n = 0;
+            for (b = 0; b < 64; b = b + 1)
+                if (x[b])
+                    n = b + 1;
+            rate_bound = 64'sd1 <<< (FG + FT - n);
+        end
+    endfunction
     reg  signed [63:0] ex, ey, rate_x, rate_y;
     // MERGE: object oi inside object oj.
     wire               m_inside = oj != oi && o_valid[oj] && o_id[oj] < o_id[oi]
@@ -365,35 +384,31 @@ module evclust_objects #(
         mul_b = 64'sd0;
         case (state)
             S_DT: begin mul_a = dt; mul_b = K_INV_T_FRAME; end
-            S_GAIN: begin
-                mul_a = dtf;
-                case (sub)
-                    4'd0: mul_b = K_INV_TRACK;
-                    4'd1: mul_b = K_INV_RATE;
-                    4'd2: begin mul_a = g_rate; mul_b = K_INV_RATE; end  // g_rate holds min(dtf/T_rate, 1) here
-                    4'd3: mul_b = K_INV_VELOCITY;
-                    4'd4: mul_b = K_INV_SIZE;
-                    default: mul_b = K_INV_COLOUR;
-                endcase
-            end
-            S_PREDICT: begin mul_a = sub == 4'd0 ? o_vxs : o_vys; mul_b = dtf; end
+            S_PREDICT: begin mul_a = sub == 5'd0 ? o_vxs : o_vys; mul_b = dtf; end
             S_PREP: case (sub)
-                4'd0: begin mul_a = K_V_REL; mul_b = abs64(sv64(c_vx[ci])) + abs64(sv64(c_vy[ci])); end
-                4'd1: begin mul_a = K_LINK; mul_b = {{(64 - RW){1'b0}}, c_rx[ci]}; end
+                5'd0: begin mul_a = K_V_REL; mul_b = abs64(sv64(c_vx[ci])) + abs64(sv64(c_vy[ci])); end
+                5'd1: begin mul_a = K_LINK; mul_b = {{(64 - RW){1'b0}}, c_rx[ci]}; end
                 default: begin mul_a = K_LINK; mul_b = {{(64 - RW){1'b0}}, c_ry[ci]}; end
             endcase
             S_UPDATE: case (sub)
-                4'd0: begin mul_a = g_pos; mul_b = u_zx - o_xs; end
-                4'd1: begin mul_a = g_pos; mul_b = u_zy - o_ys; end
-                4'd2: begin mul_a = g_rate; mul_b = ex; end
-                4'd3: begin mul_a = g_vel; mul_b = sv64(o_mvx[oi]) - o_vxs; end
-                4'd4: begin mul_a = g_rate; mul_b = ey; end
-                4'd5: begin mul_a = g_vel; mul_b = sv64(o_mvy[oi]) - o_vys; end
-                4'd6: begin mul_a = g_size; mul_b = u_hx - u_rx; end
-                4'd7: begin mul_a = g_size; mul_b = u_hy - u_ry; end
-                4'd8: begin mul_a = u_gcol; mul_b = {{(64 - CW){1'b0}}, o_mlum[oi]} - {{(64 - CW){1'b0}}, o_lum[oi]}; end
-                4'd9: begin mul_a = u_gcol; mul_b = {{(64 - CW){1'b0}}, o_mcb[oi]} - {{(64 - CW){1'b0}}, o_cb[oi]}; end
-                4'd10: begin mul_a = u_gcol; mul_b = {{(64 - CW){1'b0}}, o_mcr[oi]} - {{(64 - CW){1'b0}}, o_cr[oi]}; end
+                5'd0: begin mul_a = u_seen_us; mul_b = K_INV_T_FRAME; end
+                5'd1: begin mul_a = seen; mul_b = K_INV_TRACK; end
+                5'd2: begin mul_a = seen; mul_b = K_INV_RATE; end
+                5'd3: begin mul_a = g_rate; mul_b = K_INV_RATE; end  // g_rate holds min(Δ/T_rate, 1) here
+                5'd4: begin mul_a = seen; mul_b = K_INV_VELOCITY; end
+                5'd5: begin mul_a = seen; mul_b = K_INV_SIZE; end
+                5'd6: begin mul_a = seen; mul_b = K_INV_COLOUR; end
+                5'd7: begin mul_a = g_pos; mul_b = u_zx - o_xs; end
+                5'd8: begin mul_a = g_pos; mul_b = u_zy - o_ys; end
+                5'd9: begin mul_a = g_rate; mul_b = ex; end
+                5'd10: begin mul_a = g_vel; mul_b = sv64(o_mvx[oi]) - o_vxs; end
+                5'd11: begin mul_a = g_rate; mul_b = ey; end
+                5'd12: begin mul_a = g_vel; mul_b = sv64(o_mvy[oi]) - o_vys; end
+                5'd13: begin mul_a = g_size; mul_b = u_hx - u_rx; end
+                5'd14: begin mul_a = g_size; mul_b = u_hy - u_ry; end
+                5'd15: begin mul_a = u_gcol; mul_b = {{(64 - CW){1'b0}}, o_mlum[oi]} - {{(64 - CW){1'b0}}, o_lum[oi]}; end
+                5'd16: begin mul_a = u_gcol; mul_b = {{(64 - CW){1'b0}}, o_mcb[oi]} - {{(64 - CW){1'b0}}, o_cb[oi]}; end
+                5'd17: begin mul_a = u_gcol; mul_b = {{(64 - CW){1'b0}}, o_mcr[oi]} - {{(64 - CW){1'b0}}, o_cr[oi]}; end
                 default: begin mul_a = K_V_REL; mul_b = abs64(o_vxs) + abs64(o_vys); end
             endcase
             default: ;
@@ -412,7 +427,7 @@ module evclust_objects #(
             obj_valid <= 1'b0;
         if (rst || clear) begin
             state <= S_COLLECT;
-            sub <= 4'd0;
+            sub <= 5'd0;
             i <= 9'd0;
             j <= 9'd0;
             m <= {M_W{1'b0}};
@@ -458,28 +473,13 @@ module evclust_objects #(
                 end
                 S_DT: begin  // Δt in frames, saturated
                     dtf <= (product >>> (INV_T_FRAME_FRAC - FT)) > DTF_MAX ? DTF_MAX : (product >>> (INV_T_FRAME_FRAC - FT));
-                    sub <= 4'd0;
-                    state <= S_GAIN;
-                end
-                S_GAIN: begin  // g_pos, min(dtf/T_rate, 1), g_rate (per frame), g_vel, g_size, g_col
-                    case (sub)
-                        4'd0: g_pos <= gain_of(product);
-                        4'd1: g_rate <= gain_of(product);
-                        4'd2: g_rate <= product >>> FI;
-                        4'd3: g_vel <= gain_of(product);
-                        4'd4: g_size <= gain_of(product);
-                        default: g_col <= gain_of(product);
-                    endcase
-                    sub <= sub + 1'b1;
-                    if (sub == 4'd5) begin
-                        sub <= 4'd0;
-                        i <= 9'd0;
-                        state <= S_PREDICT;
-                    end
+                    sub <= 5'd0;
+                    i <= 9'd0;
+                    state <= S_PREDICT;
                 end
                 S_PREDICT: begin  // 1. each object moves by V·Δt; its step sums are cleared
                     if (o_valid[oi]) begin
-                        if (sub == 4'd0)
+                        if (sub == 5'd0)
                             o_x[oi] <= saturate(o_xs + (product >>> MOVE), P_MIN, P_MAX);
                         else
                             o_y[oi] <= saturate(o_ys + (product >>> MOVE), P_MIN, P_MAX);
@@ -488,14 +488,16 @@ module evclust_objects #(
                     o_claimed[oi] <= 1'b0;
                     o_owner_w[oi] <= {WW{1'b0}};
                     o_vset[oi] <= 1'b0;
+                    o_mvx[oi] <= {VW{1'b0}};  // (multiplied by a gain of 0 when no member sets it: never X)
+                    o_mvy[oi] <= {VW{1'b0}};
                     o_cw[oi] <= {AW{1'b0}};
                     o_lo_x[oi] <= P_MAX[PW-1:0];
                     o_lo_y[oi] <= P_MAX[PW-1:0];
                     o_hi_x[oi] <= P_MIN[PW-1:0];
                     o_hi_y[oi] <= P_MIN[PW-1:0];
-                    sub <= 4'd1;
-                    if (!o_valid[oi] || sub == 4'd1) begin
-                        sub <= 4'd0;
+                    sub <= 5'd1;
+                    if (!o_valid[oi] || sub == 5'd1) begin
+                        sub <= 5'd0;
                         i <= i + 1'b1;
                         if (last_object) begin
                             i <= 9'd0;
@@ -505,13 +507,13 @@ module evclust_objects #(
                 end
                 S_PREP: begin  // each cluster's velocity tolerance and link reaches
                     case (sub)
-                        4'd0: c_tol[ci] <= tol_of(product, K_V_TOL);
-                        4'd1: c_reach_x[ci] <= product >>> FS;
+                        5'd0: c_tol[ci] <= tol_of(product, K_V_TOL);
+                        5'd1: c_reach_x[ci] <= product >>> FS;
                         default: c_reach_y[ci] <= product >>> FS;
                     endcase
                     sub <= sub + 1'b1;
-                    if (sub == 4'd2) begin
-                        sub <= 4'd0;
+                    if (sub == 5'd2) begin
+                        sub <= 5'd0;
                         i <= i + 1'b1;
                         if (last_cluster) begin  // LINK from the pair (1, 0); one cluster has no pair
                             i <= m == 1 ? 9'd0 : 9'd1;
@@ -671,6 +673,8 @@ module evclust_objects #(
                                 o_members[bo] <= {M_W{1'b0}};
                                 o_owner_w[bo] <= {WW{1'b0}};
                                 o_vset[bo] <= 1'b0;
+                                o_mvx[bo] <= {VW{1'b0}};
+                                o_mvy[bo] <= {VW{1'b0}};
                                 o_cw[bo] <= {AW{1'b0}};
                                 o_lo_x[bo] <= P_MAX[PW-1:0];
                                 o_lo_y[bo] <= P_MAX[PW-1:0];
@@ -694,7 +698,7 @@ module evclust_objects #(
                         if (c_hi_x > sx64(o_hi_x[jo])) o_hi_x[jo] <= c_hi_x[PW-1:0];
                         if (c_lo_y < sx64(o_lo_y[jo])) o_lo_y[jo] <= c_lo_y[PW-1:0];
                         if (c_hi_y > sx64(o_hi_y[jo])) o_hi_y[jo] <= c_hi_y[PW-1:0];
-                        if (!o_vset[jo] || c_act[ci] > o_vw[jo]) begin
+                        if (c_meas[ci] && (!o_vset[jo] || c_act[ci] > o_vw[jo])) begin  // a measured velocity
                             o_vset[jo] <= 1'b1;
                             o_vw[jo] <= c_act[ci];
                             o_mvx[jo] <= c_vx[ci];
@@ -714,13 +718,13 @@ module evclust_objects #(
                     i <= i + 1'b1;
                     if (last_cluster) begin
                         i <= 9'd0;
-                        sub <= 4'd0;
+                        sub <= 5'd0;
                         state <= S_UPDATE;
                     end
                 end
-                S_UPDATE: begin  // 4. each object with members: the α-β filter, its size, colour, class and tolerance
+                S_UPDATE: begin  // 4. each object with members: its gains over Δ, the α-β filter, its size, colour, class and tolerance
                     if (!o_valid[oi] || o_members[oi] == {M_W{1'b0}}) begin
-                        sub <= 4'd0;
+                        sub <= 5'd0;
                         i <= i + 1'b1;
                         if (last_object) begin
                             i <= 9'd0;
@@ -728,55 +732,63 @@ module evclust_objects #(
                             state <= S_MERGE;
                         end
                     end else begin
+                        sub <= sub + 1'b1;
                         case (sub)
-                            4'd0: if (u_born) begin  // born this step: the measurement as it is
-                                o_x[oi] <= u_zx[PW-1:0];
-                                o_y[oi] <= u_zy[PW-1:0];
-                                o_rx[oi] <= u_hx[OBJ_HALF_W-1:0];
-                                o_ry[oi] <= u_hy[OBJ_HALF_W-1:0];
-                                o_vx[oi] <= o_mvx[oi];
-                                o_vy[oi] <= o_mvy[oi];
-                            end else begin
+                            5'd0: seen <= (product >>> (INV_T_FRAME_FRAC - FT)) > DTF_MAX ? DTF_MAX : (product >>> (INV_T_FRAME_FRAC - FT));
+                            5'd1: g_pos <= gain_of(product);
+                            5'd2: g_rate <= gain_of(product);
+                            5'd3: g_rate <= seen == 64'sd0 ? 64'sd0 : ((product >>> FI) < rate_bound(seen) ? (product >>> FI) : rate_bound(seen));
+                            5'd4: g_vel <= o_vset[oi] ? gain_of(product) : 64'sd0;  // no measured member: no pull
+                            5'd5: g_size <= gain_of(product);
+                            5'd6: begin
+                                g_col <= gain_of(product);
+                                if (u_born) begin  // born this step: the measurement as it is
+                                    o_x[oi] <= u_zx[PW-1:0];
+                                    o_y[oi] <= u_zy[PW-1:0];
+                                    o_rx[oi] <= u_hx[OBJ_HALF_W-1:0];
+                                    o_ry[oi] <= u_hy[OBJ_HALF_W-1:0];
+                                    if (o_vset[oi]) begin
+                                        o_vx[oi] <= o_mvx[oi];
+                                        o_vy[oi] <= o_mvy[oi];
+                                    end
+                                    sub <= u_colour ? 5'd15 : 5'd18;
+                                end
+                            end
+                            5'd7: begin
                                 ex <= u_zx - o_xs;
                                 o_x[oi] <= o_xs + (product >>> FG);
                             end
-                            4'd1: begin
+                            5'd8: begin
                                 ey <= u_zy - o_ys;
                                 o_y[oi] <= o_ys + (product >>> FG);
                             end
-                            4'd2: rate_x <= align(product, FG + FP, FV);
-                            4'd3: o_vx[oi] <= saturate(o_vxs + rate_x + (product >>> FG), V_MIN, V_MAX);
-                            4'd4: rate_y <= align(product, FG + FP, FV);
-                            4'd5: o_vy[oi] <= saturate(o_vys + rate_y + (product >>> FG), V_MIN, V_MAX);
-                            4'd6: o_rx[oi] <= u_rx + (product >>> FG);
-                            4'd7: o_ry[oi] <= u_ry + (product >>> FG);
-                            4'd8: o_lum[oi] <= {{(64 - CW){1'b0}}, o_lum[oi]} + (product >>> FG);
-                            4'd9: o_cb[oi] <= {{(64 - CW){1'b0}}, o_cb[oi]} + (product >>> FG);
-                            4'd10: begin
+                            5'd9: rate_x <= align(product, FG + FP, FV);
+                            5'd10: o_vx[oi] <= saturate(o_vxs + rate_x + (product >>> FG), V_MIN, V_MAX);
+                            5'd11: rate_y <= align(product, FG + FP, FV);
+                            5'd12: o_vy[oi] <= saturate(o_vys + rate_y + (product >>> FG), V_MIN, V_MAX);
+                            5'd13: o_rx[oi] <= u_rx + (product >>> FG);
+                            5'd14: begin
+                                o_ry[oi] <= u_ry + (product >>> FG);
+                                sub <= u_colour ? 5'd15 : 5'd18;
+                            end
+                            5'd15: o_lum[oi] <= {{(64 - CW){1'b0}}, o_lum[oi]} + (product >>> FG);
+                            5'd16: o_cb[oi] <= {{(64 - CW){1'b0}}, o_cb[oi]} + (product >>> FG);
+                            5'd17: begin
                                 o_cr[oi] <= {{(64 - CW){1'b0}}, o_cr[oi]} + (product >>> FG);
                                 o_class[oi] <= o_mclass[oi];
                             end
                             default: begin
                                 o_tol[oi] <= tol_of(product, K_V_TOL);
                                 o_t_seen[oi] <= t;
+                                sub <= 5'd0;
+                                i <= i + 1'b1;
+                                if (last_object) begin
+                                    i <= 9'd0;
+                                    j <= 9'd0;
+                                    state <= S_MERGE;
+                                end
                             end
                         endcase
-                        // The next operation: the filter's eight, or none when born; the colour's three when a member has a class.
-                        if (sub == 4'd0 && u_born)
-                            sub <= u_colour ? 4'd8 : 4'd11;
-                        else if (sub == 4'd7)
-                            sub <= u_colour ? 4'd8 : 4'd11;
-                        else
-                            sub <= sub + 1'b1;
-                        if (sub == 4'd11) begin
-                            sub <= 4'd0;
-                            i <= i + 1'b1;
-                            if (last_object) begin
-                                i <= 9'd0;
-                                j <= 9'd0;
-                                state <= S_MERGE;
-                            end
-                        end
                     end
                 end
                 S_MERGE: begin  // 5. an object inside an older one, velocities agreeing: the older absorbs it

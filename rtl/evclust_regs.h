@@ -89,41 +89,41 @@
 #define EVCLUST_CFG_MIXING_TOLERANCE_WIDTH 11u
 #define EVCLUST_CFG_SEEK_SCALE 0x170u  /* 1 bits, 1 word(s); reset 0 */
 #define EVCLUST_CFG_SEEK_SCALE_WIDTH 1u
-#define EVCLUST_CFG_MERGE_SCALE 0x174u  /* 8 bits, 1 word(s); reset 79 */
-#define EVCLUST_CFG_MERGE_SCALE_WIDTH 8u
-#define EVCLUST_CFG_MERGE_V_TOL 0x178u  /* 15 bits, 1 word(s); reset 61 */
+#define EVCLUST_CFG_MERGE_SCALE 0x174u  /* 7 bits, 1 word(s); reset 25 */
+#define EVCLUST_CFG_MERGE_SCALE_WIDTH 7u
+#define EVCLUST_CFG_MERGE_V_TOL 0x178u  /* 15 bits, 1 word(s); reset 41 */
 #define EVCLUST_CFG_MERGE_V_TOL_WIDTH 15u
-#define EVCLUST_CFG_MERGE_V_REL 0x17cu  /* 7 bits, 1 word(s); reset 5 */
+#define EVCLUST_CFG_MERGE_V_REL 0x17cu  /* 7 bits, 1 word(s); reset 10 */
 #define EVCLUST_CFG_MERGE_V_REL_WIDTH 7u
 #define EVCLUST_CFG_NOISE_GATE 0x180u  /* 1 bits, 1 word(s); reset 0 */
 #define EVCLUST_CFG_NOISE_GATE_WIDTH 1u
-#define EVCLUST_CFG_SUPPORT_WINDOW 0x184u  /* 32 bits, 1 word(s); reset 2200 */
+#define EVCLUST_CFG_SUPPORT_WINDOW 0x184u  /* 32 bits, 1 word(s); reset 6350 */
 #define EVCLUST_CFG_SUPPORT_WINDOW_WIDTH 32u
 #define EVCLUST_CFG_INV_T_FRAME 0x188u  /* 32 bits, 1 word(s); reset 85899 */
 #define EVCLUST_CFG_INV_T_FRAME_WIDTH 32u
-#define EVCLUST_CFG_OBJECT_GATE 0x18cu  /* 26 bits, 1 word(s); reset 524288 */
+#define EVCLUST_CFG_OBJECT_GATE 0x18cu  /* 26 bits, 1 word(s); reset 73400 */
 #define EVCLUST_CFG_OBJECT_GATE_WIDTH 26u
-#define EVCLUST_CFG_OBJECT_LINK_ALONG 0x190u  /* 9 bits, 1 word(s); reset 192 */
+#define EVCLUST_CFG_OBJECT_LINK_ALONG 0x190u  /* 9 bits, 1 word(s); reset 324 */
 #define EVCLUST_CFG_OBJECT_LINK_ALONG_WIDTH 9u
-#define EVCLUST_CFG_OBJECT_V_TOL 0x194u  /* 24 bits, 1 word(s); reset 19661 */
+#define EVCLUST_CFG_OBJECT_V_TOL 0x194u  /* 24 bits, 1 word(s); reset 18022 */
 #define EVCLUST_CFG_OBJECT_V_TOL_WIDTH 24u
-#define EVCLUST_CFG_OBJECT_V_REL 0x198u  /* 7 bits, 1 word(s); reset 13 */
+#define EVCLUST_CFG_OBJECT_V_REL 0x198u  /* 7 bits, 1 word(s); reset 19 */
 #define EVCLUST_CFG_OBJECT_V_REL_WIDTH 7u
-#define EVCLUST_CFG_OBJECT_INV_TRACK 0x19cu  /* 24 bits, 1 word(s); reset 1048576 */
+#define EVCLUST_CFG_OBJECT_INV_TRACK 0x19cu  /* 24 bits, 1 word(s); reset 1263345 */
 #define EVCLUST_CFG_OBJECT_INV_TRACK_WIDTH 24u
-#define EVCLUST_CFG_OBJECT_INV_RATE 0x1a0u  /* 24 bits, 1 word(s); reset 131072 */
+#define EVCLUST_CFG_OBJECT_INV_RATE 0x1a0u  /* 24 bits, 1 word(s); reset 708497 */
 #define EVCLUST_CFG_OBJECT_INV_RATE_WIDTH 24u
-#define EVCLUST_CFG_OBJECT_INV_VELOCITY 0x1a4u  /* 24 bits, 1 word(s); reset 524288 */
+#define EVCLUST_CFG_OBJECT_INV_VELOCITY 0x1a4u  /* 24 bits, 1 word(s); reset 213995 */
 #define EVCLUST_CFG_OBJECT_INV_VELOCITY_WIDTH 24u
-#define EVCLUST_CFG_OBJECT_INV_SIZE 0x1a8u  /* 24 bits, 1 word(s); reset 1048576 */
+#define EVCLUST_CFG_OBJECT_INV_SIZE 0x1a8u  /* 24 bits, 1 word(s); reset 476625 */
 #define EVCLUST_CFG_OBJECT_INV_SIZE_WIDTH 24u
-#define EVCLUST_CFG_OBJECT_INV_COLOUR 0x1acu  /* 24 bits, 1 word(s); reset 524288 */
+#define EVCLUST_CFG_OBJECT_INV_COLOUR 0x1acu  /* 24 bits, 1 word(s); reset 2330169 */
 #define EVCLUST_CFG_OBJECT_INV_COLOUR_WIDTH 24u
-#define EVCLUST_CFG_OBJECT_BIRTH_US 0x1b0u  /* 24 bits, 1 word(s); reset 25000 */
+#define EVCLUST_CFG_OBJECT_BIRTH_US 0x1b0u  /* 24 bits, 1 word(s); reset 59000 */
 #define EVCLUST_CFG_OBJECT_BIRTH_US_WIDTH 24u
-#define EVCLUST_CFG_OBJECT_COAST_US 0x1b4u  /* 24 bits, 1 word(s); reset 150000 */
+#define EVCLUST_CFG_OBJECT_COAST_US 0x1b4u  /* 24 bits, 1 word(s); reset 96500 */
 #define EVCLUST_CFG_OBJECT_COAST_US_WIDTH 24u
-#define EVCLUST_CFG_OBJECT_KEEP_US 0x1b8u  /* 24 bits, 1 word(s); reset 1500000 */
+#define EVCLUST_CFG_OBJECT_KEEP_US 0x1b8u  /* 24 bits, 1 word(s); reset 2500000 */
 #define EVCLUST_CFG_OBJECT_KEEP_US_WIDTH 24u
 #define EVCLUST_CFG_FILTER_EVERY 0x1bcu  /* 7 bits, 1 word(s); reset 64 */
 #define EVCLUST_CFG_FILTER_EVERY_WIDTH 7u

@@ -122,10 +122,12 @@ def _linked(R, i, j, C, k):
     if C[i, CL_MEASURED] != 0 and C[j, CL_MEASURED] != 0:
         if not _agree(C[i, CL_VX], C[i, CL_VY], C[i, CL_TOL], C[j, CL_VX], C[j, CL_VY], C[j, CL_TOL]):
             return False
-        if abs(C[i, CL_VX] + C[j, CL_VX]) >= abs(C[i, CL_VY] + C[j, CL_VY]):
-            sx += max(C[i, CL_REACH_Y], C[j, CL_REACH_Y])
-        else:
-            sy += max(C[i, CL_REACH_X], C[j, CL_REACH_X])
+        along_x, along_y = abs(C[i, CL_VX] + C[j, CL_VX]), abs(C[i, CL_VY] + C[j, CL_VY])
+        if along_x + along_y > 2 * max(C[i, CL_TOL], C[j, CL_TOL]):
+            if along_x >= along_y:
+                sx += max(C[i, CL_REACH_Y], C[j, CL_REACH_Y])
+            else:
+                sy += max(C[i, CL_REACH_X], C[j, CL_REACH_X])
     return dx <= sx and dy <= sy
 
 
@@ -181,26 +183,55 @@ def _join(O, o, R, i, C):
     O[o, O_HI_X] = max(O[o, O_HI_X], R[i, R_X] + R[i, R_RX])
     O[o, O_LO_Y] = min(O[o, O_LO_Y], R[i, R_Y] - R[i, R_RY])
     O[o, O_HI_Y] = max(O[o, O_HI_Y], R[i, R_Y] + R[i, R_RY])
-    if a > O[o, O_V_WEIGHT]:
+    if C[i, CL_MEASURED] != 0 and a > O[o, O_V_WEIGHT]:
         O[o, O_V_WEIGHT], O[o, O_MEMBER_VX], O[o, O_MEMBER_VY] = a, C[i, CL_VX], C[i, CL_VY]
     if R[i, R_CLASS] >= 0 and a > O[o, O_COLOUR_WEIGHT]:
         O[o, O_COLOUR_WEIGHT], O[o, O_MEMBER_CLASS] = a, R[i, R_CLASS]
         O[o, O_MEMBER_LUM], O[o, O_MEMBER_CB], O[o, O_MEMBER_CR] = R[i, R_LUM], R[i, R_CB], R[i, R_CR]
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _dt_frames(dt, k):
+    """Δt (µs, saturated) in frames, obj_dt_frames, saturated."""
+    return min((dt * k.inv_t_frame) >> (k.inv_t_frame_frac - OBJECT_DT_FRAMES_FRAC), k.dt_frames_max)
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _rate_gain(seen, k):
+    """clusterer/objects.rate_gain: min(Δ/T_rate², 2^-ceil(log2 Δ)), per frame, in obj_gain's
+    fraction bits; the power of two from the bit length of Δ's raw value."""
+    if seen == 0:
+        return np.int64(0)
+    n, x = 0, seen - 1
+    while x > 0:  # n = ceil(log2(seen)) for the raw value
+        x >>= 1
+        n += 1
+    bound = np.int64(1) << (OBJECT_GAIN_FRAC + OBJECT_DT_FRAMES_FRAC - n)
+    return min((_gain(seen, k.inv_rate) * k.inv_rate) >> OBJECT_INV_T_FRAC, bound)
+
+
 @njit(cache=True, nogil=True)
-def _update(O, o, t, gains, k, log):
-    """Step 4: g_pos, g_rate, g_vel, g_size, g_col are `gains` (obj_gain; g_rate per frame)."""
-    g_pos, g_rate, g_vel, g_size, g_col = gains[0], gains[1], gains[2], gains[3], gains[4]
+def _update(O, o, t, k, log):
+    """Step 4: the gains over Δ, the time since the object was last seen (obj_gain)."""
     down = 1 + k.fp - k.fr
     zx = (O[o, O_LO_X] + O[o, O_HI_X]) >> 1
     zy = (O[o, O_LO_Y] + O[o, O_HI_Y]) >> 1
     hx = (O[o, O_HI_X] - O[o, O_LO_X]) >> down
     hy = (O[o, O_HI_Y] - O[o, O_LO_Y]) >> down
+    seen = _dt_frames(min((t - O[o, O_T_SEEN]) & TIME_MASK, k.dt_max), k)
+    g_pos = _gain(seen, k.inv_track)
+    g_rate = _rate_gain(seen, k)
+    g_vel = _gain(seen, k.inv_velocity)
+    g_size = _gain(seen, k.inv_size)
+    g_col = _gain(seen, k.inv_colour)
+    measured = O[o, O_V_WEIGHT] >= 0
     if O[o, O_T_BORN] == t:
         O[o, O_X], O[o, O_Y], O[o, O_RX], O[o, O_RY] = zx, zy, hx, hy
-        O[o, O_VX], O[o, O_VY] = O[o, O_MEMBER_VX], O[o, O_MEMBER_VY]
+        if measured:
+            O[o, O_VX], O[o, O_VY] = O[o, O_MEMBER_VX], O[o, O_MEMBER_VY]
     else:
+        if not measured:
+            g_vel = 0
         ex = zx - O[o, O_X]
         ey = zy - O[o, O_Y]
         O[o, O_X] += (g_pos * ex) >> OBJECT_GAIN_FRAC
@@ -235,7 +266,7 @@ def cluster_velocity(R, i, k, log):
 
 
 @njit(cache=True, nogil=True)
-def object_step(O, OG, slot_obj, slot_id, R, t_full, step, k, out, n_out, C, G, gains, log):
+def object_step(O, OG, slot_obj, slot_id, R, t_full, step, k, out, n_out, C, G, log):
     """One filter step: `R` its cluster records as raw integers (RECORD_COLUMNS, slot order),
     `t_full` its whole time (the datapath counts the low 32 bits). As clusterer/objects.py's
     object_step, in the same order; writes the reported objects' records (real units) from
@@ -244,12 +275,7 @@ def object_step(O, OG, slot_obj, slot_id, R, t_full, step, k, out, n_out, C, G, 
     dt = 0 if OG[OG_STARTED] == 0 else min((t - OG[OG_T_PREV]) & TIME_MASK, k.dt_max)
     OG[OG_STARTED], OG[OG_T_PREV] = 1, t
     OG[OG_STEPS] += 1
-    dt_frames = min((dt * k.inv_t_frame) >> (k.inv_t_frame_frac - OBJECT_DT_FRAMES_FRAC), k.dt_frames_max)  # obj_dt_frames
-    gains[0] = _gain(dt_frames, k.inv_track)
-    gains[1] = (_gain(dt_frames, k.inv_rate) * k.inv_rate) >> OBJECT_INV_T_FRAC  # per frame
-    gains[2] = _gain(dt_frames, k.inv_velocity)
-    gains[3] = _gain(dt_frames, k.inv_size)
-    gains[4] = _gain(dt_frames, k.inv_colour)
+    dt_frames = _dt_frames(dt, k)
     n_objects = O.shape[0]
     move = OBJECT_DT_FRAMES_FRAC + k.fv - k.fp  # V·Δt has F_V + F_DT fraction bits; the centre F_P
     for o in range(n_objects):  # 1. predict
@@ -338,7 +364,7 @@ def object_step(O, OG, slot_obj, slot_id, R, t_full, step, k, out, n_out, C, G, 
         slot_obj[s], slot_id[s] = o, R[i, R_ID]
     for o in range(n_objects):  # 4. update
         if O[o, O_VALID] != 0 and O[o, O_MEMBERS] > 0:
-            _update(O, o, t, gains, k, log)
+            _update(O, o, t, k, log)
     for o in range(n_objects):  # 5. merge
         if O[o, O_VALID] == 0 or O[o, O_MEMBERS] == 0:
             continue
@@ -387,7 +413,7 @@ def object_step(O, OG, slot_obj, slot_id, R, t_full, step, k, out, n_out, C, G, 
 
 
 @njit(cache=True, nogil=True)
-def run_steps(O, OG, slot_obj, slot_id, raw, steps, first_step, k, out, C, G, gains, log):
+def run_steps(O, OG, slot_obj, slot_id, raw, steps, first_step, k, out, C, G, log):
     """Every filter step of a chunk: `steps[i]` is the whole time of step first_step + i, `raw`
     the chunk's cluster records as raw integers in step order. Returns the number of object records."""
     n_out = 0
@@ -397,7 +423,7 @@ def run_steps(O, OG, slot_obj, slot_id, raw, steps, first_step, k, out, C, G, ga
         lo = r
         while r < raw.shape[0] and raw[r, R_STEP] == step:
             r += 1
-        n_out = object_step(O, OG, slot_obj, slot_id, raw[lo:r].copy(), steps[i], step, k, out, n_out, C, G, gains, log)
+        n_out = object_step(O, OG, slot_obj, slot_id, raw[lo:r].copy(), steps[i], step, k, out, n_out, C, G, log)
     return n_out
 
 
@@ -424,7 +450,6 @@ class FixedObjects:
         self.slot_object = np.full(n, -1, dtype=np.int64)
         self.slot_id = np.full(n, -1, dtype=np.int64)
         self.scratch = (np.zeros((n, CLUSTER_SCRATCH_COLUMNS), np.int64), np.zeros((n, GROUP_SCRATCH_COLUMNS), np.int64))
-        self.gains = np.zeros(5, dtype=np.int64)
         self.overflow = np.zeros(len(OBJECT_SIGNALS), dtype=np.int64)
         self.first_step = 0
 
@@ -438,7 +463,7 @@ class FixedObjects:
     def feed(self, rows: np.ndarray, steps: np.ndarray) -> np.ndarray:
         out = np.empty((steps.size * self.objects.shape[0], OBJECT_RECORD_COLUMNS))
         n = run_steps(self.objects, self.globals, self.slot_object, self.slot_id, self.raw_records(rows),
-                      np.asarray(steps, np.int64), self.first_step, self.k, out, *self.scratch, self.gains, self.overflow)  # fmt: skip
+                      np.asarray(steps, np.int64), self.first_step, self.k, out, *self.scratch, self.overflow)  # fmt: skip
         self.first_step += steps.size
         return out[:n]
 
