@@ -314,11 +314,9 @@ module evclust_objects #(
     reg  signed [63:0] best_d;     // its distance (INSIDE, GATE)
     reg  [31:0]        lost_for;   // FREE: how long the lost object found has been unseen
     reg                creating;   // TAKE: `best` is a slot to create the object in
-    reg                evicting;   // ... in place of a lost object
     wire               s_match = scan == SCAN_INSIDE ? s_inside : s_gate;
     wire               s_better = s_match && (best[OIDX_W-1] || s_d < best_d);
     wire               s_lost = o_valid[oj] && o_conf[oj] && s_unseen > K_COAST && (best[OIDX_W-1] || s_unseen > lost_for);
-    wire [OSLOT_W-1:0] last_obj = K[OSLOT_W-1:0] - 1'b1;
 
     // JOIN: cluster ci into object jo.
     wire [OIDX_W-1:0]  jo_idx = g_obj[c_group[ci]];
@@ -415,10 +413,24 @@ module evclust_objects #(
         endcase
     end
 
+    // The stores' values, each in its register's width (the datapath computes in 64 bits).
+    wire signed [63:0] next_pred_x = saturate(o_xs + (product >>> MOVE), P_MIN, P_MAX);
+    wire signed [63:0] next_pred_y = saturate(o_ys + (product >>> MOVE), P_MIN, P_MAX);
+    wire signed [63:0] next_tol = tol_of(product, K_V_TOL);
+    wire signed [63:0] next_reach = product >>> FS;
+    wire signed [63:0] next_x = o_xs + (product >>> FG), next_y = o_ys + (product >>> FG);
+    wire signed [63:0] next_vx = saturate(o_vxs + rate_x + (product >>> FG), V_MIN, V_MAX);
+    wire signed [63:0] next_vy = saturate(o_vys + rate_y + (product >>> FG), V_MIN, V_MAX);
+    wire signed [63:0] next_rx = u_rx + (product >>> FG), next_ry = u_ry + (product >>> FG);
+    wire signed [63:0] next_lum = {{(64 - CW){1'b0}}, o_lum[oi]} + (product >>> FG);
+    wire signed [63:0] next_cb = {{(64 - CW){1'b0}}, o_cb[oi]} + (product >>> FG);
+    wire signed [63:0] next_cr = {{(64 - CW){1'b0}}, o_cr[oi]} + (product >>> FG);
+
     // ---------------------------------------------------------------- the sequence
     wire last_cluster = i + 9'd1 >= {{(9 - M_W){1'b0}}, m};
-    wire last_object = i + 9'd1 >= K;
-    wire scan_last = j + 9'd1 >= K;
+    wire last_object = {23'd0, i} + 32'd1 >= K;
+    wire scan_last = {23'd0, j} + 32'd1 >= K;
+    wire [SLOT_W-1:0] mi = m[SLOT_W-1:0];  // the next cluster's index (m < N while collecting)
     wire out_free = !obj_valid || obj_ready;
     wire [OSLOT_W-1:0] bo = best[OSLOT_W-1:0];
     integer q;
@@ -445,22 +457,22 @@ module evclust_objects #(
         end else begin
             case (state)
                 S_COLLECT: begin  // the step's records as they pass; at its end, Δt (saturated)
-                    if (take_rec && m < N) begin
-                        c_slot[m] <= in_slot;
-                        c_id[m] <= rec_data[REC_ID_LSB +: 32];
-                        c_x[m] <= {{(PW - REC_X_W){1'b0}}, rec_data[REC_X_LSB +: REC_X_W]};
-                        c_y[m] <= {{(PW - REC_Y_W){1'b0}}, rec_data[REC_Y_LSB +: REC_Y_W]};
-                        c_rx[m] <= in_rx[RW-1:0];
-                        c_ry[m] <= in_ry[RW-1:0];
-                        c_act[m] <= rec_data[REC_ACTIVITY_LSB +: AW];
-                        c_vx[m] <= in_vx[VW-1:0];
-                        c_vy[m] <= in_vy[VW-1:0];
-                        c_meas[m] <= in_meas;
-                        c_class[m] <= rec_data[REC_CLASS_LSB +: 8];
-                        c_lum[m] <= rec_data[REC_LUM_LSB +: CW];
-                        c_cb[m] <= rec_data[REC_CB_LSB +: CW];
-                        c_cr[m] <= rec_data[REC_CR_LSB +: CW];
-                        c_group[m] <= m[SLOT_W-1:0];
+                    if (take_rec && {{(32 - M_W){1'b0}}, m} < N) begin
+                        c_slot[mi] <= in_slot;
+                        c_id[mi] <= rec_data[REC_ID_LSB +: 32];
+                        c_x[mi] <= {{(PW - REC_X_W){1'b0}}, rec_data[REC_X_LSB +: REC_X_W]};
+                        c_y[mi] <= {{(PW - REC_Y_W){1'b0}}, rec_data[REC_Y_LSB +: REC_Y_W]};
+                        c_rx[mi] <= in_rx[RW-1:0];
+                        c_ry[mi] <= in_ry[RW-1:0];
+                        c_act[mi] <= rec_data[REC_ACTIVITY_LSB +: AW];
+                        c_vx[mi] <= in_vx[VW-1:0];
+                        c_vy[mi] <= in_vy[VW-1:0];
+                        c_meas[mi] <= in_meas;
+                        c_class[mi] <= rec_data[REC_CLASS_LSB +: 8];
+                        c_lum[mi] <= rec_data[REC_LUM_LSB +: CW];
+                        c_cb[mi] <= rec_data[REC_CB_LSB +: CW];
+                        c_cr[mi] <= rec_data[REC_CR_LSB +: CW];
+                        c_group[mi] <= mi;
                         m <= m + 1'b1;
                     end
                     if (take_step) begin
@@ -480,9 +492,9 @@ module evclust_objects #(
                 S_PREDICT: begin  // 1. each object moves by V·Δt; its step sums are cleared
                     if (o_valid[oi]) begin
                         if (sub == 5'd0)
-                            o_x[oi] <= saturate(o_xs + (product >>> MOVE), P_MIN, P_MAX);
+                            o_x[oi] <= next_pred_x[PW-1:0];
                         else
-                            o_y[oi] <= saturate(o_ys + (product >>> MOVE), P_MIN, P_MAX);
+                            o_y[oi] <= next_pred_y[PW-1:0];
                     end
                     o_members[oi] <= {M_W{1'b0}};
                     o_claimed[oi] <= 1'b0;
@@ -507,9 +519,9 @@ module evclust_objects #(
                 end
                 S_PREP: begin  // each cluster's velocity tolerance and link reaches
                     case (sub)
-                        5'd0: c_tol[ci] <= tol_of(product, K_V_TOL);
-                        5'd1: c_reach_x[ci] <= product >>> FS;
-                        default: c_reach_y[ci] <= product >>> FS;
+                        5'd0: c_tol[ci] <= next_tol[TW-1:0];
+                        5'd1: c_reach_x[ci] <= next_reach[REACH_W-1:0];
+                        default: c_reach_y[ci] <= next_reach[REACH_W-1:0];
                     endcase
                     sub <= sub + 1'b1;
                     if (sub == 5'd2) begin
@@ -541,7 +553,7 @@ module evclust_objects #(
                     if (i == 9'd0)
                         for (q = 0; q < N; q = q + 1) begin
                             g_obj[q] <= {OIDX_W{1'b1}};
-                            if (q != gg) begin
+                            if (q[SLOT_W-1:0] != gg) begin
                                 g_weight[q] <= {WW{1'b0}};
                                 g_vset[q] <= 1'b0;
                                 g_prefw[q] <= {AW{1'b0}};
@@ -618,7 +630,6 @@ module evclust_objects #(
                             if (scan_last) begin
                                 j <= 9'd0;
                                 creating <= 1'b0;
-                                evicting <= 1'b0;
                                 lost_for <= 32'd0;
                                 if (!best[OIDX_W-1] || s_better)
                                     scan <= SCAN_TAKE;
@@ -631,7 +642,6 @@ module evclust_objects #(
                             if (!o_valid[oj]) begin
                                 best <= {1'b0, oj};
                                 creating <= 1'b1;
-                                evicting <= 1'b0;
                                 j <= 9'd0;
                                 scan <= SCAN_TAKE;
                             end else begin
@@ -641,8 +651,7 @@ module evclust_objects #(
                                 end
                                 if (scan_last) begin
                                     j <= 9'd0;
-                                    creating <= !best[OIDX_W-1] || s_lost;
-                                    evicting <= !best[OIDX_W-1] || s_lost;
+                                    creating <= !best[OIDX_W-1] || s_lost;  // in place of a lost object
                                     scan <= SCAN_TAKE;
                                 end
                             end
@@ -756,29 +765,29 @@ module evclust_objects #(
                             end
                             5'd7: begin
                                 ex <= u_zx - o_xs;
-                                o_x[oi] <= o_xs + (product >>> FG);
+                                o_x[oi] <= next_x[PW-1:0];
                             end
                             5'd8: begin
                                 ey <= u_zy - o_ys;
-                                o_y[oi] <= o_ys + (product >>> FG);
+                                o_y[oi] <= next_y[PW-1:0];
                             end
                             5'd9: rate_x <= align(product, FG + FP, FV);
-                            5'd10: o_vx[oi] <= saturate(o_vxs + rate_x + (product >>> FG), V_MIN, V_MAX);
+                            5'd10: o_vx[oi] <= next_vx[VW-1:0];
                             5'd11: rate_y <= align(product, FG + FP, FV);
-                            5'd12: o_vy[oi] <= saturate(o_vys + rate_y + (product >>> FG), V_MIN, V_MAX);
-                            5'd13: o_rx[oi] <= u_rx + (product >>> FG);
+                            5'd12: o_vy[oi] <= next_vy[VW-1:0];
+                            5'd13: o_rx[oi] <= next_rx[OBJ_HALF_W-1:0];
                             5'd14: begin
-                                o_ry[oi] <= u_ry + (product >>> FG);
+                                o_ry[oi] <= next_ry[OBJ_HALF_W-1:0];
                                 sub <= u_colour ? 5'd15 : 5'd18;
                             end
-                            5'd15: o_lum[oi] <= {{(64 - CW){1'b0}}, o_lum[oi]} + (product >>> FG);
-                            5'd16: o_cb[oi] <= {{(64 - CW){1'b0}}, o_cb[oi]} + (product >>> FG);
+                            5'd15: o_lum[oi] <= next_lum[CW-1:0];
+                            5'd16: o_cb[oi] <= next_cb[CW-1:0];
                             5'd17: begin
-                                o_cr[oi] <= {{(64 - CW){1'b0}}, o_cr[oi]} + (product >>> FG);
+                                o_cr[oi] <= next_cr[CW-1:0];
                                 o_class[oi] <= o_mclass[oi];
                             end
                             default: begin
-                                o_tol[oi] <= tol_of(product, K_V_TOL);
+                                o_tol[oi] <= next_tol[TW-1:0];
                                 o_t_seen[oi] <= t;
                                 sub <= 5'd0;
                                 i <= i + 1'b1;

@@ -47,6 +47,7 @@ SWITCHES: dict[str, dict[str, dict]] = {
     "merge": {"nomerge": {"merge": False}, "merge": {"merge": True}},
     "seek": {"noseek": {"seek_scale": 0.0}, "seek": {"seek_scale": 0.09375}},
     "gate": {"nogate": {"noise_gate": 0.0}, "gate": {"noise_gate": 16.0}},
+    "objects": {"noobjects": {"objects": False}, "objects": {"objects": True}},
 }  # fmt: skip
 
 # The parameters every row shares: the small configuration's (tb/cosim.py), with the background
@@ -145,22 +146,22 @@ def cover_stream(seed: int, count: int) -> np.ndarray:
     return events
 
 
-def model_run(row: Row, events: np.ndarray) -> tuple[list[int], dict]:
-    """The fixed model's record words and status counters for a row on a stream."""
+def model_run(row: Row, events: np.ndarray) -> tuple[list[int], list[int], dict]:
+    """The fixed model's record words, object record words and status counters for a row on a stream."""
     from evclust.fixed.model import FixedClusterer
     from evclust.fixed.registers import model_counters
     from evclust.vectors.write import model_words
 
     model = FixedClusterer(row_params(row), WIDTH, HEIGHT, T_FRAME_US)
-    _, records, _ = model_words(model, events)
-    return records, model_counters(model.stats(), len(records))
+    words = model_words(model, events)
+    return words.records, words.objects, model_counters(model.stats(), len(words.records))
 
 
 def dead_switches(row: Row, events: np.ndarray) -> list[str]:
-    """The switch settings that flipping alone leaves the row's records unchanged on this stream."""
-    records, _ = model_run(row, events)
+    """The switch settings that flipping alone leaves the row's records (cluster and object records) unchanged on this stream."""
+    records, objects, _ = model_run(row, events)
     return [f"{switch}={value}" for switch, values in SWITCHES.items() for value in values
-            if value != row.values[switch] and model_run(row.flipped(switch, value), events)[0] == records]  # fmt: skip
+            if value != row.values[switch] and model_run(row.flipped(switch, value), events)[:2] == (records, objects)]  # fmt: skip
 
 
 COUNT = 3000  # events per row's stream
@@ -176,7 +177,7 @@ def live_stream(row: Row, count: int = COUNT, tries: int = TRIES) -> tuple[int, 
     tried = []
     for seed in range(base, base + tries):
         events = cover_stream(seed, count)
-        records, counters = model_run(row, events)
+        records, _, counters = model_run(row, events)
         dead = dead_switches(row, events) if records else ["(no records)"]
         if not dead:
             return seed, counters

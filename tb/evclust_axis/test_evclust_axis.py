@@ -39,8 +39,8 @@ if cocotb is not None:
 
     @cocotb.test()
     async def axis_stream(dut):
-        """Random events through the AXI4-Stream ports with random pauses; records, trace and
-        counters against the fixed model, bit for bit."""
+        """Random events through the AXI4-Stream ports with random pauses; cluster records, object
+        records, trace and counters against the fixed model, bit for bit."""
         config = json.loads(os.environ["EVCLUST_TB"])
         try:
             error, stats = await _axis_stream(dut, config)
@@ -55,8 +55,8 @@ if cocotb is not None:
         from evclust.clusterer import ClustererParams
         from evclust.fixed.model import FixedClusterer
         from evclust.fixed.registers import COUNTERS, counter_address, model_counters
-        from evclust.vectors.pack import event_fields, record_fields
-        from evclust.vectors.scoreboard import first_mismatch
+        from evclust.vectors.pack import event_fields, object_fields, record_fields
+        from evclust.vectors.scoreboard import first_mismatch, first_object_mismatch
         from evclust.vectors.stimulus import random_stream
         from evclust.vectors.write import model_words
 
@@ -64,16 +64,18 @@ if cocotb is not None:
         params = ClustererParams(**config["parameters"])
         width, height, t_frame = config["width"], config["height"], config["t_frame_us"]
         model = FixedClusterer(params, width, height, t_frame)
-        events, expected, expected_trace = model_words(model, random_stream(config["seed"], config["count"], width, height, t_frame))
+        events, expected, expected_trace, expected_objects = model_words(model, random_stream(config["seed"], config["count"], width, height, t_frame))
 
         source = AxiStreamSource(AxiStreamBus.from_prefix(dut, "s_axis_event"), dut.clk, dut.rst)
         sink = AxiStreamSink(AxiStreamBus.from_prefix(dut, "m_axis_record"), dut.clk, dut.rst)
+        object_sink = AxiStreamSink(AxiStreamBus.from_prefix(dut, "m_axis_object"), dut.clk, dut.rst)
         registers = AxiLiteMaster(AxiLiteBus.from_prefix(dut, "s_axil"), dut.clk, dut.rst)
         source.set_pause_generator(_pauses(config["seed"], config["pause"]))
         sink.set_pause_generator(_pauses(config["seed"] + 1, config["pause"]))
+        object_sink.set_pause_generator(_pauses(config["seed"] + 2, config["pause"]))
 
-        # Monitor: each trace word, and each record as it is taken with the events traced so far.
-        trace, records, tags = [], [], []
+        # Monitor: each trace word, and each record and object record as it is taken with the events traced so far.
+        trace, records, tags, objects, object_tags = [], [], [], [], []
 
         async def monitor():
             while True:
@@ -83,6 +85,9 @@ if cocotb is not None:
                 if int(dut.m_axis_record_tvalid.value) and int(dut.m_axis_record_tready.value):
                     records.append(int(dut.m_axis_record_tdata.value))
                     tags.append(len(trace))
+                if int(dut.m_axis_object_tvalid.value) and int(dut.m_axis_object_tready.value):
+                    objects.append(int(dut.m_axis_object_tdata.value))
+                    object_tags.append(len(trace))
 
         dut.rst.value = 1
         await ClockCycles(dut.clk, 4)
@@ -93,19 +98,23 @@ if cocotb is not None:
             await source.send(word.to_bytes(ev_bytes, "little"))
         bound = 1000 + len(events) * 64  # cycles: pauses on both sides, every filter step
         await with_timeout(source.wait(), bound * CLOCK_NS, "ns")
-        while len(trace) < len(events) or len(records) < len(expected):
+        while len(trace) < len(events) or len(records) < len(expected) or len(objects) < len(expected_objects):
             await RisingEdge(dut.clk)
             bound -= 1
             if bound < 0:
-                return f"no progress: {len(trace)} of {len(events)} events traced, {len(records)} of {len(expected)} records", {}
+                return (f"no progress: {len(trace)} of {len(events)} events traced, {len(records)} of {len(expected)} records, "
+                        f"{len(objects)} of {len(expected_objects)} object records"), {}
         await ClockCycles(dut.clk, 4)  # a record more than the model's would show here
         while not sink.empty():
             sink.recv_nowait()
+        while not object_sink.empty():
+            object_sink.recv_nowait()
         counters = {name: await registers.read_dword(counter_address(name)) for name in COUNTERS}
         error = first_mismatch("axis stream", events, event_fields(model.table), expected_trace, trace,
                                record_fields(model.table), expected, records, tags)  # fmt: skip
+        error = error or first_object_mismatch("axis stream", object_fields(model.table), expected_objects, objects, object_tags)
         error = error or (None if counters == model_counters(model.stats(), len(expected)) else f"counters: RTL {counters}")
-        return error, {"events": len(trace), "records": len(records), "counters": counters}
+        return error, {"events": len(trace), "records": len(records), "objects": len(objects), "counters": counters}
 
 
 # ------------------------------------------------------------------------------------------
@@ -120,4 +129,5 @@ def test_events_and_records_over_axi4_stream_with_random_pauses_match_the_model(
     result = run(sim, header, "axis_stream", config, toplevel="evclust_axis")
     assert result["events"] == 3000
     assert result["records"] > 0, "a stream that reports nothing checks little"
+    assert result["objects"] > 0, "nor one without objects"
     assert result["counters"]["events"] == 3000

@@ -282,7 +282,7 @@ if cocotb is not None:
     @cocotb.test()
     async def serve(dut):
         """The RTL as a clusterer model (evclust.rtl.session): batches of event words in over a
-        named pipe, record words back, the status counters at the end. No model here: the
+        named pipe, record words and object record words back, the status counters at the end. No model here: the
         caller's own tests compare it with the fixed model."""
         import numpy as np
 
@@ -300,8 +300,10 @@ if cocotb is not None:
                 words = [int(w) for w in np.load(line.strip()).tolist()]
                 _, records, _ = await harness.stream(words, 1, 0, 0, config["n_clusters"])
                 out = line.strip()[: -len(".npy")] + "-records.npy"
+                objects = line.strip()[: -len(".npy")] + "-objects.npy"
                 np.save(out, np.array([str(r) for r in records]))
-                answers.write(out + "\n")
+                np.save(objects, np.array([str(r) for r in harness.objects]))
+                answers.write(f"{out} {objects}\n")
                 answers.flush()
         _finish(config, {"error": None})
 

@@ -56,10 +56,10 @@ def test_the_papers_configuration_matches_the_model_in_the_loop(sim, n_clusters)
 
 def test_the_cover_holds_every_pair_of_switch_values():
     rows = cover()
-    assert len(all_pairs()) == 217  # two three-valued switches and eight two-valued ones
+    assert len(all_pairs()) == 261  # two three-valued switches and nine two-valued ones
     assert pairs(rows) == all_pairs()
     # A pairwise cover needs at least 3 × 3 rows (the two three-valued switches); all
-    # 3 × 3 × 2^8 = 2,304 combinations would be exhaustive.
+    # 3 × 3 × 2^9 = 4,608 combinations would be exhaustive.
     assert 9 <= len(rows) <= 12
     assert len({row.name for row in rows}) == len(rows)
     from evclust.clusterer import load_params
@@ -79,7 +79,7 @@ def test_a_stream_that_reports_nothing_exercises_no_switch():
     import switch_cover
 
     row = cover()[0]
-    assert switch_cover.model_run(row, cover_stream(1, 5))[0] == []
+    assert switch_cover.model_run(row, cover_stream(1, 5))[:2] == ([], [])
     assert len(switch_cover.dead_switches(row, cover_stream(1, 5))) == sum(len(v) - 1 for v in SWITCHES.values())
     with pytest.raises(AssertionError, match=f"{row.name}: none of 3 streams exercises every switch"):
         switch_cover.live_stream.__wrapped__(row, count=5, tries=3)
@@ -120,3 +120,5 @@ def test_switch_cover_row_matches_the_model_in_the_loop(sim, row, tmp_path):
         assert expected["merges"] > 0
     if params.create_support:
         assert expected["unsupported"] > 0
+    if params.objects:
+        assert result["objects"] > 0

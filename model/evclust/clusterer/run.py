@@ -38,8 +38,11 @@ class TrackRun:
     def summary(self) -> str:
         s = self.stats
         rate = s["events"] / self.wall_s if self.wall_s > 0 else float("inf")
-        objects = (f", {s['object_records']} object records ({s['objects_confirmed']} objects confirmed of "
-                   f"{s['objects_created']} created)") if "object_records" in s else ""  # fmt: skip
+        objects = ""
+        if "object_records" in s:
+            objects = f", {s['object_records']} object records"
+            if "objects_created" in s:
+                objects += f" ({s['objects_confirmed']} objects confirmed of {s['objects_created']} created)"
         return (
             f"{s['events']} events, {s['steps']} filter steps, {s['records']} cluster records{objects}, "
             f"{s['created']} clusters created ({s['evicted']} by eviction), {s['dropped']} events dropped, "

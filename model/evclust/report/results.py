@@ -13,6 +13,7 @@ from evclust.errors import atomic_output
 from evclust.metrics import DEFAULT_GATE_PX, match_with_counts
 from evclust.metrics.scores import class_correct, score, scores_from_matches
 from evclust.render.plots import plot_colour, plot_velocity
+from evclust.tracks import VELOCITY_METHODS
 from evclust.scenes import load_scene
 from evclust.scenes.truth import truth_array
 from evclust.simulator import simulate_scene
@@ -34,19 +35,28 @@ def _better(*values):
     return min(known) if known else None
 
 
+def _methods(d: dict) -> list[str]:
+    """The velocity methods a score dict holds (mcm and interval for cluster records, object for object records)."""
+    return [m for m in ("object", "mcm", "interval") if m in d]
+
+
 TARGETS = (
-    ("velocity NRMSE, better method", lambda d: _better(d["mcm"]["nrmse"], d["interval"]["nrmse"]), 0.15, True),
-    ("mean angular error, better method (°)", lambda d: _better(d["mcm"]["angular_deg"], d["interval"]["angular_deg"]), 15.0, True),
+    ("velocity NRMSE, better method", lambda d: _better(*(d[m]["nrmse"] for m in _methods(d))), 0.15, True),
+    ("mean angular error, better method (°)", lambda d: _better(*(d[m]["angular_deg"] for m in _methods(d))), 15.0, True),
     ("chrominance NRMSE", lambda d: d["chrominance"]["nrmse"], 0.03, True),
     ("luminance NRMSE", lambda d: d["luminance"]["nrmse"], 0.12, True),
     ("palette classification", lambda d: d["class_palette_accuracy"], 0.95, False),
 )
 
 
-# The task metrics compared between models: (label, path in the score dict).
+# The task metrics compared between models: (label, path in the score dict); the velocity rows
+# are each method the records have.
+VELOCITY_AGREEMENT = {
+    "object": (("object velocity NRMSE", ("object", "nrmse")), ("object angular error", ("object", "angular_deg"))),
+    "mcm": (("MCM velocity NRMSE", ("mcm", "nrmse")), ("MCM angular error", ("mcm", "angular_deg"))),
+    "interval": (("interval velocity NRMSE", ("interval", "nrmse")), ("interval angular error", ("interval", "angular_deg"))),
+}
 AGREEMENT_METRICS = (
-    ("MCM velocity NRMSE", ("mcm", "nrmse")), ("MCM angular error", ("mcm", "angular_deg")),
-    ("interval velocity NRMSE", ("interval", "nrmse")), ("interval angular error", ("interval", "angular_deg")),
     ("position RMSE", ("position_rmse_px",)), ("luminance NRMSE", ("luminance", "nrmse")),
     ("chrominance NRMSE", ("chrominance", "nrmse")), ("classification, direct", ("class_direct_accuracy",)),
     ("classification, palette", ("class_palette_accuracy",)), ("recall", ("recall",)), ("precision", ("precision",)),
@@ -73,15 +83,17 @@ def prepare_scene(name: str) -> PreparedScene:
 
 
 def model_agreement(p: PreparedScene) -> dict:
-    """Fixed against float on one scene: each metric's relative difference, the filter steps
-    reporting the same objects (records paired by position within 2 px), the centre difference."""
+    """Fixed against float on one scene, on what the runs report (object records with an object
+    layer): each metric's relative difference, the filter steps reporting the same objects
+    (records paired by position within 2 px), the centre difference."""
     from scipy.optimize import linear_sum_assignment
 
     truth = p.truth
     runs = {"float": p.float_run, "fixed": track_events(p.sim.events, p.sim.meta, p.params, model="fixed")}
-    scores = {m: score(r.tracks, r.meta, truth).to_dict() for m, r in runs.items()}
+    scores = {m: score(*r.output, truth).to_dict() for m, r in runs.items()}
     rows = []
-    for label, path in AGREEMENT_METRICS:
+    metrics = tuple(row for m in _methods(scores["float"]) for row in VELOCITY_AGREEMENT[m]) + AGREEMENT_METRICS
+    for label, path in metrics:
         a, b = scores["float"], scores["fixed"]
         for key in path:
             a, b = a[key], b[key]
@@ -89,7 +101,7 @@ def model_agreement(p: PreparedScene) -> dict:
         rows.append((label, a, b, rel))
     steps = {}
     for m, r in runs.items():
-        for row in r.tracks:
+        for row in r.output[0]:
             steps.setdefault(int(row["step"]), {}).setdefault(m, []).append((row["x"], row["y"]))
     same, dist = 0, []
     for pair in steps.values():
@@ -103,7 +115,8 @@ def model_agreement(p: PreparedScene) -> dict:
                 continue
             dist.extend(cost[i, j])
         same += 1
-    return {"rows": rows, "same_steps": same / max(len(steps), 1), "centre_median": float(np.median(dist)) if dist else None,
+    return {"rows": rows, "labels": [label for label, _ in metrics], "same_steps": same / max(len(steps), 1),
+            "centre_median": float(np.median(dist)) if dist else None,
             "centre_max": float(np.max(dist)) if dist else None, "saturations": runs["fixed"].stats["saturations"]}  # fmt: skip
 
 
@@ -118,16 +131,18 @@ def configuration_table(prepared: list[PreparedScene]) -> list[str]:
              "on the generalization suite's tuning split: [GENERALIZATION.md](GENERALIZATION.md)) and the `paper` "
              "preset (the paper's algorithm and Table 4/6 traffic values), all visible objects. The defaults have no "
              "prior knowledge of the scene: their palette is the generic one, their background colour is learnt.", "",
-             "| scene | configuration | velocity NRMSE MCM / interval | angular error MCM / interval | position RMSE (px) "
+             "| scene | configuration | records | velocity NRMSE (method) | angular error | position RMSE (px) "
              "| luminance / chrominance NRMSE | palette classification | recall / precision |",
-             "|---|---|---:|---:|---:|---:|---:|---:|"]  # fmt: skip
+             "|---|---|---|---:|---:|---:|---:|---:|---:|"]  # fmt: skip
     for p in prepared:
         for label, params in configs:
             run = p.float_run if params is None else track_events(p.sim.events, p.sim.meta, params)
-            d = score(run.tracks, run.meta, p.truth).to_dict()
+            records, meta = run.output
+            d = score(records, meta, p.truth).to_dict()
+            velocity = " / ".join(f"{_pct(d[m]['nrmse'])} ({m})" for m in _methods(d))
+            angle = " / ".join(f"{_num(d[m]['angular_deg'], 1)}°" for m in _methods(d))
             lines.append(
-                f"| {p.name} | {label} | {_pct(d['mcm']['nrmse'])} / {_pct(d['interval']['nrmse'])} "
-                f"| {_num(d['mcm']['angular_deg'], 1)}° / {_num(d['interval']['angular_deg'], 1)}° | {_num(d['position_rmse_px'])} "
+                f"| {p.name} | {label} | {meta.kind} | {velocity} | {angle} | {_num(d['position_rmse_px'])} "
                 f"| {_pct(d['luminance']['nrmse'])} / {_pct(d['chrominance']['nrmse'])} | {_pct(d['class_palette_accuracy'])} "
                 f"| {_pct(d['recall'])} / {_pct(d['precision'])} |"
             )  # fmt: skip
@@ -139,11 +154,11 @@ def agreement_table(prepared: list[PreparedScene]) -> list[str]:
     names = [p.name for p in prepared]
     results = {p.name: model_agreement(p) for p in prepared}
     lines = ["## Fixed-point model against the float model", "",
-             "The same events, the same preset; the fixed model's figures relative to the float model's "
-             "(issue 4's target: every task metric within 1 %).", "",
+             "The same events, the same preset, what each model reports (its object records); the fixed model's "
+             "figures relative to the float model's (issue 4's target: every task metric within 1 %).", "",
              "| measure | " + " | ".join(f"{n}: float / fixed / difference" for n in names) + " |",
              "|---|" + "---:|" * len(names)]  # fmt: skip
-    for k, (label, _) in enumerate(AGREEMENT_METRICS):
+    for k, label in enumerate(results[names[0]]["labels"]):
         cells = []
         for n in names:
             _, a, b, rel = results[n]["rows"][k]
@@ -160,13 +175,15 @@ def agreement_table(prepared: list[PreparedScene]) -> list[str]:
 class SceneResult:
     name: str
     events: int
-    records: int
+    records: int  # of the output (object records with an object layer)
     params_origin: str
-    all_objects: dict
+    all_objects: dict  # the output's scores
     fully_visible: dict
     stats: dict
-    steady: dict  # velocity NRMSE where the true velocity has not changed for a second
+    steady: dict  # velocity NRMSE where the true velocity has not changed for a second, per method
     per_label: dict  # palette accuracy per ground-truth label: (correct, evaluations)
+    kind: str = "clusters"  # what the output's records are
+    clusters: "SceneResult | None" = None  # the cluster records' result, when the output is objects
 
 
 def steady_velocity(matches, truth, frames_back: int) -> dict:
@@ -181,10 +198,14 @@ def steady_velocity(matches, truth, frames_back: int) -> dict:
     out = {"evaluations": int(keep.sum()), "of": int(matches.size)}
     sel = matches[keep]
     speed = np.hypot(sel["gt_vx"], sel["gt_vy"])
-    for method in ("mcm", "int"):
-        err = np.hypot(sel[f"vx_{method}"] - sel["gt_vx"], sel[f"vy_{method}"] - sel["gt_vy"])
+    for method, vx, vy in VELOCITY_METHODS[record_kind_of_matches(matches)]:
+        err = np.hypot(sel[vx] - sel["gt_vx"], sel[vy] - sel["gt_vy"])
         out[method] = float(np.sqrt(np.mean(err**2)) / np.mean(speed)) if sel.size else None
     return out
+
+
+def record_kind_of_matches(matches) -> str:
+    return "clusters" if "vx_mcm" in matches.dtype.names else "objects"
 
 
 def label_accuracy(matches, palette) -> dict:
@@ -194,21 +215,30 @@ def label_accuracy(matches, palette) -> dict:
 
 
 def scene_results(p: PreparedScene, figures: Path | None = None) -> SceneResult:
+    """The scene's scores on what the run reports (its object records, with an object layer), its
+    cluster records' in `.clusters`; the figures of the output."""
     name, sim, truth, origin, run = p.name, p.sim, p.truth, p.origin, p.float_run
-    matches, counts = match_with_counts(run.tracks, run.meta, truth)
-    if figures is not None:
-        figures.mkdir(parents=True, exist_ok=True)
-        plot_velocity(matches, figures / f"results_{name}_velocity.png", truth=truth, axis="time", t_frame_us=run.meta.t_frame_us, title=name)
-        plot_colour(matches, figures / f"results_{name}_colour.png", truth=truth, axis="time", t_frame_us=run.meta.t_frame_us, palette=run.meta.palette, title=name)
-    visible, visible_counts = match_with_counts(run.tracks, run.meta, truth, fully_visible_only=True)
-    return SceneResult(
-        name, sim.events.size, run.tracks.size, origin,
-        scores_from_matches(matches, counts, run.meta, DEFAULT_GATE_PX, False).to_dict(),
-        scores_from_matches(visible, visible_counts, run.meta, DEFAULT_GATE_PX, True).to_dict(),
-        run.stats,
-        steady_velocity(matches, truth, frames_back=int(round(1e6 / run.meta.t_frame_us))),
-        label_accuracy(matches, run.meta.palette),
-    )  # fmt: skip
+
+    def level(records, meta, draw: bool) -> SceneResult:
+        matches, counts = match_with_counts(records, meta, truth)
+        if draw and figures is not None:
+            figures.mkdir(parents=True, exist_ok=True)
+            plot_velocity(matches, figures / f"results_{name}_velocity.png", truth=truth, axis="time", t_frame_us=meta.t_frame_us, title=name)
+            plot_colour(matches, figures / f"results_{name}_colour.png", truth=truth, axis="time", t_frame_us=meta.t_frame_us, palette=meta.palette, title=name)
+        visible, visible_counts = match_with_counts(records, meta, truth, fully_visible_only=True)
+        return SceneResult(
+            name, sim.events.size, records.size, origin,
+            scores_from_matches(matches, counts, meta, DEFAULT_GATE_PX, False).to_dict(),
+            scores_from_matches(visible, visible_counts, meta, DEFAULT_GATE_PX, True).to_dict(),
+            run.stats,
+            steady_velocity(matches, truth, frames_back=int(round(1e6 / meta.t_frame_us))),
+            label_accuracy(matches, meta.palette), meta.kind,
+        )  # fmt: skip
+
+    out = level(*run.output, draw=True)
+    if run.object_meta is not None:
+        out.clusters = level(run.tracks, run.meta, draw=False)
+    return out
 
 
 def _pct(v) -> str:
@@ -219,26 +249,41 @@ def _num(v, digits=2) -> str:
     return "n/a" if v is None else f"{v:.{digits}f}"
 
 
+METHOD_LABELS = {"object": "Object", "mcm": "MCM", "interval": "Interval"}
+
+
 def scene_table(r: SceneResult) -> list[str]:
-    a, f, p = r.all_objects, r.fully_visible, PAPER.get(r.name)
+    """Tables 5 and 7 of one scene: the output's figures (object records, with an object layer)
+    and the cluster records' beside them, all and fully visible objects, and the paper's."""
+    p = PAPER.get(r.name)
+    levels = [r] + ([r.clusters] if r.clusters is not None else [])
+    columns = [(level, d) for level in levels for d in (level.all_objects, level.fully_visible)]
 
-    def row(label, get, fmt, paper):
-        return f"| {label} | {fmt(get(a))} | {fmt(get(f))} | {paper if p else 'n/a'} |"
+    def row(label, get, fmt, paper, kinds=None):
+        cells = [fmt(get(d)) if kinds is None or level.kind in kinds else "" for level, d in columns]
+        return f"| {label} | " + " | ".join(cells) + f" | {paper if p else 'n/a'} |"
 
+    head = " | ".join(f"{level.kind}, {which}" for level in levels for which in ("all visible", "fully visible"))
     lines = [
         f"### {r.name}",
         "",
-        f"{r.events:,} events, {r.records:,} track records, parameters from {r.params_origin}; "
-        f"{r.stats['created']} clusters created, {r.stats['exited']} freed by exit prediction.",
+        f"{r.events:,} events, {r.records:,} {r.kind[:-1]} records"
+        + (f" ({r.clusters.records:,} cluster records)" if r.clusters is not None else "")
+        + f", parameters from {r.params_origin}; {r.stats['created']} clusters created, {r.stats['exited']} freed by exit prediction"
+        + (f"; {r.stats['objects_confirmed']} objects confirmed of {r.stats['objects_created']} created." if "objects_created" in r.stats else "."),
         "",
-        "| measure | ours, all visible objects | ours, fully visible objects | paper |",
-        "|---|---:|---:|---:|",
+        f"| measure | {head} | paper |",
+        "|---|" + "---:|" * len(columns) + "---:|",
     ]
-    for method, label in (("mcm", "MCM"), ("interval", "Interval")):
+    for method, kinds in (("object", ("objects",)), ("mcm", ("clusters",)), ("interval", ("clusters",))):
+        if not any(level.kind in kinds for level in levels):
+            continue
+        label = METHOD_LABELS[method]
+        paper = p.get(method) if p else None
         lines += [
-            row(f"{label} velocity RMSE (px/frame)", lambda d, m=method: d[m]["rmse"], _num, p and p[method][0]),
-            row(f"{label} velocity NRMSE", lambda d, m=method: d[m]["nrmse"], _pct, p and _pct(p[method][1])),
-            row(f"{label} angular error (°)", lambda d, m=method: d[m]["angular_deg"], lambda v: _num(v, 1), p and p[method][2]),
+            row(f"{label} velocity RMSE (px/frame)", lambda d, m=method: d[m]["rmse"], _num, paper[0] if paper else "", kinds),
+            row(f"{label} velocity NRMSE", lambda d, m=method: d[m]["nrmse"], _pct, _pct(paper[1]) if paper else "", kinds),
+            row(f"{label} angular error (°)", lambda d, m=method: d[m]["angular_deg"], lambda v: _num(v, 1), paper[2] if paper else "", kinds),
         ]
     lines += [
         row("position RMSE (px)", lambda d: d["position_rmse_px"], _num, p and p["position"]),
@@ -248,12 +293,15 @@ def scene_table(r: SceneResult) -> list[str]:
         row("classification direct / palette", lambda d: (d["class_direct_accuracy"], d["class_palette_accuracy"]), lambda v: f"{_pct(v[0])} / {_pct(v[1])}", p and f"{_pct(p['classes'][0])} / {_pct(p['classes'][1])}"),
         row("recall / precision", lambda d: (d["recall"], d["precision"]), lambda v: f"{_pct(v[0])} / {_pct(v[1])}", "not reported"),
         row("identity switches", lambda d: d["id_switches"], str, "not reported"),
+        row("tracks per object", lambda d: d["tracks_per_object"], _num, "not reported"),
         "",
-        f"Velocity NRMSE in steady state (the object moves and had the same velocity one second earlier; "
-        f"{r.steady['evaluations']:,} of {r.steady['of']:,} evaluations): MCM {_pct(r.steady['mcm'])}, "
-        f"interval {_pct(r.steady['int'])}.",
+        "Velocity NRMSE in steady state (the object moves and had the same velocity one second earlier): "
+        + "; ".join(f"{level.kind} {level.steady['evaluations']:,} of {level.steady['of']:,} evaluations, "
+                    + ", ".join(f"{METHOD_LABELS[m]} {_pct(level.steady[m])}" for m in ('object', 'mcm', 'interval') if m in level.steady)
+                    for level in levels)
+        + ".",
         "",
-        "Palette classification per ground-truth label: "
+        f"Palette classification per ground-truth label ({r.kind}): "
         + ", ".join(f"{label} {_pct(c / n)} ({n:,})" for label, (c, n) in r.per_label.items()) + ".",
         "",
     ]

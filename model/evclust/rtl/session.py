@@ -19,10 +19,11 @@ from pathlib import Path
 
 import numpy as np
 
+from evclust.clusterer.layout import OBJECT_RECORD_COLUMNS
 from evclust.errors import EvclustError
 from evclust.fixed.formats import verilog_header
 from evclust.fixed.model import FixedClusterer
-from evclust.vectors.pack import event_words, record_rows
+from evclust.vectors.pack import event_words, object_rows, record_rows
 
 SIMULATOR = "verilator"  # the fast one; `make cosim SIM=icarus` covers the other
 
@@ -64,6 +65,8 @@ class RtlClusterer:
         self._receive = open(self._answers)
         self._batch = 0
         self._counters: dict | None = None
+        self.steps = np.zeros(0, np.int64)  # (the object unit needs no step times: it has the core's)
+        self._objects = np.zeros((0, OBJECT_RECORD_COLUMNS))  # the object unit's records of the last batch
 
     def _unblock(self) -> None:
         # The simulator died: open the pipes' other ends so that this side's open/readline returns.
@@ -86,18 +89,29 @@ class RtlClusterer:
         np.save(path, np.array([str(w) for w in event_words(events, self.table)]))
         self._send.write(f"{path}\n")
         self._send.flush()
-        answer = Path(self._answer())
+        answer, object_answer = (Path(p) for p in self._answer().split())
         words = np.load(answer).tolist()
+        object_words = np.load(object_answer).tolist()
         answer.unlink()
+        object_answer.unlink()
         path.unlink()
-        rows = record_rows(words, self.table)
+        rows = self._whole_time(record_rows(words, self.table), events)
+        self._objects = self._whole_time(object_rows(object_words, self.table), events)
+        return rows
+
+    @staticmethod
+    def _whole_time(rows: np.ndarray, events: np.ndarray) -> np.ndarray:
+        """The RTL's records hold the time's low 32 bits; their event is of this batch or just
+        before, so the whole time is the latest event's minus their difference mod 2^32."""
         if rows.size and events.size:
-            # The RTL's record holds the time's low 32 bits; its event is of this batch or just
-            # before, so the whole time is the latest event's minus their difference mod 2^32.
             latest = int(events["t"][-1])
             low = rows[:, 0].astype(np.int64)
             rows[:, 0] = latest - ((latest - low) & 0xFFFFFFFF)
         return rows
+
+    def object_layer(self) -> "RtlObjects":
+        """The object unit's records of each batch, as the other models' object layers give theirs."""
+        return RtlObjects(self)
 
     def stats(self) -> dict:
         """The status counters read from the register file; ends the session."""
@@ -116,3 +130,16 @@ class RtlClusterer:
         return {"events": c["events"], "steps": c["events"] // self.params.filter_every, "created": c["creates"], "evicted": c["evictions"], "dropped": c["drops"],
                 "expired": c["expiries"], "exited": c["exits"], "merged": c["merges"], "unsupported": c["unsupported"],
                 "saturations": saturations, "counters": c}  # fmt: skip
+
+
+class RtlObjects:
+    """The RTL's object unit as an object layer: its records of the last batch fed to the core."""
+
+    def __init__(self, rtl: RtlClusterer):
+        self.rtl = rtl
+
+    def feed(self, rows: np.ndarray, steps: np.ndarray) -> np.ndarray:
+        return self.rtl._objects
+
+    def stats(self) -> dict:
+        return {}

@@ -297,6 +297,111 @@ def creation_support() -> Case:
                 params=_small_params(create_support=True, support_cell_bits=1, support_window_us=300.0), source="directed")  # fmt: skip
 
 
+# ---------------------------------------------------------------------------------------------
+# The object layer's cases: blobs whose paths give each behaviour in a few hundred events. The
+# object layer's times are short (birth 1 frame, coast 2, keep 6) so that each shows within a
+# case; the clusters have measured velocities after τ = 2 frames.
+
+OBJECT_SMALL = dict(width=96, height=64, t_frame_us=10_000.0)
+
+
+def _object_params(**update) -> ClustererParams:
+    base = dict(t_half_us=4000.0, object_gate=2.0, object_link_along=3.0, object_v_tol=0.4, object_v_rel=0.3, object_track_frames=1.0,
+                object_rate_frames=3.0, object_velocity_frames=2.0, object_size_frames=1.0, object_colour_frames=1.0,
+                object_birth_frames=1.0, object_coast_frames=2.0, object_keep_frames=6.0, n_objects=8)  # fmt: skip
+    return _small_params(**{**base, **update})
+
+
+def _blobs(paths, t_end: int, dt: int = 50, radius: int = 2, seed: int = 0, t0: int = 1000) -> np.ndarray:
+    """Events of blobs: each path a list of legs (t_from, t_to, x, y, vx, vy, colour), positions
+    in px at t_from and velocities in px per frame (OBJECT_SMALL's 10 ms); every dt µs, one event
+    of each blob alive, within `radius` px of its centre, in turn."""
+    rng = np.random.default_rng(seed)
+    rows = []
+    for t in range(t0, t_end, dt):
+        for legs in paths:
+            for t_from, t_to, x, y, vx, vy, colour in legs:
+                if t_from <= t < t_to:
+                    frames = (t - t_from) / OBJECT_SMALL["t_frame_us"]
+                    cx, cy = x + vx * frames + rng.integers(-radius, radius + 1), y + vy * frames + rng.integers(-radius, radius + 1)
+                    if 0 <= cx < OBJECT_SMALL["width"] and 0 <= cy < OBJECT_SMALL["height"]:
+                        rows.append((t, int(round(cx)), int(round(cy)), *colour))
+    return _events(rows)
+
+
+RED, BLUE, GREEN = (80, 90, 220), (60, 200, 110), (150, 60, 70)
+
+
+def object_two_edges() -> Case:
+    # A uniform bar 12 px long moving right at 2 px/frame: its leading and trailing edges make
+    # clusters (no merging), which the object layer groups into one object by their common
+    # motion, the link reaching along it.
+    rows = _bar(x0=30, speed=0.05, steps=800, dt=250, rows=range(22, 30), length=12)
+    return Case("the two edges of a uniform bar: clusters on each edge, one object (the link along their motion)", _events(rows),
+                **OBJECT_SMALL, params=_object_params(r_init=2.0, seek_margin=2.0, size_gain=2.0, alpha_vel_int=0.7), source="directed")  # fmt: skip
+
+
+def object_split() -> Case:
+    # Two blobs side by side move together (one object), then part: one keeps the object, the
+    # other starts its own.
+    a = [(1000, 60_000, 20, 30, 1.0, 0.0, RED), (60_000, 160_000, 26, 30, 1.0, -1.5, RED)]
+    b = [(1000, 60_000, 26, 30, 1.0, 0.0, RED), (60_000, 160_000, 32, 30, 1.0, 1.5, RED)]
+    return Case("two blobs moving as one object, then parting: the object splits", _blobs([a, b], 160_000, seed=1), **OBJECT_SMALL,
+                params=_object_params(r_init=3.0), source="directed")  # fmt: skip
+
+
+def object_crossing() -> Case:
+    # Two blobs on crossing paths with opposite velocities: two objects. Where the blobs meet,
+    # the clusters take each other's events (the seek's nearest cluster), and the objects follow
+    # their clusters: the case exercises the crossing, whatever the identities do.
+    a = [(1000, 400_000, 20, 20, 1.0, 0.2, RED)]
+    b = [(1000, 400_000, 70, 26, -1.0, 0.0, BLUE)]
+    return Case("two blobs crossing with opposite velocities: two objects, each following its cluster through the crossing",
+                _blobs([a, b], 400_000, dt=100, seed=2),
+                **OBJECT_SMALL, params=_object_params(r_init=3.0), source="directed")  # fmt: skip
+
+
+def object_turn() -> Case:
+    # A blob that turns by 90° and then back: one object, its velocity following the turns.
+    legs = [(1000, 60_000, 10, 50, 1.2, 0.0, GREEN), (60_000, 120_000, 17.08, 50, 0.0, -1.2, GREEN),
+            (120_000, 180_000, 17.08, 42.92, 1.2, 0.0, GREEN)]  # fmt: skip
+    return Case("a blob turning by 90° and back: one object, its velocity turning", _blobs([legs], 180_000, seed=3), **OBJECT_SMALL,
+                params=_object_params(r_init=3.0), source="directed")  # fmt: skip
+
+
+def object_occlusion() -> Case:
+    # A blob moving right goes silent for 30 ms (an occluder) and reappears further along: its
+    # cluster expires, its object coasts (a static blob's events keep the filter steps coming),
+    # drops out of the records after 2 frames, and takes the new cluster when it comes: the same
+    # identity.
+    legs = [(1000, 70_000, 10, 30, 1.0, 0.0, BLUE), (100_000, 200_000, 20, 30, 1.0, 0.0, BLUE)]
+    still = [(1000, 200_000, 80, 50, 0.0, 0.0, RED)]  # a static blob: its events keep the filter steps coming
+    return Case("a blob hidden for 3 frames: its cluster expires, its object coasts and keeps its identity", _blobs([legs, still], 200_000, dt=100, seed=4),
+                **OBJECT_SMALL, params=_object_params(r_init=3.0), source="directed")  # fmt: skip
+
+
+def object_birth_death() -> Case:
+    # Three blobs one after another for a two-slot object table: each is born after a frame,
+    # dies when it stops (its object kept 6 frames, unreported after 2), and the third takes the
+    # slot of the first, lost; a flash of 3 ms starts a tentative object that is never reported.
+    a = [(1000, 60_000, 15, 15, 0.8, 0.5, RED)]
+    b = [(30_000, 120_000, 70, 20, -0.8, 0.6, GREEN)]
+    flash = [(60_000, 63_000, 40, 55, 0.0, 0.0, BLUE)]
+    c = [(100_000, 260_000, 20, 50, 0.7, -0.6, BLUE)]
+    return Case("births, deaths, a flash never confirmed, and a lost object's slot taken in a two-slot object table",
+                _blobs([a, b, flash, c], 300_000, seed=5), **OBJECT_SMALL,
+                params=_object_params(r_init=3.0, n_objects=2), source="directed")  # fmt: skip
+
+
+def object_merge() -> Case:
+    # A textured object as two patches that start apart: two objects, until the second's centre
+    # lies in the first's box: the older absorbs it.
+    a = [(1000, 150_000, 30, 30, 0.5, 0.0, RED)]
+    b = [(20_000, 150_000, 36, 31, 0.5, 0.0, RED)]
+    return Case("an object's second patch starts its own object, then lies inside the first: absorbed", _blobs([a, b], 150_000, radius=3,
+                seed=6), **OBJECT_SMALL, params=_object_params(r_init=4.0, object_gate=0.0, object_link_along=0.0), source="directed")  # fmt: skip
+
+
 def suite_clip() -> Case:
     # A clip of a generalization-suite scene through the default configuration: scaled seek,
     # merging, the noise gate and the warm-up of the interval velocity together.
@@ -361,4 +466,11 @@ CASES = {
     "noise_gate": noise_gate,
     "creation_support": creation_support,
     "suite_clip": suite_clip,
+    "object_two_edges": object_two_edges,
+    "object_split": object_split,
+    "object_crossing": object_crossing,
+    "object_turn": object_turn,
+    "object_occlusion": object_occlusion,
+    "object_birth_death": object_birth_death,
+    "object_merge": object_merge,
 }
