@@ -78,7 +78,8 @@ def test_the_guard_bits_move_every_filtered_signals_fraction_and_nothing_else(de
     narrow = build_formats(params, 480, 270, 50000.0, dead_band_bits=dead_band_bits)
     filtered = {"centre", "offset", "seek_distance", "centre_step", "half_size", "size_target", "v_mcm", "mcm_norm", "v_int", "colour", "background",
                 "merge_moment",  # activity × centre
-                "r_init", "r_min", "r_max", "seek_margin", "exit_margin", "merge_v_tol"}  # the last six: constants held in R's, P's and V's formats
+                "obj_centre", "obj_half",  # the object layer's, in the centre's and the half-size's fraction bits
+                "r_init", "r_min", "r_max", "seek_margin", "exit_margin", "merge_v_tol", "object_gate"}  # the last seven: constants held in R's, P's and V's formats
     shift = dead_band_bits - DEAD_BAND_BITS
     for name, fmt in default.formats.items():
         moved = narrow[name].frac_bits - fmt.frac_bits

@@ -57,10 +57,11 @@ def test_track_prints_the_time_constants_it_chose(tmp_path, capsys):
     capsys.readouterr()
     assert main(["track", str(tmp_path / "e.npz"), "-o", str(tmp_path / "t.csv"), "-q"]) == 0
     line = capsys.readouterr().out
-    # 15 fps: T_half 1.8 frames is 120,000 µs, τ 5.3 frames 353,333 µs.
+    # 15 fps: the defaults' T_half and τ in frames times 66,667 µs (τ rounded to whole µs).
     defaults = ClustererParams()
-    assert (defaults.t_half_frames, defaults.tau_frames) == (1.8, 5.3)
-    assert "parameters from defaults (t_half 120,000 µs (= 1.8 frames), tau 353,333 µs (= 5.3 frames))" in line
+    t_half, tau = defaults.t_half_frames * 1e6 / 15, round(defaults.tau_frames * 1e6 / 15)
+    assert (f"parameters from defaults (t_half {t_half:,.0f} µs (= {defaults.t_half_frames:g} frames), "
+            f"tau {tau:,.0f} µs (= {defaults.tau_frames:g} frames))") in line
 
 
 def test_suite_tuning_keeps_its_trials_in_sqlite_and_resumes(tmp_path):

@@ -1,5 +1,6 @@
-"""`evclust track --model rtl`: the RTL under Verilator as a clusterer model, bit for bit the
-fixed model on a segment of a built-in scene, with the status counters read from its registers."""
+"""`evclust track --model rtl`: the RTL under Verilator as a clusterer model, its cluster records
+and its object unit's records bit for bit the fixed model's on a segment of a built-in scene,
+with the status counters read from its registers."""
 
 from __future__ import annotations
 
@@ -16,12 +17,12 @@ from evclust.simulator import simulate_scene
 
 @pytest.fixture(scope="module")
 def segment(tmp_path_factory):
-    """The first 15000 events of `traffic`: creations, filter steps and reported tracks."""
+    """The first 40000 events of `traffic`: creations, filter steps, reported clusters and objects."""
     folder = tmp_path_factory.mktemp("rtl_track")
     sim = simulate_scene(load_scene("traffic"), seed=1)
     path = folder / "segment.npz"
     with event_writer(path, sim.meta) as writer:
-        writer.write(sim.events[:15000])
+        writer.write(sim.events[:40000])
     return path
 
 
@@ -31,9 +32,10 @@ def _records(path):
     return lines[1:]
 
 
-def test_track_model_rtl_writes_the_fixed_models_track_file(segment, tmp_path):
+@pytest.mark.parametrize("kind", ["--clusters", "--every-step"])
+def test_track_model_rtl_writes_the_fixed_models_track_file(segment, tmp_path, kind):
     for model in ("fixed", "rtl"):
-        assert main(["track", str(segment), "-o", str(tmp_path / f"{model}.csv"), "--model", model, "-q"]) == 0
+        assert main(["track", str(segment), "-o", str(tmp_path / f"{model}.csv"), "--model", model, kind, "-q"]) == 0
     fixed, rtl = _records(tmp_path / "fixed.csv"), _records(tmp_path / "rtl.csv")
     assert len(fixed) > 30, "a segment that reports little checks little"
     assert rtl == fixed
@@ -47,6 +49,7 @@ def test_the_rtl_models_counters_are_the_fixed_models_statistics(segment):
     fixed = track_events(events, reader.meta, params, model="fixed")
     rtl = track_events(events, reader.meta, params, model="rtl")
     assert np.array_equal(rtl.tracks, fixed.tracks)
+    assert fixed.objects.size > 0 and np.array_equal(rtl.objects, fixed.objects)
     for name in ("events", "steps", "created", "evicted", "dropped", "expired", "exited", "merged", "records"):
         assert rtl.stats[name] == fixed.stats[name], name
     assert rtl.stats["counters"]["updates"] == events.size - fixed.stats["created"] - fixed.stats["dropped"] - fixed.stats["unsupported"]

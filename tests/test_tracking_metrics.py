@@ -404,10 +404,12 @@ def test_the_objective_is_zero_when_perfect_and_grows_as_recall_drops():
     perfect = aggregate.figures([ra])
     assert perfect["recall"] == 1.0 and perfect["precision"] == 1.0
     assert aggregate.objective(perfect) == pytest.approx(0.0, abs=1e-6)
-    pooled = aggregate.figures([ra, rb])  # recall 5/7, everything else still perfect
-    assert aggregate.objective(pooled) == pytest.approx(2 * (1 - 50 / 70), abs=1e-6)
-    worse = dict(perfect, recall=0.25)
-    assert aggregate.objective(worse) == pytest.approx(2 * 0.75, abs=1e-6)
+    # Recall 5/7; the per-sample errors stay zero, HOTA drops below 1 with the detections missed.
+    pooled = aggregate.figures([ra, rb])
+    assert 0.0 < pooled["HOTA"] < 1.0
+    assert aggregate.objective(pooled) == pytest.approx(4 * (1 - pooled["HOTA"]) + (1 - 50 / 70), abs=1e-6)
+    worse = dict(pooled, recall=0.25)  # recall alone weighs once
+    assert aggregate.objective(worse) == pytest.approx(aggregate.objective(pooled) + (50 / 70 - 0.25), abs=1e-6)
     assert aggregate.objective(perfect) < aggregate.objective(pooled) < aggregate.objective(worse)
 
 

@@ -59,6 +59,13 @@ from evclust.jit import njit
 DT_MAX_US = (1 << 24) - 1  # Δt saturates here (16.8 s): every gain is 1 long before, and the hardware counts 24 bits
 DT_FRAMES_MAX = 1024.0 - 2.0**-24  # ... and so does Δt in frames
 
+def object_time_us(p, name: str, t_frame_us: float) -> int:
+    """The birth, coast or keep time (`name`) in whole µs, keep at least coast, at most DT_MAX_US
+    (Δt saturates there, and an object unseen that long is gone)."""
+    frames = getattr(p, f"object_{name}_frames") if name != "keep" else max(p.object_keep_frames, p.object_coast_frames)
+    return min(round(frames * t_frame_us), DT_MAX_US)
+
+
 # The object layer's parameters as the compiled step reads them.
 ObjectConstants = namedtuple(
     "ObjectConstants",
@@ -78,13 +85,12 @@ ObjectConstants = namedtuple(
 
 
 def object_constants(p, width: int, height: int, t_frame_us: float) -> ObjectConstants:
-    """The constants of a parameter set (p resolved to µs); the times in whole µs, as the hardware counts them."""
-    us = lambda frames: float(round(frames * t_frame_us))  # noqa: E731
+    """The constants of a parameter set (p resolved to µs); the times in whole µs, as the hardware
+    counts them (`object_time_us`)."""
     return ObjectConstants(
         float(t_frame_us), p.object_gate, p.object_link_along, p.object_v_tol, p.object_v_rel,
         p.object_track_frames, p.object_rate_frames, p.object_velocity_frames, p.object_size_frames, p.object_colour_frames,
-        us(p.object_birth_frames), us(p.object_coast_frames), us(max(p.object_keep_frames, p.object_coast_frames)),
-        float(width), float(height),
+        *(float(object_time_us(p, name, t_frame_us)) for name in ("birth", "coast", "keep")), float(width), float(height),
     )  # fmt: skip
 
 

@@ -13,6 +13,7 @@ import dataclasses
 import math
 from typing import Literal
 
+from evclust.clusterer.objects import DT_MAX_US, object_time_us
 from evclust.clusterer.params import ClustererParams
 from evclust.errors import EvclustError
 
@@ -35,14 +36,14 @@ DECAY_FRAC_BITS = 16
 SCALE_FRAC_BITS = 6  # seek, merge and velocity-agreement scales: steps of 1/64
 NOISE_GATE_FRAC_BITS = 4
 # The object layer (beyond the paper; fixed/objects.py).
-OBJECT_DT_BITS = 24  # the time between filter steps, µs, saturated at 2^24 - 1 (16.8 s: beyond it every gain is 1)
+OBJECT_DT_BITS = DT_MAX_US.bit_length()  # the time between filter steps, µs, saturated at 2^24 - 1 (16.8 s: beyond it every gain is 1)
 OBJECT_DT_FRAMES_FRAC = 24  # Δt in frames: 2^-24 frame steps,
 OBJECT_DT_FRAMES_INT = 10  # saturated below 1024 frames
 OBJECT_GAIN_FRAC = 24  # the filters' gains Δt/T, at most 1
 OBJECT_VELOCITY_FRAC = 16  # an object's velocity, px/frame
 OBJECT_INV_T_FRAC = 20  # 1/T of the object filters' time constants, per frame
 OBJECT_INV_T_INT = 4  # ... at most 15: every time constant is at least 1/15 frame
-OBJECT_TIME_BITS = 24  # birth, coast and keep times, µs
+OBJECT_TIME_BITS = DT_MAX_US.bit_length()  # birth, coast and keep times, µs
 INV_T_FRAME_SIGNIFICANT = 16  # bits of 1/T_frame kept below its leading one
 
 
@@ -340,11 +341,9 @@ def _object_constants(p: ClustererParams, t_frame_us: float, formats: dict, cons
             raise EvclustError(f"clusterer.object_{name}_frames: {frames:g}; the object filters' time constants are at least 1/{2**OBJECT_INV_T_INT - 1} frame")
         const(f"object_inv_{name}", 1.0 / frames, False, OBJECT_INV_T_INT, OBJECT_INV_T_FRAC, f"clusterer.object_{name}_frames", f"1/T of the object's {name} filter, per frame")
     for name in ("birth", "coast", "keep"):
-        frames = getattr(p, f"object_{name}_frames") if name != "keep" else max(p.object_keep_frames, p.object_coast_frames)
-        us = round(frames * t_frame_us)
-        if us >= 2**OBJECT_TIME_BITS:
-            raise EvclustError(f"clusterer.object_{name}_frames: {frames:g} frames is {us} µs, over the {2**OBJECT_TIME_BITS - 1} µs the object layer counts")
+        us = object_time_us(p, name, t_frame_us)  # at most DT_MAX_US
         const(f"object_{name}_us", us, False, OBJECT_TIME_BITS, 0, f"clusterer.object_{name}_frames", f"object {name} time, µs")
+
 
 
 # Constants a parameter set may leave out (a zero margin, no luminance weight, ...): the RTL
