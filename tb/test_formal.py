@@ -76,7 +76,8 @@ BREAKAGES = {
         "evclust_core",
         "        if (rec_valid && rec_ready)\n            rec_valid <= 1'b0;\n",
         "        if (rec_valid && rec_ready)\n            rec_valid <= 1'b1;\n",
-        ("!f_recorded[f_rec_slot]);", "assert (&f_visited && f_out == f_kept", "assert (state == ST_SWEEP || f_after_sweep);"),
+        ("!f_recorded[f_rec_slot]);", "assert (&f_visited && f_out == f_kept", "assert (state == ST_SWEEP || f_after_sweep);",
+         "assert (f_offered[f_s] == (f_out[f_s] && f_reported[f_s]));"),
     ),
     # The reference build (MERGE = 0) never merges and still proves with this core: only the
     # merge-enabled job sees the MERGE state hang.

@@ -84,3 +84,19 @@ def test_the_quick_report_writes_its_markdown_and_figures(tmp_path):
         tail = sweep_tail_cycles(build_formats(params.model_copy(update={"n_clusters": n}), 480, 270, params.t_frame_us or 50000.0))
         law = 1 + (2 + max(n, len(params.palette)) + tail) / params.filter_every
         assert law <= cycles[label] < law + 0.05, label
+
+
+def test_the_object_records_budget_pairs_nearly_every_record_and_stays_far_below_a_pixel(traffic_budget):
+    # The traffic preset keeps the object layer: its records get their own rows. The fixed model's
+    # object layer makes the float one's decisions (nearly every record is paired within 2 px), so
+    # what remains is rounding, well under the metrics' resolution.
+    rows = traffic_budget["object_rows"]
+    assert set(rows) == {"all", "fixed model"} and traffic_budget["reference_objects"] > 0
+    for source in rows:
+        errors = rows[source]
+        assert errors["position"].pairs >= 0.95 * traffic_budget["reference_objects"], source
+        assert errors["position"].rms < 0.05 and errors["size"].rms < 0.2, source
+        assert errors["velocity"].rms < 0.01 and errors["colour"].rms < 0.05, source
+    # The object layer's own formats add to the emulated clusters' error, never take from it much.
+    for group in ("position", "size", "velocity"):
+        assert rows["fixed model"][group].rms >= 0.9 * rows["all"][group].rms, group

@@ -20,11 +20,17 @@ def test_generalize_writes_the_page_for_a_few_scenes(tmp_path, capsys):
                  "--workers", "2", "-o", str(out), "-q"])  # fmt: skip
     assert code == 0
     text = out.read_text()
-    # Three configurations, float and fixed of the defaults beside the paper's.
-    overall = text.split("## Overall")[1].split("\n## ")[0]
-    rows = [line for line in overall.splitlines() if re.match(r"\| (default|paper) \| (float|fixed) \|", line)]
-    assert [r.split("|")[1:3] for r in rows] == [[" default ", " float "], [" default ", " fixed "], [" paper ", " float "]]
-    for section in ("## Targets", "## By category: default, float model", "## Per scene", "## Typical failures", "## Commands"):
+    # Three configurations, float and fixed of the defaults beside the paper's: what each reports
+    # (the defaults' objects, the paper's clusters), then every one's cluster records.
+    def overall(title):
+        table = text.split(f"## Overall: {title}")[1].split("\n## ")[0]
+        rows = [line for line in table.splitlines() if re.match(r"\| (default|paper) \| (float|fixed) \|", line)]
+        return [[cell.strip() for cell in r.split("|")[1:4]] for r in rows]
+
+    assert overall("what each configuration reports") == [["default", "float", "objects"], ["default", "fixed", "objects"], ["paper", "float", "clusters"]]
+    assert overall("cluster records") == [["default", "float", "clusters"], ["default", "fixed", "clusters"], ["paper", "float", "clusters"]]
+    for section in ("## Targets", "## By category: default, float model, objects", "## By category: default, float model, its cluster records",
+                    "## Per scene", "## Typical failures", "## Commands", "## Fixed against float"):  # fmt: skip
         assert section in text
     assert all(f"gen_{s}" in text for s in SMALL_TEST_SEEDS)
     assert (tmp_path / "img" / "g_failures.png").stat().st_size > 10_000

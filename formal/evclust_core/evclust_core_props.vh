@@ -49,6 +49,9 @@
     always @(posedge clk) if (f_past_valid && !$past(dp_rst) && $past(step_valid && !step_ready))
         assert (step_valid && step_t == $past(step_t));
     always @* assert (!(step_valid && rec_valid));
+    // What k-induction needs: no sweep runs while the last step's end waits (PHASE holds it).
+    always @* if (f_past_valid && step_pending)
+        assert (state != ST_SWEEP && state != ST_MERGE && (state != ST_PHASE || phase_step == PHASE_DECIDE));
 
     // ---------------------------------------------------------------- the filter step ends
     // Bounded liveness: a filter step (PHASE, SWEEP, MERGE) ends within F_FILTER_BOUND cycles

@@ -29,6 +29,9 @@ module evclust_tb #(
     output reg  [31:0] cycles,
     output reg  [31:0] filter_cycles,
     output reg  [31:0] filter_steps,
+    output reg  [31:0] object_wait_cycles,  // filter-step cycles the core waits on the object unit
+    output reg  [31:0] object_busy_cycles,  // cycles the object unit works on a step
+    output reg  [31:0] object_drain_cycles, // ... of them with the core idle (the last step of a batch)
     output wire        idle,
     output wire        irq,
     // AXI4-Lite: the register file
@@ -204,6 +207,9 @@ module evclust_tb #(
             cycles <= 32'd0;
             filter_cycles <= 32'd0;
             filter_steps <= 32'd0;
+            object_wait_cycles <= 32'd0;
+            object_busy_cycles <= 32'd0;
+            object_drain_cycles <= 32'd0;
             filter_was_active <= 1'b0;
         end else if (running) begin
             random <= next_random;
@@ -213,6 +219,14 @@ module evclust_tb #(
                 filter_cycles <= filter_cycles + 32'd1;
             if (filter_active && !filter_was_active)
                 filter_steps <= filter_steps + 32'd1;
+            // In a step the core waits on the object unit while it holds a record back, and in the
+            // next step's first phase cycle while the last step's end is not taken.
+            if (filter_active && ((core_rec_valid && !core_rec_ready) || step_valid))
+                object_wait_cycles <= object_wait_cycles + 32'd1;
+            if (!objects_idle)
+                object_busy_cycles <= object_busy_cycles + 32'd1;
+            if (!objects_idle && core_idle)
+                object_drain_cycles <= object_drain_cycles + 32'd1;
             // Input: hold an offered event until it is taken (valid may not drop before ready).
             if (ev_valid && ev_ready)
                 accepted <= accepted + 32'd1;

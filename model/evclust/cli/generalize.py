@@ -31,6 +31,7 @@ def add_parser(sub) -> None:
     p.add_argument("--workers", type=int, metavar="N", help="local Dask workers (default: one per core)")
     p.add_argument("--ablation", action="store_true",
                    help="instead: the defaults with each addition beyond the paper off in turn, and the paper's (float model)")
+    p.add_argument("--json", metavar="PATH", help="also write every configuration's pooled figures (what it reports, and its clusters') as JSON")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bars")
     p.set_defaults(run=run)
 
@@ -38,7 +39,7 @@ def add_parser(sub) -> None:
 def run(args) -> int:
     from evclust.clusterer.run import MODELS
     from evclust.suite import dask_client, split_seeds
-    from evclust.suite.report import ablation_configurations, default_configurations, run_configurations, write_report
+    from evclust.suite.report import ablation_configurations, default_configurations, run_configurations, write_figures, write_report
 
     seeds = split_seeds(args.split)
     if args.seeds:
@@ -61,5 +62,7 @@ def run(args) -> int:
     write_report(runs, Path(args.suite_dir), out, args.split, seeds, command, machine, picture,
                  categories_of=("default",) if args.ablation else None,
                  title="Ablation: what each addition beyond the paper buys" if args.ablation else "Generalization")  # fmt: skip
+    if args.json:
+        write_figures(runs, Path(args.json))
     print(f"{out}: {len(seeds)} scenes of the {args.split} split, {len(runs)} configurations")
     return 0

@@ -90,6 +90,11 @@ class Scores:
         return plain(out)
 
 
+def scored_velocity_methods(scores: dict) -> list[str]:
+    """The velocity methods a score dict (Scores.to_dict) holds: those of its record kind, in order."""
+    return [name for methods in VELOCITY_METHODS.values() for name, *_ in methods if name in scores]
+
+
 def _ratio(num: float, den: float) -> float | None:
     return float(num) / float(den) if den else None
 

@@ -26,6 +26,7 @@ from evclust.choices import PLOT_AXES, PLOT_KINDS  # noqa: E402
 from evclust.colour import ycbcr_to_rgb  # noqa: E402
 from evclust.errors import EvclustError, atomic_output  # noqa: E402
 from evclust.events.format import EventMeta  # noqa: E402
+from evclust.metrics.tracking import velocity_methods  # noqa: E402
 from evclust.tracks.record import TrackMeta  # noqa: E402
 
 PLOT_SUFFIXES = (".png", ".svg", ".pdf")
@@ -51,7 +52,7 @@ def pick_object(matches: np.ndarray, gt_id: int | None = None) -> tuple[int, np.
     """(gt_id, its match rows in time order). Default: the object with the most matches."""
     names = matches.dtype.names or ()
     missing = [name for name in _MATCH_FIELDS if name not in names]
-    if missing or not _methods(matches):
+    if missing or not velocity_methods(matches):
         raise EvclustError(f"matches: missing field(s) {', '.join(missing) or 'of a velocity'}")
     if matches.size == 0:
         raise EvclustError("no track record was matched to a ground-truth object")
@@ -64,14 +65,6 @@ def pick_object(matches: np.ndarray, gt_id: int | None = None) -> tuple[int, np.
     rows = matches[matches["gt_id"] == gt_id]
     rows = rows[np.lexsort((rows["track_id"], rows["step"], rows["t_us"]))]
     return int(gt_id), rows
-
-
-def _methods(matches: np.ndarray) -> tuple[tuple[str, str, str], ...]:
-    """The velocity methods the matches hold (name, vx field, vy field)."""
-    from evclust.tracks import VELOCITY_METHODS
-
-    names = matches.dtype.names or ()
-    return tuple(m for methods in VELOCITY_METHODS.values() for m in methods if m[1] in names and m[2] in names)
 
 
 def presence_gaps(truth: np.ndarray | None, gt_id: int) -> list[tuple[int, int]]:
@@ -157,7 +150,7 @@ def plot_velocity(matches: np.ndarray, path: str | Path, gt_id: int | None = Non
     for ax, c in zip(axes, ("y", "x")):
         gt = rows[f"gt_v{c}"]
         ax.plot(*_with_breaks(x, gt, rows["frame"]), color=GT_COLOUR, lw=2.0, label="ground truth", zorder=3)
-        for method, vx, vy in _methods(rows):
+        for method, vx, vy in velocity_methods(rows):
             name, colour, lw = METHOD_LINES[method]
             values = rows[vx if c == "x" else vy]
             ax.plot(*_with_breaks(x, values, rows["frame"]), color=colour, lw=lw, label=f"{name} (RMSE {_rmse(values, gt):.3g})", zorder=2)

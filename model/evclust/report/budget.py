@@ -19,12 +19,20 @@ import numpy as np
 from evclust.clusterer import ClustererParams, track_events
 from evclust.clusterer.float_model import PRECISION_SIGNALS
 from evclust.fixed.formats import FormatTable, build_formats, precision_table
+from evclust.metrics.scores import scored_velocity_methods
 
-# Output groups: the record columns each reports, and the format whose LSB measures it.
+# Output groups: the record columns each reports, and the format whose LSB measures it; for the
+# cluster records, then for the object records.
 OUTPUTS = {
     "position": (("x", "y"), "centre"),
     "size": (("rx", "ry"), "half_size"),
     "velocity": (("vx_mcm", "vy_mcm", "vx_int", "vy_int"), "v_int"),
+    "colour": (("Y", "Cb", "Cr"), "colour"),
+}
+OBJECT_OUTPUTS = {
+    "position": (("x", "y"), "obj_centre"),
+    "size": (("rx", "ry"), "obj_half"),
+    "velocity": (("vx", "vy"), "obj_velocity"),
     "colour": (("Y", "Cb", "Cr"), "colour"),
 }
 SOURCES = (*PRECISION_SIGNALS, "constants")
@@ -70,11 +78,11 @@ def emulate(events, meta, params: ClustererParams, table: FormatTable, sources, 
     return track_events(events, meta, run_params, model="float", precision=precision)
 
 
-def record_errors(reference: np.ndarray, tracks: np.ndarray, table: FormatTable) -> dict[str, Error]:
+def record_errors(reference: np.ndarray, tracks: np.ndarray, table: FormatTable, outputs: dict = OUTPUTS) -> dict[str, Error]:
     """Each output group's error of `tracks` against `reference`, over the records both emit."""
     pairs = paired_records(reference, tracks)
     out = {}
-    for group, (columns, fmt) in OUTPUTS.items():
+    for group, (columns, fmt) in outputs.items():
         if not pairs:
             out[group] = Error(math.nan, math.nan, math.nan, math.nan, math.nan, 0)
             continue
@@ -104,18 +112,28 @@ def paired_records(reference: np.ndarray, tracks: np.ndarray) -> list[tuple]:
 
 
 def budget(events, meta, params: ClustererParams, progress=None) -> dict:
-    """Per source, then all together (emulated) and the fixed model itself: errors per output."""
+    """Per source, then all together (emulated) and the fixed model itself: errors per output of
+    the cluster records. With an object layer, the object records' errors too: the float object
+    layer over the emulated clusters (every source quantised), then the fixed model, whose object
+    layer adds its own formats."""
     t_frame = params.t_frame_us or meta.t_frame_us
     table = build_formats(params, meta.width, meta.height, t_frame)
-    reference = track_events(events, meta, params, model="float").tracks
-    rows = {}
+    reference = track_events(events, meta, params, model="float")
+    rows, object_rows = {}, {}
     for source in (*SOURCES, "all"):
         sources = SOURCES if source == "all" else (source,)
-        rows[source] = record_errors(reference, emulate(events, meta, params, table, sources).tracks, table)
+        run = emulate(events, meta, params, table, sources)
+        rows[source] = record_errors(reference.tracks, run.tracks, table)
+        if source == "all" and params.objects:
+            object_rows["all"] = record_errors(reference.objects, run.objects, table, OBJECT_OUTPUTS)
         if progress:
             progress(source)
-    rows["fixed model"] = record_errors(reference, track_events(events, meta, params, model="fixed").tracks, table)
-    return {"table": table, "rows": rows, "reference_records": len(reference)}
+    fixed = track_events(events, meta, params, model="fixed")
+    rows["fixed model"] = record_errors(reference.tracks, fixed.tracks, table)
+    if params.objects:
+        object_rows["fixed model"] = record_errors(reference.objects, fixed.objects, table, OBJECT_OUTPUTS)
+    return {"table": table, "rows": rows, "reference_records": len(reference.tracks), "object_rows": object_rows,
+            "reference_objects": 0 if reference.objects is None else len(reference.objects)}  # fmt: skip
 
 
 def noise_sum_ratio(rows: dict, group: str) -> float:
@@ -150,30 +168,32 @@ SIGNAL_GROUP = {
 }  # fmt: skip
 
 
-# The task metrics a recommended set of formats must keep within tolerance of the float model's.
-TASK_METRICS = (
-    ("mcm", "nrmse"), ("mcm", "angular_deg"), ("interval", "nrmse"), ("interval", "angular_deg"),
-    ("position_rmse_px",), ("luminance", "nrmse"), ("chrominance", "nrmse"), ("class_palette_accuracy",),
-)  # fmt: skip
+# The task metrics a recommended set of formats must keep within tolerance of the float model's:
+# each velocity method's (those of the record kind), then these.
+TASK_METRICS = (("position_rmse_px",), ("luminance", "nrmse"), ("chrominance", "nrmse"), ("class_palette_accuracy",))
 
 
-def scene_scores(run, truth) -> dict:
-    """Every task metric of a tracking run against the scene's ground truth (metrics' dict form)."""
+def scene_scores(run, truth, level: str | None = None) -> dict:
+    """Every task metric of a tracking run against the scene's ground truth (metrics' dict form),
+    on its output (the object records when it has an object layer) or on `level`'s records
+    ("clusters" or "objects")."""
     from evclust.metrics.scores import score
 
-    return score(run.tracks, run.meta, truth).to_dict()
+    records, meta = {None: run.output, "clusters": (run.tracks, run.meta), "objects": (run.objects, run.object_meta)}[level]
+    return score(records, meta, truth).to_dict()
 
 
 def best_velocity_nrmse(scores: dict) -> float | None:
-    """The better of the two velocity methods' NRMSE (None when neither was scored)."""
-    values = [v for v in (scores["mcm"]["nrmse"], scores["interval"]["nrmse"]) if v is not None]
+    """The best velocity method's NRMSE (None when none was scored)."""
+    values = [v for m in scored_velocity_methods(scores) if (v := scores[m]["nrmse"]) is not None]
     return min(values) if values else None
 
 
 def task_scores(run, truth) -> dict:
     s = scene_scores(run, truth)
     out = {}
-    for path in TASK_METRICS:
+    paths = [(m, key) for m in scored_velocity_methods(s) for key in ("nrmse", "angular_deg")] + list(TASK_METRICS)
+    for path in paths:
         value = s
         for key in path:
             value = value[key]

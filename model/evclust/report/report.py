@@ -15,9 +15,11 @@ from evclust.clusterer import load_params, track_events
 from evclust.errors import atomic_output
 from evclust.fixed.formats import DEAD_BAND_BITS, build_formats
 from evclust.fixed.model import SIGNAL_FORMATS
+from evclust.metrics.scores import scored_velocity_methods
 from evclust.report import figures
 from evclust.report.budget import (
-    OUTPUTS, SIGNAL_GROUP, SOURCES, best_velocity_nrmse, budget, error_vs_frac_bits, noise_sum_ratio, scene_scores, wordlength_search,
+    OBJECT_OUTPUTS, OUTPUTS, SIGNAL_GROUP, SOURCES, best_velocity_nrmse, budget, error_vs_frac_bits, noise_sum_ratio, scene_scores,
+    wordlength_search,
 )  # fmt: skip
 from evclust.report.hardware import CONFIGS, evaluate_configs, rtl_runtime, start_synthesis
 from evclust.report.results import PAPER, _num, _pct
@@ -87,7 +89,29 @@ def budget_section(name: str, result: dict, img: Path) -> list[str]:
         "",
     ]
     figures.noise_shares(rows, SOURCES, groups, img / f"budget_{name}.png", f"{name}: each source's share of the noise power")
-    return lines
+    return lines + object_budget_lines(result)
+
+
+def object_budget_lines(result: dict) -> list[str]:
+    """The object records' errors: the float object layer over the emulated clusters, then the fixed model."""
+    rows = result["object_rows"]
+    if not rows:
+        return []
+    groups = list(OBJECT_OUTPUTS)
+    lines = [
+        f"Object records: {result['reference_objects']:,} float records, paired in the same way. Max |e| in LSBs of "
+        + ", ".join(f"{g}: {result['table'][fmt].q}" for g, (_, fmt) in OBJECT_OUTPUTS.items())
+        + ". The first row is the float object layer fed by the emulated clusters (every source above quantised), so "
+        "the fixed model's excess over it is the object layer's own arithmetic.",
+        "",
+        "| object records | " + " | ".join(f"{g}: max LSB / RMS / bias / SQNR dB" for g in groups) + " |",
+        "|---|" + "---|" * len(groups),
+    ]
+    labels = {"all": "all sources (emulated), float object layer", "fixed model": "**fixed model (bit-exact)**"}
+    for source, label in labels.items():
+        cells = [f"{_fmt(e.max_lsb, 3)} / {_fmt(e.rms)} / {_fmt(e.bias)} / {_fmt(e.sqnr_db, 3)}" for e in (rows[source][g] for g in groups)]
+        lines.append(f"| {label} | " + " | ".join(cells) + " |")
+    return lines + [""]
 
 
 def ranges_section(name: str, meta, events, params) -> tuple[list[str], list]:
@@ -102,9 +126,15 @@ def ranges_section(name: str, meta, events, params) -> tuple[list[str], list]:
     return lines, plot_rows
 
 
+LEVELS = (("clusters", "float"), ("clusters", "fixed"), ("objects", "float"), ("objects", "fixed"))
+
+
 def task_section(name: str, meta, events, params, origin, truth) -> list[str]:
+    """Both models' task metrics on both record levels (the object level when the parameters have
+    an object layer), beside the paper's own figures."""
     runs = {model: track_events(events, meta, params, model=model) for model in ("float", "fixed")}
-    scores = {m: scene_scores(r, truth) for m, r in runs.items()}
+    levels = [lv for lv in LEVELS if lv[0] == "clusters" or params.objects]
+    scores = {(level, model): scene_scores(runs[model], truth, level) for level, model in levels}
     p = PAPER.get(name)
     lines = [
         f"### {name}",
@@ -112,23 +142,32 @@ def task_section(name: str, meta, events, params, origin, truth) -> list[str]:
         f"{events.size:,} events, parameters from {origin}. "
         + ("The paper's column is its own figure on its real video, not on this scene." if p else "The paper has no such scene."),
         "",
-        "| measure | float | fixed | paper |",
-        "|---|---:|---:|---:|",
+        "| measure | " + " | ".join(f"{level}, {model}" for level, model in levels) + " | paper |",
+        "|---|" + "---:|" * (len(levels) + 1),
     ]
-    for method, label in (("mcm", "MCM"), ("interval", "Interval")):
-        paper = p[method] if p else ("n/a", None, "n/a")
+
+    def row(label, cell, paper):
+        return f"| {label} | " + " | ".join(cell(scores[lv]) for lv in levels) + f" | {paper} |"
+
+    def velocity(method, key, fmt):
+        return lambda s: fmt(s[method][key]) if method in s else "—"
+
+    for method, label in (("mcm", "MCM"), ("interval", "Interval"), ("object", "Object")):
+        paper = p[method] if p and method in p else ("n/a", None, "n/a")
         lines += [
-            f"| {label} velocity RMSE (px/frame) | {_num(scores['float'][method]['rmse'])} | {_num(scores['fixed'][method]['rmse'])} | {paper[0]} |",
-            f"| {label} velocity NRMSE | {_pct(scores['float'][method]['nrmse'])} | {_pct(scores['fixed'][method]['nrmse'])} | {_pct(paper[1])} |",
-            f"| {label} angular error (°) | {_num(scores['float'][method]['angular_deg'], 1)} | {_num(scores['fixed'][method]['angular_deg'], 1)} | {paper[2]} |",
+            row(f"{label} velocity RMSE (px/frame)", velocity(method, "rmse", _num), paper[0]),
+            row(f"{label} velocity NRMSE", velocity(method, "nrmse", _pct), _pct(paper[1])),
+            row(f"{label} angular error (°)", velocity(method, "angular_deg", lambda v: _num(v, 1)), paper[2]),
         ]
     for key in ("luminance", "chrominance"):
         paper = f"{p[key][0]} / {_pct(p[key][1])}" if p else "n/a"
-        lines.append(f"| {key} RMSE / NRMSE | {_num(scores['float'][key]['rmse'], 1)} / {_pct(scores['float'][key]['nrmse'])} "
-                     f"| {_num(scores['fixed'][key]['rmse'], 1)} / {_pct(scores['fixed'][key]['nrmse'])} | {paper} |")  # fmt: skip
+        lines.append(row(f"{key} RMSE / NRMSE", lambda s, key=key: f"{_num(s[key]['rmse'], 1)} / {_pct(s[key]['nrmse'])}", paper))
     lines += [
-        f"| position RMSE (px) | {_num(scores['float']['position_rmse_px'])} | {_num(scores['fixed']['position_rmse_px'])} | {p['position'] if p else 'n/a'} |",
-        f"| classification, palette | {_pct(scores['float']['class_palette_accuracy'])} | {_pct(scores['fixed']['class_palette_accuracy'])} | {_pct(p['classes'][1]) if p else 'n/a'} |",
+        row("position RMSE (px)", lambda s: _num(s["position_rmse_px"]), p["position"] if p else "n/a"),
+        row("classification, palette", lambda s: _pct(s["class_palette_accuracy"]), _pct(p["classes"][1]) if p else "n/a"),
+        row("recall", lambda s: _pct(s["recall"]), "n/a"),
+        row("precision", lambda s: _pct(s["precision"]), "n/a"),
+        row("tracks per object", lambda s: _num(s["tracks_per_object"]), "n/a"),
         "",
     ]
     return lines
@@ -312,8 +351,8 @@ def shift_section(results, params_by_scene: dict, scene_names: list[str]) -> lis
     lines += ["", "| measure | multiplier β | shift-only β |", "|---|---:|---:|"]
     for name in scene_names:
         a, b = mult.scores[name], shift.scores[name]
-        for method, label in (("mcm", "MCM"), ("interval", "interval")):
-            lines.append(f"| {name}: {label} velocity NRMSE | {_pct(a[method]['nrmse'])} | {_pct(b[method]['nrmse'])} |")
+        for method in scored_velocity_methods(a):
+            lines.append(f"| {name}: {method} velocity NRMSE | {_pct(a[method]['nrmse'])} | {_pct(b[method]['nrmse'])} |")
         lines += [
             f"| {name}: position RMSE (px) | {_num(a['position_rmse_px'])} | {_num(b['position_rmse_px'])} |",
             f"| {name}: chrominance NRMSE | {_pct(a['chrominance']['nrmse'])} | {_pct(b['chrominance']['nrmse'])} |",

@@ -11,7 +11,7 @@ import numpy as np
 from evclust.clusterer import load_params, track_events
 from evclust.errors import atomic_output
 from evclust.metrics import DEFAULT_GATE_PX, match_with_counts
-from evclust.metrics.scores import class_correct, score, scores_from_matches
+from evclust.metrics.scores import class_correct, score, scored_velocity_methods, scores_from_matches
 from evclust.render.plots import plot_colour, plot_velocity
 from evclust.tracks import VELOCITY_METHODS
 from evclust.scenes import load_scene
@@ -35,14 +35,9 @@ def _better(*values):
     return min(known) if known else None
 
 
-def _methods(d: dict) -> list[str]:
-    """The velocity methods a score dict holds (mcm and interval for cluster records, object for object records)."""
-    return [m for m in ("object", "mcm", "interval") if m in d]
-
-
 TARGETS = (
-    ("velocity NRMSE, better method", lambda d: _better(*(d[m]["nrmse"] for m in _methods(d))), 0.15, True),
-    ("mean angular error, better method (°)", lambda d: _better(*(d[m]["angular_deg"] for m in _methods(d))), 15.0, True),
+    ("velocity NRMSE, better method", lambda d: _better(*(d[m]["nrmse"] for m in scored_velocity_methods(d))), 0.15, True),
+    ("mean angular error, better method (°)", lambda d: _better(*(d[m]["angular_deg"] for m in scored_velocity_methods(d))), 15.0, True),
     ("chrominance NRMSE", lambda d: d["chrominance"]["nrmse"], 0.03, True),
     ("luminance NRMSE", lambda d: d["luminance"]["nrmse"], 0.12, True),
     ("palette classification", lambda d: d["class_palette_accuracy"], 0.95, False),
@@ -92,7 +87,7 @@ def model_agreement(p: PreparedScene) -> dict:
     runs = {"float": p.float_run, "fixed": track_events(p.sim.events, p.sim.meta, p.params, model="fixed")}
     scores = {m: score(*r.output, truth).to_dict() for m, r in runs.items()}
     rows = []
-    metrics = tuple(row for m in _methods(scores["float"]) for row in VELOCITY_AGREEMENT[m]) + AGREEMENT_METRICS
+    metrics = tuple(row for m in scored_velocity_methods(scores["float"]) for row in VELOCITY_AGREEMENT[m]) + AGREEMENT_METRICS
     for label, path in metrics:
         a, b = scores["float"], scores["fixed"]
         for key in path:
@@ -139,8 +134,8 @@ def configuration_table(prepared: list[PreparedScene]) -> list[str]:
             run = p.float_run if params is None else track_events(p.sim.events, p.sim.meta, params)
             records, meta = run.output
             d = score(records, meta, p.truth).to_dict()
-            velocity = " / ".join(f"{_pct(d[m]['nrmse'])} ({m})" for m in _methods(d))
-            angle = " / ".join(f"{_num(d[m]['angular_deg'], 1)}°" for m in _methods(d))
+            velocity = " / ".join(f"{_pct(d[m]['nrmse'])} ({m})" for m in scored_velocity_methods(d))
+            angle = " / ".join(f"{_num(d[m]['angular_deg'], 1)}°" for m in scored_velocity_methods(d))
             lines.append(
                 f"| {p.name} | {label} | {meta.kind} | {velocity} | {angle} | {_num(d['position_rmse_px'])} "
                 f"| {_pct(d['luminance']['nrmse'])} / {_pct(d['chrominance']['nrmse'])} | {_pct(d['class_palette_accuracy'])} "

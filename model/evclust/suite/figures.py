@@ -42,12 +42,12 @@ def worst_samples(results, per_kind: int = 1) -> list[tuple[str, object, int, in
 
 
 def draw_sample(files, params, frame: int, scale: int = 1) -> np.ndarray:
-    """RGB picture of one scene at one frame: a frame period of events, the records of the last
-    filter step, and the true boxes."""
+    """RGB picture of one scene at one frame: a frame period of events, the reported records
+    (objects, or clusters without an object layer) of the last filter step, and the true boxes."""
     events, meta = read_events(files.events)
     truth = read_truth(files.truth)
     run = track_events(events, meta, params)
-    drawer = FrameDrawer(events, meta, run.tracks, run.meta, scale=scale)
+    drawer = FrameDrawer(events, meta, *run.output, scale=scale)
     t = frame * run.meta.t_frame_us
     canvas = drawer.draw(t)
     for row in truth[truth["frame"] == frame]:
@@ -78,7 +78,8 @@ def failure_grid(results, files_of, params, path: str | Path) -> list[tuple[str,
         ax.set_title(f"{CAPTIONS[kind]}\n{r.name} frame {frame} ({count}): {f['width']}x{f['height']}, {f['fps']:g} fps, "
                      f"{len(f['objects'])} objects{', codec' if f['codec'] else ''}{', noise' if f['noise'] else ''}",
                      fontsize=9)  # fmt: skip
-    fig.suptitle("Typical failures on the test split (white: true boxes; red: cluster boxes; green: seek regions)", fontsize=11)
+    legend = "cyan: object boxes, dashed while coasting" if params.objects else "red: cluster boxes; green: seek regions"
+    fig.suptitle(f"Typical failures on the test split (white: true boxes; {legend})", fontsize=11)
     fig.tight_layout()
     Path(path).parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=90)
