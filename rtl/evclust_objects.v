@@ -254,6 +254,7 @@ module evclust_objects #(
     wire [OSLOT_W-1:0] oj = j[OSLOT_W-1:0];                  // a scanned object (ASSOC, MERGE)
     wire signed [63:0] o_xs = sx64(o_x[oi]), o_ys = sx64(o_y[oi]);
     wire signed [63:0] o_vxs = sv64(o_vx[oi]), o_vys = sv64(o_vy[oi]);
+    wire signed [63:0] o_tols = {{(64 - TW){1'b0}}, o_tol[oi]};  // the velocity's tolerance (UPDATE: before this step's)
 
     // LINK: clusters ci and cj.
     wire signed [63:0] l_vxi = sv64(c_vx[ci]), l_vyi = sv64(c_vy[ci]), l_vxj = sv64(c_vx[cj]), l_vyj = sv64(c_vy[cj]);
@@ -771,9 +772,9 @@ module evclust_objects #(
                                 ey <= u_zy - o_ys;
                                 o_y[oi] <= next_y[PW-1:0];
                             end
-                            5'd9: rate_x <= align(product, FG + FP, FV);
+                            5'd9: rate_x <= saturate(align(product, FG + FP, FV), -o_tols, o_tols);  // the residual's pull, within the tolerance
                             5'd10: o_vx[oi] <= next_vx[VW-1:0];
-                            5'd11: rate_y <= align(product, FG + FP, FV);
+                            5'd11: rate_y <= saturate(align(product, FG + FP, FV), -o_tols, o_tols);
                             5'd12: o_vy[oi] <= next_vy[VW-1:0];
                             5'd13: o_rx[oi] <= next_rx[OBJ_HALF_W-1:0];
                             5'd14: begin

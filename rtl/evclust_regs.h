@@ -101,29 +101,29 @@
 #define EVCLUST_CFG_SUPPORT_WINDOW_WIDTH 32u
 #define EVCLUST_CFG_INV_T_FRAME 0x188u  /* 32 bits, 1 word(s); reset 85899 */
 #define EVCLUST_CFG_INV_T_FRAME_WIDTH 32u
-#define EVCLUST_CFG_OBJECT_GATE 0x18cu  /* 26 bits, 1 word(s); reset 73400 */
+#define EVCLUST_CFG_OBJECT_GATE 0x18cu  /* 26 bits, 1 word(s); reset 334234 */
 #define EVCLUST_CFG_OBJECT_GATE_WIDTH 26u
-#define EVCLUST_CFG_OBJECT_LINK_ALONG 0x190u  /* 9 bits, 1 word(s); reset 324 */
+#define EVCLUST_CFG_OBJECT_LINK_ALONG 0x190u  /* 9 bits, 1 word(s); reset 280 */
 #define EVCLUST_CFG_OBJECT_LINK_ALONG_WIDTH 9u
-#define EVCLUST_CFG_OBJECT_V_TOL 0x194u  /* 24 bits, 1 word(s); reset 18022 */
+#define EVCLUST_CFG_OBJECT_V_TOL 0x194u  /* 24 bits, 1 word(s); reset 129761 */
 #define EVCLUST_CFG_OBJECT_V_TOL_WIDTH 24u
-#define EVCLUST_CFG_OBJECT_V_REL 0x198u  /* 7 bits, 1 word(s); reset 19 */
+#define EVCLUST_CFG_OBJECT_V_REL 0x198u  /* 7 bits, 1 word(s); reset 56 */
 #define EVCLUST_CFG_OBJECT_V_REL_WIDTH 7u
-#define EVCLUST_CFG_OBJECT_INV_TRACK 0x19cu  /* 24 bits, 1 word(s); reset 1263345 */
+#define EVCLUST_CFG_OBJECT_INV_TRACK 0x19cu  /* 24 bits, 1 word(s); reset 738434 */
 #define EVCLUST_CFG_OBJECT_INV_TRACK_WIDTH 24u
-#define EVCLUST_CFG_OBJECT_INV_RATE 0x1a0u  /* 24 bits, 1 word(s); reset 708497 */
+#define EVCLUST_CFG_OBJECT_INV_RATE 0x1a0u  /* 24 bits, 1 word(s); reset 501711 */
 #define EVCLUST_CFG_OBJECT_INV_RATE_WIDTH 24u
-#define EVCLUST_CFG_OBJECT_INV_VELOCITY 0x1a4u  /* 24 bits, 1 word(s); reset 213995 */
+#define EVCLUST_CFG_OBJECT_INV_VELOCITY 0x1a4u  /* 24 bits, 1 word(s); reset 60964 */
 #define EVCLUST_CFG_OBJECT_INV_VELOCITY_WIDTH 24u
-#define EVCLUST_CFG_OBJECT_INV_SIZE 0x1a8u  /* 24 bits, 1 word(s); reset 476625 */
+#define EVCLUST_CFG_OBJECT_INV_SIZE 0x1a8u  /* 24 bits, 1 word(s); reset 7231559 */
 #define EVCLUST_CFG_OBJECT_INV_SIZE_WIDTH 24u
-#define EVCLUST_CFG_OBJECT_INV_COLOUR 0x1acu  /* 24 bits, 1 word(s); reset 2330169 */
+#define EVCLUST_CFG_OBJECT_INV_COLOUR 0x1acu  /* 24 bits, 1 word(s); reset 589088 */
 #define EVCLUST_CFG_OBJECT_INV_COLOUR_WIDTH 24u
-#define EVCLUST_CFG_OBJECT_BIRTH_US 0x1b0u  /* 24 bits, 1 word(s); reset 59000 */
+#define EVCLUST_CFG_OBJECT_BIRTH_US 0x1b0u  /* 24 bits, 1 word(s); reset 218000 */
 #define EVCLUST_CFG_OBJECT_BIRTH_US_WIDTH 24u
-#define EVCLUST_CFG_OBJECT_COAST_US 0x1b4u  /* 24 bits, 1 word(s); reset 96500 */
+#define EVCLUST_CFG_OBJECT_COAST_US 0x1b4u  /* 24 bits, 1 word(s); reset 460000 */
 #define EVCLUST_CFG_OBJECT_COAST_US_WIDTH 24u
-#define EVCLUST_CFG_OBJECT_KEEP_US 0x1b8u  /* 24 bits, 1 word(s); reset 2500000 */
+#define EVCLUST_CFG_OBJECT_KEEP_US 0x1b8u  /* 24 bits, 1 word(s); reset 4100000 */
 #define EVCLUST_CFG_OBJECT_KEEP_US_WIDTH 24u
 #define EVCLUST_CFG_FILTER_EVERY 0x1bcu  /* 7 bits, 1 word(s); reset 64 */
 #define EVCLUST_CFG_FILTER_EVERY_WIDTH 7u

@@ -3,11 +3,12 @@
     .venv/bin/python synth/ablation.py [--figures build/ablation.json] [--write docs/TUNING.md]
 
 Each addition (merging, the scaled seek, the noise gate, the interval warm start) is switched off
-in turn from the defaults, and the core synthesised at N = 4 and N = 16 with the constants built
-in (`RUNTIME_CONFIG = 0`), so that Yosys removes what an addition no longer uses. An addition's
-cost per slot is the slope over N of what it adds, (on16 - off16 - (on4 - off4)) / 12, and its
-shared cost what remains at N = 4. The creation-support map is a RAM of cells, one per pixel cell
-and not per slot: its bits come from the formats table. The object unit (evclust_objects) is
+in turn from the defaults with every addition on (the scaled seek, off by default, at its last
+tuned scale), and the core synthesised at N = 4 and N = 16 with the constants built in
+(`RUNTIME_CONFIG = 0`), so that Yosys removes what an addition no longer uses. An addition's cost
+per slot is the slope over N of what it adds, (on16 - off16 - (on4 - off4)) / 12, and its shared
+cost what remains at N = 4. The creation-support map is a RAM of cells, one per pixel cell and
+not per slot: its bits come from the formats table. The object unit (evclust_objects) is
 synthesised alone at the defaults. Tracking figures come from `evclust generalize --split tuning
 --ablation --json build/ablation.json` (`make ablation` runs both).
 """
@@ -28,20 +29,24 @@ ROOT = Path(__file__).resolve().parents[1]
 START, END = "<!-- ablation:start -->", "<!-- ablation:end -->"
 SENSOR = (480, 270, 50000.0)  # the synthesis sensor of synth/synth.py
 N_SMALL, N_LARGE = 4, 16
-# The additions a synthesis can remove, by the configuration name of `generalize --ablation`.
+# The additions' configuration names in `generalize --ablation` (with it off, or on when the
+# defaults leave it off), and what switches each off from "every addition on".
 ADDITIONS = {
-    "no merging": ("merging", {"merge": False}),
-    "no scaled seek": ("scaled seek", {"seek_scale": 0.0}),
-    "no noise gate": ("noise gate", {"noise_gate": 0.0}),
-    "no warm start (plain α filters)": ("interval warm start", {"velocity_warm_start": False}),
+    "merging": ("no merging", {"merge": False}),
+    "scaled seek": ("scaled seek on", {"seek_scale": 0.0}),
+    "noise gate": ("no noise gate", {"noise_gate": 0.0}),
+    "interval warm start": ("no warm start (plain α filters)", {"velocity_warm_start": False}),
 }
-SUPPORT = "no creation support"
+SUPPORT = ("creation-support map", "no creation support")
 KEYS = ("lut", "ff", "dsp48e1", "carry4")
 
 
 def header(n: int, **update) -> str:
-    """The defaults at N = n on the synthesis sensor, the support map left out (a block RAM)."""
-    params = ClustererParams(n_clusters=n, create_support=False).model_copy(update=update)
+    """The defaults with every addition on, at N = n on the synthesis sensor, the support map left
+    out (a block RAM); `update` switches some off."""
+    from evclust.suite.report import SEEK_SCALE_TUNED
+
+    params = ClustererParams(n_clusters=n, create_support=False, seek_scale=SEEK_SCALE_TUNED).model_copy(update=update)
     return rtl_header(params, *SENSOR)
 
 
@@ -79,51 +84,54 @@ def _pct(v):
     return "n/a" if v is None else f"{100 * v:.1f} %"
 
 
-def section(defaults: dict, costs: dict, objects: dict, support: tuple, tracking: dict | None, rtl: str) -> str:
-    base = tracking.get("default") if tracking else None
+def section(all_on: dict, costs: dict, objects: dict, support: tuple, tracking: dict | None, rtl: str) -> str:
+    from evclust.suite.report import SEEK_SCALE_TUNED
 
-    def figures(name):
-        f = tracking.get(name) if tracking else None
-        if not f:
+    defaults = ClustererParams()
+
+    def on_off(config: str, in_defaults: bool) -> list[str]:
+        """The addition's tracking figures with it and without it ("with → without")."""
+        if not tracking or "default" not in tracking or config not in tracking:
             return ["—"] * 5
-        o = f["figures"]
-        delta = f" ({100 * (o['HOTA'] - base['figures']['HOTA']):+.1f})" if base and name != "default" else ""
-        return [_pct(o["recall"]), _pct(o["precision"]), f"{o['tracks_per_object']:.2f}", _pct(o["HOTA"]) + delta,
-                _pct(o.get("best_velocity_nrmse"))]  # fmt: skip
+        a, b = tracking["default"]["figures"], tracking[config]["figures"]
+        on, off = (a, b) if in_defaults else (b, a)
+        cells = [f"{_pct(on[k])} → {_pct(off[k])}" for k in ("HOTA", "recall", "precision")]
+        cells.append(f"{on['tracks_per_object']:.2f} → {off['tracks_per_object']:.2f}")
+        cells.append(f"{100 * (on['HOTA'] - off['HOTA']):+.1f}")
+        return cells
 
-    head = ("| configuration | recall | precision | tracks/object | HOTA (points vs defaults) | velocity NRMSE "
+    head = ("| addition | in the defaults | HOTA with → without | recall | precision | tracks/object | HOTA bought (points) "
             "| LUT per slot | FF per slot | DSP48E1 per slot | LUT shared | FF shared | DSP48E1 shared |")  # fmt: skip
     lines = [head, "|" + "---|" * (head.count("|") - 1)]
-    lines.append("| defaults (object layer on) | " + " | ".join(figures("default")) + " | " + " | ".join(
-        [f"{(defaults[N_LARGE][k] - defaults[N_SMALL][k]) / (N_LARGE - N_SMALL):,.0f} (all)" for k in ("lut", "ff", "dsp48e1")]
-        + [f"{defaults[N_SMALL][k] - N_SMALL * (defaults[N_LARGE][k] - defaults[N_SMALL][k]) / (N_LARGE - N_SMALL):,.0f} (all)" for k in ("lut", "ff", "dsp48e1")]
-    ) + " |")  # fmt: skip
-    for name, (label, _) in ADDITIONS.items():
-        c = costs[name]
-        lines.append(f"| {name} (saves: {label}) | " + " | ".join(figures(name)) + " | "
+    slope = {k: (all_on[N_LARGE][k] - all_on[N_SMALL][k]) / (N_LARGE - N_SMALL) for k in KEYS}
+    lines.append("| the core, every addition on | | | | | | | " + " | ".join(f"{slope[k]:,.0f}" for k in ("lut", "ff", "dsp48e1")) + " | "
+                 + " | ".join(f"{all_on[N_SMALL][k] - N_SMALL * slope[k]:,.0f}" for k in ("lut", "ff", "dsp48e1")) + " |")  # fmt: skip
+    for label, (config, _) in ADDITIONS.items():
+        in_defaults = not config.endswith(" on")
+        c = costs[label]
+        lines.append(f"| {label} | {'yes' if in_defaults else '**no**'} | " + " | ".join(on_off(config, in_defaults)) + " | "
                      + " | ".join(f"{c[k][0]:,.1f}" for k in ("lut", "ff", "dsp48e1")) + " | "
                      + " | ".join(f"{c[k][1]:,.0f}" for k in ("lut", "ff", "dsp48e1")) + " |")  # fmt: skip
     cells, bits, total = support
-    lines.append(f"| {SUPPORT} | " + " | ".join(figures(SUPPORT)) + f" | 0 | 0 | 0 | a RAM of {cells:,} cells × {bits} bits "
-                 f"= {total / 8 / 1024:,.0f} KiB ({-(-total // 36864)} RAMB36) | | |")  # fmt: skip
-    for name in ("none of the five", "no object layer", "paper"):
-        if tracking and name in tracking:
-            lines.append(f"| {name} | " + " | ".join(figures(name)) + " | | | | | | |")
+    label, config = SUPPORT
+    lines.append(f"| {label} | {'yes' if defaults.create_support else '**no**'} | " + " | ".join(on_off(config, defaults.create_support))
+                 + f" | 0 | 0 | 0 | RAM: {cells:,} cells × {bits} bits = {total / 8 / 1024:,.0f} KiB ({-(-total // 36864)} RAMB36) | | |")  # fmt: skip
     o = objects
     return "\n".join([
         START,
         f"Hardware: `.venv/bin/python synth/ablation.py --write docs/TUNING.md`, run "
         f"{datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC, RTL at {rtl}: Yosys `synth_xilinx` (the flow "
-        f"of `make synth`), the defaults on 480×270 at 20 fps with the constants built in, N = {N_SMALL} and {N_LARGE}; per slot "
-        f"is the slope over N of what the addition adds, shared what remains at N = {N_SMALL}. Tracking: the tuning split "
-        "(`evclust generalize --split tuning --ablation`, float model, object records), in [ABLATION.md](ABLATION.md).",
+        f"of `make synth`) on 480×270 at 20 fps, the defaults with every addition on (the scaled seek at "
+        f"{SEEK_SCALE_TUNED}, its last tuned scale) and one switched off at a time, the constants built in, "
+        f"N = {N_SMALL} and {N_LARGE}; per slot is the slope over N of what the addition adds, shared what remains at "
+        f"N = {N_SMALL}. Tracking: the tuning split, float model, object records (`evclust generalize --split tuning --ablation`, "
+        "[ABLATION.md](ABLATION.md)), the defaults against the defaults with the addition switched.",
         "",
         *lines,
         "",
-        f"The object unit alone (`evclust_objects`, K = {ClustererParams().n_objects} object slots behind N = {N_LARGE} clusters, "
+        f"The object unit alone (`evclust_objects`, K = {defaults.n_objects} object slots behind N = {N_LARGE} clusters, "
         f"constants built in): {o['lut']:,} LUT (+{o['inv']:,} INV), {o['ff']:,} FF, {o['dsp48e1']} DSP48E1, {o['carry4']:,} CARRY4, "
-        f"{o['lutram_luts']} LUTRAM LUTs; logic depth {o['depth_cells']} cells. It does not grow with the event rate: it runs "
-        "once per filter step.",
+        f"{o['lutram_luts']} LUTRAM LUTs; logic depth {o['depth_cells']} cells. It runs once per filter step, not per event.",
         END,
         "",
     ])  # fmt: skip
@@ -136,13 +144,13 @@ def main():
     args = parser.parse_args()
     snapshot = rtl_snapshot()
     try:
-        defaults = {n: synth(f"ablation-defaults-n{n}", header(n), snapshot) for n in (N_SMALL, N_LARGE)}
+        defaults = {n: synth(f"ablation-all-on-n{n}", header(n), snapshot) for n in (N_SMALL, N_LARGE)}
         costs = {}
-        for name, (label, update) in ADDITIONS.items():
+        for label, (_, update) in ADDITIONS.items():
             slug = label.replace(" ", "-")
             off = {n: synth(f"ablation-no-{slug}-n{n}", header(n, **update), snapshot) for n in (N_SMALL, N_LARGE)}
-            costs[name] = cost(defaults, off)
-        objects = synth(f"objects-n{N_LARGE}", header(N_LARGE), snapshot, top="evclust_objects")
+            costs[label] = cost(defaults, off)
+        objects = synth(f"objects-n{N_LARGE}", header(N_LARGE, seek_scale=ClustererParams().seek_scale), snapshot, top="evclust_objects")
     except EvclustError as e:
         sys.exit(f"ablation: {e}")
     tracking = None

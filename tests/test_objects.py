@@ -10,10 +10,15 @@ import numpy as np
 import pytest
 
 from evclust.clusterer import ClustererParams
+from evclust.clusterer import objects as float_objects
+from evclust.clusterer.layout import (
+    O_HI_X, O_HI_Y, O_LO_X, O_LO_Y, O_MEMBERS, O_RX, O_RY, O_T_BORN, O_TOL, O_V_WEIGHT, O_VALID, O_VX, O_VY, O_X, O_Y, OBJECT_COLUMNS,
+)  # fmt: skip
 from evclust.clusterer.objects import DT_FRAMES_MAX, FloatObjects, rate_gain
-from evclust.clusterer.run import FloatClusterer, rows_to_records
+from evclust.clusterer.run import FloatClusterer, rerun_objects, rows_to_records, track_events
 from evclust.fixed.formats import OBJECT_DT_FRAMES_FRAC, OBJECT_GAIN_FRAC, build_formats
 from evclust.fixed.model import FixedClusterer
+from evclust.fixed import objects as fixed_objects
 from evclust.fixed.objects import _rate_gain, fixed_object_constants
 from evclust.tracks import OBJECT_DTYPE, ObjectFlags
 from evclust.vectors.cases import CASES, OBJECT_SMALL, _blobs, _object_params
@@ -149,3 +154,51 @@ def test_object_records_hold_their_invariants_on_a_suite_clip():
         ids = objects["id"][objects["step"] == step]
         assert np.unique(ids).size == ids.size
     assert np.isfinite(objects["vx"]).all() and math.isfinite(float(objects["x"].mean()))
+
+
+def _jumping_box(centre_to_px: float, px: float) -> np.ndarray:
+    """One object at (20, 20) moving at 1 px/frame along x, seen one frame ago, whose members'
+    box now spans x from 35 to 65 (a cluster joined 30 px ahead): no member with a measured
+    velocity. In the units of `px` (1: float; 2^F: raw fixed)."""
+    O = np.zeros((1, len(OBJECT_COLUMNS)), np.float64 if px == 1 else np.int64)
+    O[0, O_VALID], O[0, O_MEMBERS], O[0, O_V_WEIGHT], O[0, O_T_BORN] = 1, 1, -1, -T_FRAME
+    O[0, O_X] = O[0, O_Y] = round(20 * centre_to_px)
+    O[0, O_RX] = O[0, O_RY] = 5
+    O[0, O_LO_X], O[0, O_HI_X] = round(35 * centre_to_px), round(65 * centre_to_px)
+    O[0, O_LO_Y], O[0, O_HI_Y] = round(15 * centre_to_px), round(25 * centre_to_px)
+    O[0, O_VX] = round(1.0 * px)
+    return O
+
+
+def test_a_box_that_jumps_as_a_cluster_joins_moves_the_velocity_by_its_tolerance_at_most():
+    # g_rate over one frame with T_rate = 1 is 1: unclipped, the 30 px residual would give 31 px/frame.
+    params = _object_params(object_rate_frames=1.0, object_track_frames=1.0, object_v_tol=0.25, object_v_rel=0.5)
+    k = float_objects.object_constants(params, W, H, T_FRAME)
+    O = _jumping_box(1.0, 1.0)
+    O[0, O_TOL] = 0.25 + 0.5 * 1.0  # the tolerance of 1 px/frame
+    float_objects._update(O, 0, float(T_FRAME), k)
+    assert O[0, O_VX] == pytest.approx(1.0 + 0.75) and O[0, O_VY] == 0.0
+    assert O[0, O_X] == pytest.approx(50.0)  # the centre itself follows the box (gain 1)
+    # The fixed model: the same clip, in raw units of the velocity's format.
+    table = build_formats(params, W, H, T_FRAME)
+    kx = fixed_object_constants(table)
+    O = _jumping_box(2.0**kx.fp, 2.0**kx.fv)
+    O[0, O_TOL] = fixed_objects._tolerance(O[0, O_VX], O[0, O_VY], kx)
+    tol = int(O[0, O_TOL])
+    assert tol == pytest.approx(0.75 * 2**kx.fv, abs=2)
+    fixed_objects._update(O, 0, np.int64(T_FRAME), kx, np.zeros(8, np.int64))
+    assert int(O[0, O_VX]) == 2**kx.fv + tol and int(O[0, O_VY]) == 0
+
+
+def test_rerunning_the_object_layer_over_a_runs_clusters_is_a_run_with_those_object_parameters():
+    case = CASES["object_crossing"]()
+    from evclust.events import EventMeta
+
+    meta = EventMeta(width=case.width, height=case.height, t_frame_us=case.t_frame_us)
+    first = track_events(case.events, meta, case.params)
+    other = case.params.model_copy(update={"object_gate": 4.0, "object_velocity_frames": 1.0, "object_birth_frames": 0.5})
+    again = rerun_objects(first, other)
+    direct = track_events(case.events, meta, other)
+    assert np.array_equal(again.objects, direct.objects) and again.objects.size > 0
+    assert not np.array_equal(again.objects, first.objects)  # the parameters made a difference
+    assert np.array_equal(again.tracks, first.tracks)

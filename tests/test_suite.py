@@ -90,3 +90,21 @@ def test_suite_tuning_keeps_its_trials_in_sqlite_and_resumes(tmp_path):
 
 def test_the_split_seeds_are_disjoint_and_the_test_split_is_big_enough():
     assert not set(SPLITS["tuning"]) & set(SPLITS["test"]) and len(SPLITS["test"]) >= 30
+
+
+def test_a_search_of_the_object_layer_alone_leaves_every_other_parameter_as_it_starts(capsys):
+    from evclust.tune.suite import searched, suggest
+
+    space, categorical = searched("object_")
+    assert space and not categorical and all(name.startswith("object_") for name, *_ in space)
+
+    class Trial:  # each suggestion at its range's top
+        def suggest_float(self, name, low, high, log=False, step=None):
+            return high
+
+    base = ClustererParams()
+    tried = suggest(Trial(), base, "object_")
+    changed = {k for k, v in tried.model_dump().items() if v != base.model_dump()[k]}
+    assert changed and all(k.startswith("object_") for k in changed)
+    assert main(["tune", "traffic", "--only", "object_", "-o", "x.toml"]) == 2
+    assert "--only works with --suite" in capsys.readouterr().err

@@ -29,6 +29,8 @@ def add_parser(sub) -> None:
     p.add_argument("--seed", type=int, default=0, metavar="S", help="sampler seed (default 0)")
     p.add_argument("--segment", type=float, default=0.5, metavar="F", help="fraction of the scene to tune on (default 0.5)")
     p.add_argument("--params", metavar="P", help="starting parameters (.toml or preset; default: the scene's preset)")
+    p.add_argument("--only", metavar="PREFIX", help="--suite: search only the parameters whose names start with PREFIX (object_: "
+                   "the object layer alone, each scene's clusters run once per worker)")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     p.set_defaults(run=run)
 
@@ -42,6 +44,8 @@ def run(args) -> int:
         return _run_suite(args)
     if not args.scene:
         raise EvclustError("give a SCENE to tune on, or --suite SPLIT")
+    if args.only:
+        raise EvclustError("--only works with --suite")
     if not 0.0 < args.segment <= 1.0:
         raise EvclustError(f"--segment {args.segment}: must be in (0, 1]")
     from evclust.clusterer import load_params
@@ -83,9 +87,10 @@ def _run_suite(args) -> int:
     with dask_client(args.scheduler, args.workers) as client:
         prepare_split(client, args.suite, args.suite_dir, progress=not args.quiet)
         result = tune_suite(client, Path(args.suite_dir), seeds, base, args.trials, args.storage, args.study, seed=args.seed,
-                            progress=not args.quiet)  # fmt: skip
+                            progress=not args.quiet, only=args.only)  # fmt: skip
+    only = f" --only {args.only}" if args.only else ""
     header = (
-        f"# Tuned by: evclust tune --suite {args.suite} --trials {args.trials} --seed {args.seed} --study {args.study}\n"
+        f"# Tuned by: evclust tune --suite {args.suite} --trials {args.trials} --seed {args.seed} --study {args.study}{only}\n"
         f"# from {origin}; suite objective {result.value:.4f} (docs/TUNING.md) after {result.trials} trials in {args.storage}"
     )
     with atomic_output(args.output) as tmp:

@@ -20,7 +20,8 @@ are formed at record rate, once per filter step, from the step's reported cluste
    centre's residual and its most active member's measured velocity (an interval estimate; the
    MCM guess of a young cluster is no measurement). Each gain is min(Δ/T, 1), Δ the time since
    the object was last seen and T in frames, so the filters' memory is in time, whatever the event
-   rate and however long it coasted; the residual's gain on the velocity is Δ/T², at most 1/Δ.
+   rate and however long it coasted; the residual's gain on the velocity is Δ/T², at most 1/Δ,
+   and what it adds to the velocity in one step is clipped to the velocity's tolerance.
    Its half-size, colour and class follow its members' (colour and class from its most active
    member that has a class: an edge mixture with the background has none).
 5. **Merge.** An object whose centre lies in an older object's box, velocities agreeing, is a
@@ -228,17 +229,19 @@ def _update(O, o, t, k):
         if measured:
             O[o, O_VX], O[o, O_VY] = O[o, O_MEMBER_VX], O[o, O_MEMBER_VY]
     else:
-        # α-β: the centre moves towards the measurement, the velocity by the residual's rate,
+        # α-β: the centre moves towards the measurement, the velocity by the residual's rate
+        # (clipped to the velocity's tolerance: a box that grows as a member joins is no motion),
         # and towards its most active member's measured velocity.
         ex, ey = zx - O[o, O_X], zy - O[o, O_Y]
+        lim = O[o, O_TOL]
         g_pos = _gain(seen, k.track_frames)
         g_rate = rate_gain(seen, k.rate_frames)
         g_vel = _gain(seen, k.velocity_frames) if measured else 0.0
         g_size = _gain(seen, k.size_frames)
         O[o, O_X] += g_pos * ex
         O[o, O_Y] += g_pos * ey
-        O[o, O_VX] += g_rate * ex + g_vel * (O[o, O_MEMBER_VX] - O[o, O_VX])
-        O[o, O_VY] += g_rate * ey + g_vel * (O[o, O_MEMBER_VY] - O[o, O_VY])
+        O[o, O_VX] += min(max(g_rate * ex, -lim), lim) + g_vel * (O[o, O_MEMBER_VX] - O[o, O_VX])
+        O[o, O_VY] += min(max(g_rate * ey, -lim), lim) + g_vel * (O[o, O_MEMBER_VY] - O[o, O_VY])
         O[o, O_RX] += g_size * (hx - O[o, O_RX])
         O[o, O_RY] += g_size * (hy - O[o, O_RY])
     if O[o, O_COLOUR_WEIGHT] > 0.0:

@@ -101,7 +101,9 @@ class ClustererParams(BaseModel):
     mixing_tolerance: NonNegative = 12.0  # L1 (luma weighted) distance to a mixing segment
     # Beyond the paper: one cluster per object (docs/TUNING.md, "One cluster per object").
     # Scales are in steps of 1/64 in the fixed model and the RTL.
-    seek_scale: NonNegative = 0.234375  # the seek margin grows by seek_scale·max(Rx, Ry): a large object's far edge is in reach
+    # The seek margin grows by seek_scale·max(Rx, Ry), so a large object's far edge is in reach. Off
+    # by default: with the object layer on it costs a multiply per slot and buys no HOTA (docs/TUNING.md).
+    seek_scale: NonNegative = 0.0
     merge: bool = True  # filter step: merge two clusters whose grown boxes overlap and whose velocities agree
     merge_scale: NonNegative = 0.390625  # for merging, each box grows by merge_scale·max(Rx, Ry)
     merge_v_tol: NonNegative = 0.32  # px/frame: the L1 velocity difference two merging clusters may have,
@@ -123,18 +125,18 @@ class ClustererParams(BaseModel):
     # gated association. Times in frames of the event stream.
     objects: bool = True
     n_objects: Annotated[int, Field(ge=1, le=256)] = 16  # object slots
-    object_gate: NonNegative = 0.56  # px: the margin of the overlap tests (cluster with cluster, group with object)
-    object_link_along: NonNegative = 5.06  # along their motion, clusters link this many of their half-sizes across it apart
-    object_v_tol: NonNegative = 0.275  # px/frame: common fate, velocities within this (L1)
-    object_v_rel: NonNegative = 0.29  # plus this fraction of the faster L1 speed
-    object_track_frames: Positive = 0.83  # the centre's α-β filter: time constant, frames
-    object_rate_frames: Positive = 1.48  # ... and of the velocity's pull by the centre's residual
-    object_velocity_frames: Positive = 4.9  # the velocity's pull towards its clusters' velocities
-    object_size_frames: Positive = 2.2
-    object_colour_frames: Positive = 0.45
-    object_birth_frames: NonNegative = 1.18  # members for this long before an object is reported
-    object_coast_frames: NonNegative = 1.93  # an object without members is predicted and reported this long,
-    object_keep_frames: NonNegative = 50.0  # and kept, unreported, this long for its clusters to return
+    object_gate: NonNegative = 2.55  # px: the margin of the overlap tests (cluster with cluster, group with object)
+    object_link_along: NonNegative = 4.375  # along their motion, clusters link this many of their half-sizes across it apart
+    object_v_tol: NonNegative = 1.98  # px/frame: common fate, velocities within this (L1)
+    object_v_rel: NonNegative = 0.875  # plus this fraction of the faster L1 speed
+    object_track_frames: Positive = 1.42  # the centre's α-β filter: time constant, frames
+    object_rate_frames: Positive = 2.09  # ... and of the velocity's pull by the centre's residual
+    object_velocity_frames: Positive = 17.2  # the velocity's pull towards its clusters' velocities
+    object_size_frames: Positive = 0.145
+    object_colour_frames: Positive = 1.78
+    object_birth_frames: NonNegative = 4.36  # members for this long before an object is reported
+    object_coast_frames: NonNegative = 9.2  # an object without members is predicted and reported this long,
+    object_keep_frames: NonNegative = 82.0  # and kept, unreported, this long for its clusters to return
 
     @model_validator(mode="after")
     def _consistent(self):

@@ -18,6 +18,7 @@ from evclust.events import EventMeta
 from evclust.tracks import OBJECT_DTYPE, TRACK_DTYPE, TrackMeta
 
 CHUNK = 1 << 18  # events per compiled call: the progress bar's granularity
+STEPS_PER_FEED = 1 << 12  # filter steps per object-layer call in rerun_objects (its output buffer is per step)
 
 
 @dataclasses.dataclass
@@ -29,6 +30,7 @@ class TrackRun:
     clusterer: object = None  # the model after the run: its state, and the fixed model's logs
     objects: np.ndarray | None = None  # object records (None: no object layer, or they went to a sink)
     object_meta: TrackMeta | None = None  # their metadata (None: no object layer)
+    step_times: np.ndarray | None = None  # every filter step's time, records or not (None: records went to a sink)
 
     @property
     def output(self) -> tuple[np.ndarray, TrackMeta]:
@@ -184,7 +186,7 @@ def track_stream(
     layer = _object_layer(clusterer, params, model, meta.width, meta.height, out_meta.t_frame_us)
     object_meta = dataclasses.replace(out_meta, kind="objects") if layer is not None else None
     start = time.perf_counter()
-    kept, kept_objects, n_records, n_objects = [], [], 0, 0
+    kept, kept_objects, kept_steps, n_records, n_objects = [], [], [], 0, 0
     with tqdm(total=total, unit="ev", unit_scale=True, disable=None if progress else True, desc=f"track ({model})") as bar:
         for chunk in chunks:
             step = getattr(clusterer, "feed_size", CHUNK)  # the RTL takes smaller bites, for the progress bar
@@ -195,6 +197,7 @@ def track_stream(
                 n_records += tracks.size
                 if sink is None:
                     kept.append(tracks)
+                    kept_steps.append(np.asarray(clusterer.steps, np.float64))
                 elif tracks.size:
                     sink(tracks)
                 if layer is not None:
@@ -213,7 +216,31 @@ def track_stream(
     stats = {**clusterer.stats(), "records": n_records}
     if layer is not None:
         stats |= layer.stats() | {"object_records": n_objects}
-    return TrackRun(tracks, out_meta, stats, wall, clusterer, objects, object_meta)
+    step_times = None if sink is not None else (np.concatenate(kept_steps) if kept_steps else np.zeros(0))
+    return TrackRun(tracks, out_meta, stats, wall, clusterer, objects, object_meta, step_times)
+
+
+def rerun_objects(run: TrackRun, params: ClustererParams) -> TrackRun:
+    """A float run's cluster records through the object layer again, with the object parameters
+    of `params` (whose other parameters must be the run's): tuning the object layer alone needs
+    the clusters once per scene, not once per trial."""
+    if run.meta.model != "float" or run.tracks is None or run.step_times is None:
+        raise EvclustError("rerun_objects needs a float run that kept its cluster records and step times")
+    from evclust.clusterer.objects import FloatObjects
+
+    params = params.resolved(run.meta.t_frame_us)
+    if not params.objects:
+        return dataclasses.replace(run, objects=None, object_meta=None)
+    rows = np.stack([run.tracks[name].astype(np.float64) for name in TRACK_DTYPE.names], axis=1)
+    layer = FloatObjects(params, run.meta.width, run.meta.height, run.meta.t_frame_us)
+    start = time.perf_counter()
+    bounds = np.searchsorted(run.tracks["step"], np.arange(0, run.step_times.size + STEPS_PER_FEED, STEPS_PER_FEED))
+    objects = np.concatenate([rows_to_records(layer.feed(rows[lo:hi], run.step_times[i : i + STEPS_PER_FEED]), OBJECT_DTYPE)
+                              for i, lo, hi in zip(range(0, run.step_times.size, STEPS_PER_FEED), bounds, bounds[1:])]
+                             or [np.zeros(0, OBJECT_DTYPE)])  # fmt: skip
+    stats = {**run.stats, **layer.stats(), "object_records": objects.size}
+    return dataclasses.replace(run, objects=objects, object_meta=dataclasses.replace(run.meta, kind="objects"), stats=stats,
+                               wall_s=run.wall_s + time.perf_counter() - start)  # fmt: skip
 
 
 def track_events(

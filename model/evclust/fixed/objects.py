@@ -236,8 +236,11 @@ def _update(O, o, t, k, log):
         ey = zy - O[o, O_Y]
         O[o, O_X] += (g_pos * ex) >> OBJECT_GAIN_FRAC
         O[o, O_Y] += (g_pos * ey) >> OBJECT_GAIN_FRAC
-        vx = O[o, O_VX] + _align(g_rate * ex, OBJECT_GAIN_FRAC + k.fp, k.fv) + ((g_vel * (O[o, O_MEMBER_VX] - O[o, O_VX])) >> OBJECT_GAIN_FRAC)
-        vy = O[o, O_VY] + _align(g_rate * ey, OBJECT_GAIN_FRAC + k.fp, k.fv) + ((g_vel * (O[o, O_MEMBER_VY] - O[o, O_VY])) >> OBJECT_GAIN_FRAC)
+        lim = O[o, O_TOL]  # obj_tolerance, the velocity's fraction
+        rate_x = min(max(_align(g_rate * ex, OBJECT_GAIN_FRAC + k.fp, k.fv), -lim), lim)
+        rate_y = min(max(_align(g_rate * ey, OBJECT_GAIN_FRAC + k.fp, k.fv), -lim), lim)
+        vx = O[o, O_VX] + rate_x + ((g_vel * (O[o, O_MEMBER_VX] - O[o, O_VX])) >> OBJECT_GAIN_FRAC)
+        vy = O[o, O_VY] + rate_y + ((g_vel * (O[o, O_MEMBER_VY] - O[o, O_VY])) >> OBJECT_GAIN_FRAC)
         O[o, O_VX] = _saturate(vx, k.velocity_min, k.velocity_max, S_OBJ_VELOCITY, log)
         O[o, O_VY] = _saturate(vy, k.velocity_min, k.velocity_max, S_OBJ_VELOCITY, log)
         O[o, O_RX] += (g_size * (hx - O[o, O_RX])) >> OBJECT_GAIN_FRAC

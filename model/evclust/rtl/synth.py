@@ -108,8 +108,11 @@ def script(src: Path, out: Path, hier: bool, top: str = TOP, static: bool = Fals
     comb = "* t:FD* %d t:RAM* %d t:SRL* %d @regdsp %d"
     reads = " ".join(str(src / f) for f in RTL_SOURCES)
     lines = ABC9_KNOBS + [
-        f"read_verilog -I{src} {reads}",
+        # -defer: each module is elaborated with the parameters it is instantiated with, not with
+        # its defaults first (those need not match this header, and a mismatch stops elaboration).
+        f"read_verilog -defer -I{src} {reads}",
         *([f"chparam -set RUNTIME_CONFIG 0 {top}"] if static else []),  # the header's constants built in
+        f"hierarchy -top {top}",  # (hierarchy -chparam on deferred modules trips an assertion in Yosys 0.4x)  # the header's constants built in
         f"{SYNTH.format(top=top)}{'' if hier else ' -flatten'}",
         f"tee -o {out / 'stat.json'} stat -json -tech xilinx",
         f"tee -o {out / 'stat.txt'} stat -tech xilinx",  # per module when hier

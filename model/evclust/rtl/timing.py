@@ -55,8 +55,11 @@ def yosys_script(src: Path, out: Path, static: bool = False) -> str:
     reads = " ".join(str(src / f) for f in RTL_SOURCES)
     # ABC9's &mfs and &verify off, as for synth_xilinx (evclust.rtl.synth: &mfs runs for tens of minutes here).
     return "\n".join(ABC9_KNOBS + [
-        f"read_verilog -I{src} {reads}",
-        *([f"chparam -set RUNTIME_CONFIG 0 {TOP}"] if static else []),
+        # -defer: each module is elaborated with the parameters it is instantiated with, not with
+        # its defaults first (those need not match this header, and a mismatch stops elaboration).
+        f"read_verilog -defer -I{src} {reads}",
+        *([f"chparam -set RUNTIME_CONFIG 0 {TOP}"] if static else []),  # the header's constants built in
+        f"hierarchy -top {TOP}",  # (hierarchy -chparam on deferred modules trips an assertion in Yosys 0.4x)
         f"synth_ecp5 -top {TOP} -json {out / 'netlist.json'}",
         f"tee -o {out / 'stat.txt'} stat",
     ]) + "\n"  # fmt: skip

@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 import dataclasses
+import json
 import time
 
 import numpy as np
 
 from evclust.clusterer import ClustererParams, track_events
+from evclust.clusterer.run import rerun_objects
 from evclust.events import read_events
 from evclust.metrics import tracking
 from evclust.scenes.truth import read_truth
@@ -41,12 +43,20 @@ class SceneResult:
         return self.matches.size / self.n_records if self.n_records else None
 
 
+def _cluster_key(name: str, params: ClustererParams) -> tuple[str, str]:
+    """A scene and the parameters its clusters depend on (all but the object layer's)."""
+    keep = {k: v for k, v in params.model_dump(mode="json").items() if k != "objects" and not k.startswith("object_")}
+    return name, json.dumps(keep, sort_keys=True)
+
+
 def evaluate_scene(files: SceneFiles, params: ClustererParams, model: str = "float", cache: dict | None = None,
-                   trackeval: bool = True) -> SceneResult:  # fmt: skip
+                   trackeval: bool = True, cluster_runs: dict | None = None) -> SceneResult:  # fmt: skip
     """Track one scene and score what the run reports (its object records when the parameters
     have an object layer; its cluster records, scored too, in `.clusters`). `cache` (a dict)
     keeps the scene's events and truth for the next call in this process; trackeval=False skips
-    HOTA/MOTA/IDF1 (a tuning loop's speed)."""
+    HOTA/MOTA/IDF1 (a tuning loop's speed). `cluster_runs` (a dict; float model) keeps each
+    scene's cluster run per cluster parameter set, so that a call that changes only the object
+    layer's parameters runs the object layer alone."""
     if cache is not None and files.name in cache:
         events, meta, truth = cache[files.name]
     else:
@@ -54,7 +64,13 @@ def evaluate_scene(files: SceneFiles, params: ClustererParams, model: str = "flo
         if cache is not None:
             cache[files.name] = (events, meta, truth)
     start = time.perf_counter()
-    run = track_events(events, meta, params, model=model)
+    if cluster_runs is not None and model == "float":
+        key = _cluster_key(files.name, params)
+        if key not in cluster_runs:
+            cluster_runs[key] = track_events(events, meta, params.model_copy(update={"objects": False}), model=model)
+        run = rerun_objects(cluster_runs[key], params)
+    else:
+        run = track_events(events, meta, params, model=model)
     wall = time.perf_counter() - start
 
     def result(records, records_meta) -> SceneResult:

@@ -32,6 +32,7 @@ TARGETS = (
     ("class_palette", ">=", 0.90, "palette classification"),
 )
 CATEGORY_RECALL = 0.80  # every category's recall
+SEEK_SCALE_TUNED = 0.234375  # the scaled seek's last tuned scale, before the object layer made it redundant (docs/TUNING.md)
 FIXED_POINTS = 0.01  # fixed within 1 point (absolute) of float on every pooled figure given as a share
 
 
@@ -54,7 +55,7 @@ def ablation_configurations() -> list[Configuration]:
     d = ClustererParams()
     off = {
         "no merging": {"merge": False},
-        "no scaled seek": {"seek_scale": 0.0},
+        "scaled seek on" if not d.seek_scale else "no scaled seek": {"seek_scale": SEEK_SCALE_TUNED if not d.seek_scale else 0.0},
         "no noise gate": {"noise_gate": 0.0},
         "creation support on" if not d.create_support else "no creation support": {"create_support": not d.create_support},
         "no warm start (plain α filters)": {"velocity_warm_start": False},

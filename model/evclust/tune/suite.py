@@ -61,7 +61,7 @@ SUITE_SPACE = (
 )
 # Scales the fixed model holds in steps of 1/64 (formats.SCALE_FRAC_BITS): searched on that grid,
 # so that the float and the fixed model use the same value.
-ON_SCALE_GRID = ("seek_scale", "merge_scale", "merge_v_rel")
+ON_SCALE_GRID = ("seek_scale", "merge_scale", "merge_v_rel", "object_link_along", "object_v_rel")
 SUITE_CATEGORICAL = (
     ("merge", (True, False)),
     ("create_support", (True, False)),
@@ -94,33 +94,43 @@ def values_of(p: ClustererParams) -> dict:
     return values
 
 
-def suggest(trial, base: ClustererParams) -> ClustererParams:
+def searched(only: str | None = None) -> tuple[tuple, tuple]:
+    """The continuous and the categorical parameters searched: all, or those whose names start with `only`."""
+    keep = (lambda name: True) if not only else (lambda name: name.startswith(only))
+    return tuple(s for s in SUITE_SPACE if keep(s[0])), tuple(s for s in SUITE_CATEGORICAL if keep(s[0]))
+
+
+def suggest(trial, base: ClustererParams, only: str | None = None) -> ClustererParams:
+    space, categorical = searched(only)
     values = {}
-    for name, low, high, scale in SUITE_SPACE:
+    for name, low, high, scale in space:
         step = 1 / 64 if name in ON_SCALE_GRID else None
         values[name] = trial.suggest_float(name, low, high, log=scale == "log", step=step)
-    for name, choices in SUITE_CATEGORICAL:
+    for name, choices in categorical:
         values[name] = trial.suggest_categorical(name, list(choices))
     return params_from_values(values, base)
 
 
 _EVENTS_CACHE: dict = {}
+_CLUSTER_RUNS: dict = {}  # per scene and cluster parameters: a search of the object layer alone runs the clusters once
 
 
-def split_objective(folder: str, seeds: tuple[int, ...], params: ClustererParams) -> tuple[float, dict]:
+def split_objective(folder: str, seeds: tuple[int, ...], params: ClustererParams, objects_only: bool = False) -> tuple[float, dict]:
     """The suite objective of one parameter set on the given scenes (their events kept in this
-    process between trials), and the pooled figures."""
+    process between trials), and the pooled figures. `objects_only`: the trials differ only in
+    the object layer's parameters, so each scene's clusters are run once and kept."""
     from evclust.suite.aggregate import figures, objective
     from evclust.suite.evaluate import evaluate_scene
     from evclust.suite.prepare import SceneFiles
     from evclust.scenes.generate import scene_name
 
-    results = [evaluate_scene(SceneFiles(scene_name(s), Path(folder)), params, cache=_EVENTS_CACHE) for s in seeds]
+    runs = _CLUSTER_RUNS if objects_only else None
+    results = [evaluate_scene(SceneFiles(scene_name(s), Path(folder)), params, cache=_EVENTS_CACHE, cluster_runs=runs) for s in seeds]
     f = figures(results)
     return objective(f), f
 
 
-def _worker(storage: str, study_name: str, folder: str, seeds, base: ClustererParams, trials: int, seed: int) -> int:
+def _worker(storage: str, study_name: str, folder: str, seeds, base: ClustererParams, trials: int, seed: int, only: str | None = None) -> int:
     """One Dask task: pull `trials` trials from the shared study."""
     import optuna
 
@@ -130,7 +140,7 @@ def _worker(storage: str, study_name: str, folder: str, seeds, base: ClustererPa
     study = optuna.load_study(study_name=study_name, storage=storage, sampler=sampler)
 
     def objective(trial):
-        value, f = split_objective(folder, seeds, suggest(trial, base))
+        value, f = split_objective(folder, seeds, suggest(trial, base, only), objects_only=bool(only) and only.startswith("object_"))
         for key in ("HOTA", "IDF1", "recall", "precision", "tracks_per_object", "position_rel_rmse", "interval_nrmse", "mcm_nrmse", "object_nrmse"):
             trial.set_user_attr(key, f.get(key))
         return value if math.isfinite(value) else 1e9
@@ -150,10 +160,13 @@ class SuiteTuneResult:
 
 def tune_suite(
     client, folder: str | Path, seeds: tuple[int, ...], base: ClustererParams, trials: int, storage: str,
-    study_name: str, seed: int = 0, progress: bool = True,
+    study_name: str, seed: int = 0, progress: bool = True, only: str | None = None,
 ) -> SuiteTuneResult:  # fmt: skip
     """Search `trials` more trials of the study (created if new, with `base` as its first trial),
-    spread over the client's workers."""
+    spread over the client's workers; `only`: just the parameters whose names start with it
+    (the rest as in `base`)."""
+    if not any(searched(only)):
+        raise EvclustError(f"--only {only}: no searched parameter starts with it")
     import optuna
 
     optuna.logging.set_verbosity(optuna.logging.WARNING)
@@ -164,11 +177,13 @@ def tune_suite(
     except Exception as exc:  # a bad URL, an unreachable database
         raise EvclustError(f"optuna storage {storage}: {exc}") from None
     if not study.trials:
-        study.enqueue_trial(values_of(base))  # the starting point: the search can only improve on it
+        space, categorical = searched(only)
+        names = {s[0] for s in space + categorical}
+        study.enqueue_trial({k: v for k, v in values_of(base).items() if k in names})  # the starting point: the search can only improve on it
     workers = max(1, len(client.scheduler_info()["workers"]))
     shares = [trials // workers + (1 if i < trials % workers else 0) for i in range(workers)]
     done_before = len(study.trials)
-    futures = [client.submit(_worker, storage, study_name, str(folder), tuple(seeds), base, n, seed + i, pure=False)
+    futures = [client.submit(_worker, storage, study_name, str(folder), tuple(seeds), base, n, seed + i, only, pure=False)
                for i, n in enumerate(shares) if n]  # fmt: skip
     with tqdm(total=trials, desc=f"tune {study_name}", unit="trial", disable=None if progress else True) as bar:
         while not all(f.done() for f in futures):
