@@ -81,13 +81,20 @@ def main() -> int:
         "sweep, merges and tail). Cycles count from the end of the reset, so they include the reset's fill: one cycle "
         "per creation-support map cell where the map is on (creation_support, suite_clip).",
         "",
-        "| case | N | events | cycles | cycles/event | cycles/event outside sweeps | sweeps | cycles/sweep | evictions + drops |",
-        "|---|---:|---:|---:|---:|---:|---:|---:|---:|",
+        "The object unit (evclust_objects, where the case has an object layer) works on each step while the core goes "
+        "on with its events: `object unit cycles/step` is its busy time per step, and `core held` the filter-step cycles "
+        "the core waited for it (a record it could not pass on, or the last step's end not taken yet).",
+        "",
+        "| case | N | events | cycles | cycles/event | cycles/event outside sweeps | sweeps | cycles/sweep | evictions + drops "
+        "| object unit cycles/step | core held (cycles) |",
+        "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
     for r in cases["verilator"]:
         outside = (r["cycles"] - r["filter_cycles"]) / r["events"]
+        busy = f"{r['object_busy_cycles'] / max(1, r['filter_steps']):.1f}" if r["object_busy_cycles"] else "—"
         lines.append(f"| {r['case']} | {r['n']} | {r['events']:,} | {r['cycles']:,} | {r['cycles'] / r['events']:.2f} | {outside:.2f} "
-                     f"| {r['filter_steps']} | {r['filter_cycles'] / max(1, r['filter_steps']):.1f} | {r['evictions']} |")  # fmt: skip
+                     f"| {r['filter_steps']} | {r['filter_cycles'] / max(1, r['filter_steps']):.1f} | {r['evictions']} "
+                     f"| {busy} | {r['object_wait_cycles']:,} |")  # fmt: skip
     same = all(a["cycles"] == b["cycles"] for a, b in zip(cases["icarus"], cases["verilator"]))
     lines += ["", f"Icarus counts the same cycles for every case: {'yes' if same else '**no**'}.", *sustained(cases["verilator"])]
     lines += [

@@ -27,6 +27,7 @@ import common  # noqa: F401  (first: pins every thread pool to one core)
 from evclust.clusterer import ClustererParams
 from evclust.clusterer.run import prepare_run, track_stream
 from evclust.metrics import score
+from evclust.report.results import VIDEO_SECTION
 from evclust.scenes.truth import read_truth
 from evclust.simulator.source import open_events
 from evclust.tracks import track_writer, read_tracks
@@ -36,7 +37,7 @@ ROOT = Path(__file__).resolve().parents[1]
 VIDEO_DIR = ROOT / "build" / "video"
 VIDEO = VIDEO_DIR / "vtest.avi"
 EVCLUST = ROOT / ".venv" / "bin" / "evclust"
-START, END = "<!-- results:video:start -->", "<!-- results:video:end -->"
+START, END = VIDEO_SECTION  # make results keeps this section
 
 # name -> (sensor effects, clusterer overrides)
 CONFIGURATIONS = {

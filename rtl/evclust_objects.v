@@ -845,5 +845,8 @@ module evclust_objects #(
             endcase
         end
     end
+`ifdef FORMAL
+`include "evclust_objects_props.vh"
+`endif
 endmodule
 `default_nettype wire

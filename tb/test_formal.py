@@ -87,6 +87,24 @@ BREAKAGES = {
         "wire                  div_start = state == ST_MERGE;",
         ("assert (!f_filter || f_filter_cycles < F_FILTER_BOUND);", "f_filter_cycles + f_merge_x_count <= f_sweep_cycles + 2 + MERGE_MOMENT_W);"),
     ),
+    "object unit overwrites an object record before it is taken": (
+        "evclust_objects",
+        "S_OUT: if (out_free) begin",
+        "S_OUT: begin",
+        ("assert (obj_valid && obj_data == $past(obj_data));",),
+    ),
+    "object unit passes a record on while it works on a step": (
+        "evclust_objects",
+        "assign out_rec_valid = collecting && rec_valid;",
+        "assign out_rec_valid = rec_valid;",
+        ("assert ((rec_valid && rec_ready) == (out_rec_valid && out_rec_ready));",),
+    ),
+    "object unit loses count of the step's records": (
+        "evclust_objects",
+        "                        m <= m + 1'b1;\n",
+        "                        m <= m;\n",
+        ("assert ({1'b0, m} == f_recs);",),
+    ),
 }
 # The job that proves a breakage's module, where it is not <module>.sby.
 JOB = {"core's merge never finishes (its dividers restart in every MERGE cycle)": "evclust_core_merge"}

@@ -317,6 +317,19 @@ def target_table(results: list[SceneResult]) -> list[str]:
     return lines
 
 
+# The real-video section of RESULTS.md, written by bench/video.py (make results-video): kept as it is.
+VIDEO_SECTION = ("<!-- results:video:start -->", "<!-- results:video:end -->")
+
+
+def _kept_section(path: Path, markers: tuple[str, str]) -> str:
+    """The part of an existing file between `markers`, markers included ("" when there is none)."""
+    start, end = markers
+    text = path.read_text() if path.exists() else ""
+    if start not in text or end not in text:
+        return ""
+    return start + text.split(start, 1)[1].split(end, 1)[0] + end
+
+
 def write_results(
     path: Path, scenes=("pedestrian", "traffic"), figures: Path | None = None, preamble: str = "", epilogue: str = ""
 ) -> list[SceneResult]:
@@ -332,6 +345,9 @@ def write_results(
     lines += configuration_table(prepared)
     lines += agreement_table(prepared)
     lines.append(epilogue)
+    video = _kept_section(Path(path), VIDEO_SECTION)
+    if video:
+        lines += ["", video]
     with atomic_output(path) as tmp:
         tmp.write_text("\n".join(lines).lstrip() + "\n")
     return results

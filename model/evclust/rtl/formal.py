@@ -45,8 +45,18 @@ def _merge_header() -> str:
     return params_header(params, 160, 120, params.t_frame_us or 16666.0)
 
 
+def _objects_header() -> str:
+    """evclust_objects.sby's header: the defaults (the object layer on) at N = 4 with K = 2
+    object slots on the same 160x120 sensor; the stream properties do not depend on the sizes."""
+    from evclust.clusterer import ClustererParams
+    from evclust.rtl.sources import params_header
+
+    params = ClustererParams(n_clusters=4, n_objects=2, support_cell_bits=4)
+    return params_header(params, 160, 120, params.t_frame_us or 16666.0)
+
+
 # Jobs (by file stem) whose header is generated: the function that writes it.
-GENERATED_HEADERS = {"evclust_core_merge": _merge_header}
+GENERATED_HEADERS = {"evclust_core_merge": _merge_header, "evclust_objects": _objects_header}
 
 
 def jobs(root: Path = FORMAL_DIR) -> list[Path]:

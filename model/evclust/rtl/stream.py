@@ -26,6 +26,8 @@ class RtlRun:
     filter_steps: int
     stream_s: float  # time in the stream: loading batches, simulating, reading records back
     total_s: float  # the whole co-simulation: simulator start, the model and the comparison too
+    object_busy_cycles: int = 0  # cycles the object unit worked on a step
+    object_wait_cycles: int = 0  # filter-step cycles the core waited for the object unit
 
     @property
     def cycles_per_event(self) -> float:
@@ -57,4 +59,5 @@ def run_stream(
     start = time.perf_counter()
     result = run(sim, header, "model_in_the_loop", config)
     total = time.perf_counter() - start
-    return RtlRun(sim, result["events"], result["records"], result["cycles"], result["filter_cycles"], result["filter_steps"], result["wall_s"], total)
+    return RtlRun(sim, result["events"], result["records"], result["cycles"], result["filter_cycles"], result["filter_steps"], result["wall_s"], total,
+                  result.get("object_busy_cycles", 0), result.get("object_wait_cycles", 0))  # fmt: skip
