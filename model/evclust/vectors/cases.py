@@ -300,13 +300,14 @@ def creation_support() -> Case:
 # ---------------------------------------------------------------------------------------------
 # The object layer's cases: blobs whose paths give each behaviour in a few hundred events. The
 # object layer's times are short (birth 1 frame, coast 2, keep 6) so that each shows within a
-# case; the clusters have measured velocities after τ = 2 frames.
+# case; the clusters have measured velocities after τ = 2 frames. A filter step every 16 events
+# (a few per frame) gives the object layer all the steps it needs, at half the RTL cycles of 8.
 
 OBJECT_SMALL = dict(width=96, height=64, t_frame_us=10_000.0)
 
 
 def _object_params(**update) -> ClustererParams:
-    base = dict(t_half_us=4000.0, object_gate=2.0, object_link_along=3.0, object_v_tol=0.4, object_v_rel=0.3, object_track_frames=1.0,
+    base = dict(filter_every=16, t_half_us=4000.0, object_gate=2.0, object_link_along=3.0, object_v_tol=0.4, object_v_rel=0.3, object_track_frames=1.0,
                 object_rate_frames=3.0, object_velocity_frames=2.0, object_size_frames=1.0, object_colour_frames=1.0,
                 object_birth_frames=1.0, object_coast_frames=2.0, object_keep_frames=6.0, n_objects=8)  # fmt: skip
     return _small_params(**{**base, **update})
