@@ -83,7 +83,7 @@ def main() -> int:
     for model in MODELS:
         with_layer = next(r[6] for r in rows if r[0] == "traffic" and r[1] == "defaults" and r[2] == model)
         without = next(r[6] for r in rows if r[0] == "traffic" and r[1] == "defaults, no object layer" and r[2] == model)
-        lines.append(f"The object layer's share of the {model} model's time on `traffic` (defaults, medians of the same run): "
+        lines.append(f"What the object layer adds to the {model} model's time on `traffic` (defaults, medians of the same run): "
                      f"{100 * (with_layer / without - 1):+.1f} %.")  # fmt: skip
     lines.append(END)
     text = "\n".join(lines) + "\n"

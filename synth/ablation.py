@@ -117,6 +117,11 @@ def section(all_on: dict, costs: dict, objects: dict, support: tuple, tracking: 
     lines.append(f"| {label} | {'yes' if defaults.create_support else '**no**'} | " + " | ".join(on_off(config, defaults.create_support))
                  + f" | 0 | 0 | 0 | RAM: {cells:,} cells × {bits} bits = {total / 8 / 1024:,.0f} KiB ({-(-total // 36864)} RAMB36) | | |")  # fmt: skip
     o = objects
+    bought = ""
+    if tracking and "no object layer" in tracking and "default" in tracking:
+        on, off = tracking["default"]["figures"], tracking["no object layer"]["figures"]
+        bought = (f" With it, on the tuning split: HOTA {_pct(on['HOTA'])} against {_pct(off['HOTA'])} for the cluster records "
+                  f"of the same run, {on['tracks_per_object']:.2f} tracks per object against {off['tracks_per_object']:.2f}.")
     return "\n".join([
         START,
         f"Hardware: `.venv/bin/python synth/ablation.py --write docs/TUNING.md`, run "
@@ -131,7 +136,7 @@ def section(all_on: dict, costs: dict, objects: dict, support: tuple, tracking: 
         "",
         f"The object unit alone (`evclust_objects`, K = {defaults.n_objects} object slots behind N = {N_LARGE} clusters, "
         f"constants built in): {o['lut']:,} LUT (+{o['inv']:,} INV), {o['ff']:,} FF, {o['dsp48e1']} DSP48E1, {o['carry4']:,} CARRY4, "
-        f"{o['lutram_luts']} LUTRAM LUTs; logic depth {o['depth_cells']} cells. It runs once per filter step, not per event.",
+        f"{o['lutram_luts']} LUTRAM LUTs; logic depth {o['depth_cells']} cells. It runs once per filter step, not per event.{bought}",
         END,
         "",
     ])  # fmt: skip
