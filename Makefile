@@ -43,7 +43,7 @@ cosim: $(STAMP)
 # Every configuration the model supports against the fixed model, under both simulators: the
 # pairwise cover of the switches (tb/switch_cover.py), every row, and the paper's configuration
 # at N = 4 and 16. `make test` runs two rows of the cover, chosen from the commit hash, and
-# Icarus on the first 30 % of the random streams: here they run whole.
+# Icarus on the first 3,000 events of two random streams: here they run whole.
 cosim-full: $(STAMP)
 	EVCLUST_COVER=all $(PY) -m pytest -q -n auto tb/evclust_core/test_every_configuration.py
 	EVCLUST_COVER=all SIM=icarus $(PY) -m pytest -q -n auto tb/evclust_core/test_evclust_core.py -k "random_streams or axi_lite"

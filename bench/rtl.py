@@ -54,8 +54,11 @@ def sustained(rows) -> list[str]:
     timing = ROOT / "build" / "timing" / "results.json"
     fmax = {r["n_clusters"]: r for r in json.loads(timing.read_text())} if timing.exists() else {}
     if 16 not in fmax:
-        return ["", "Sustained rate at Fmax: no N = 16 result in build/timing/results.json (run `make timing` first)."]
+        return ["", "Sustained rate at Fmax: not computed in this run: no N = 16 result of `make timing` in "
+                    "build/timing/results.json (the placed figures in the section below are of the RTL they name)."]
     mhz = fmax[16]["fmax_mhz"]
+    if mhz is None:
+        return ["", "Sustained rate at Fmax: none: the N = 16 core of `make timing` does not fit the part (section below)."]
     traffic = next(r for r in rows if r["case"] == "traffic_clip")
     rate = traffic["events"] / traffic["cycles"] * mhz
     return ["", f"Sustained rate on `traffic_clip` at the N = 16 Fmax of `make timing` ({mhz:.1f} MHz, LFE5U-85F speed 8): "
