@@ -31,8 +31,10 @@ demo: $(STAMP)
 	$(VENV)/bin/evclust plot $(DEMO)_tracks.csv --truth $(DEMO)_truth.csv -o $(DEMO)_colour.png --kind colour
 	@echo "pictures: $(DEMO)_events.png $(DEMO)_tracks.png $(DEMO)_tracks.mp4 $(DEMO)_velocity.png $(DEMO)_colour.png"
 
+# worksteal: a worker that runs out of tests takes some of the other's, so a long test near the
+# end does not leave a core idle.
 test: $(STAMP)
-	$(PY) -m pytest -q -n auto
+	$(PY) -m pytest -q -n auto --dist worksteal
 
 # Co-simulation of the RTL against the fixed model under one simulator: SIM=icarus|verilator
 # (`make test` runs both).
