@@ -253,12 +253,14 @@ def synthesise(header: str, label: str, hier: bool = False, heartbeat=None, snap
     done = out / "figures.json"
     if done.exists():
         return json.loads(done.read_text()) | {"cached": True}
-    src = stage_sources(out, sources, header)
-    (out / "synth.ys").write_text(script(src, out, hier, top, static))
+    stage_sources(out, sources, header)
+    # Yosys runs in `out` and sees it by relative paths only: yowasp maps its own temporary
+    # folder over /tmp, so an absolute path into a clone under /tmp would not be the clone's.
+    (out / "synth.ys").write_text(script(Path("src"), Path("."), hier, top, static))
     log = out / "yosys.log"
     # -q keeps the console quiet (the log has everything); with console logging on, the
     # yowasp build ends silently inside ABC when stdout is a file or a pipe.
-    cmd = yosys + ["-q", "-l", str(log), str(out / "synth.ys")]
+    cmd = yosys + ["-q", "-l", "yosys.log", "synth.ys"]
     beat = (lambda seconds: heartbeat(seconds, last_step(log))) if heartbeat else None
     status, wall = run_tool(cmd, out, out / "yosys.stderr", beat, on_start)
     where = f"(log: {log.relative_to(REPO)})"

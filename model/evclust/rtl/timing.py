@@ -150,11 +150,14 @@ def place_and_route(header: str, label: str, route: bool = True, heartbeat=None,
     done = out / "figures.json"
     if done.exists():
         return json.loads(done.read_text()) | {"cached": True}
-    src = stage_sources(out, sources, header)
-    (out / "synth.ys").write_text(yosys_script(src, out, static))
-    synth_s = _run("yosys", ["-q", "-l", str(out / "yosys.log"), str(out / "synth.ys")], out, out / "yosys.log", heartbeat)
+    stage_sources(out, sources, header)
+    # The tools run in `out` and see it by relative paths only: yowasp maps its own temporary
+    # folder over /tmp, so an absolute path into a clone under /tmp would not be the clone's.
+    here = Path(".")
+    (out / "synth.ys").write_text(yosys_script(here / "src", here, static))
+    synth_s = _run("yosys", ["-q", "-l", "yosys.log", "synth.ys"], out, out / "yosys.log", heartbeat)
     try:
-        pnr_s = _run("nextpnr-ecp5", nextpnr_args(out, route), out, out / "nextpnr.log", heartbeat)
+        pnr_s = _run("nextpnr-ecp5", nextpnr_args(here, route), out, out / "nextpnr.log", heartbeat)
         measured = _figures(out)
     except EvclustError:
         measured = _unplaced(out)  # too large for the part: a result, not an error
