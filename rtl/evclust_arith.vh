@@ -56,3 +56,19 @@ function automatic signed [63:0] min64;
     end
 endfunction
 
+// a * b as shifted additions over b's b_bits bits (two's complement: b's top bit is its sign;
+// give an unsigned b one bit more). Synthesis builds it from logic cells, where a `*` would
+// take a whole DSP block however narrow its operands: for the narrow multiplies that run per
+// palette entry. Slice the result to the product's width, so synthesis trims the additions.
+function automatic signed [63:0] mul_by_addition;
+    input signed [63:0] a;
+    input signed [63:0] b;
+    input integer b_bits;
+    integer i;
+    begin
+        mul_by_addition = 64'sd0;
+        for (i = 0; i < b_bits - 1; i = i + 1)
+            mul_by_addition = mul_by_addition + ((a <<< i) & {64{b[i]}});
+        mul_by_addition = mul_by_addition - ((a <<< (b_bits - 1)) & {64{b[b_bits - 1]}});
+    end
+endfunction

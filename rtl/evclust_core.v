@@ -74,7 +74,13 @@ module evclust_core #(
 
 
     // The configuration block the datapath reads (CFG_* word indices).
+    /* verilator lint_off UNUSEDSIGNAL */  // a field's word holds only its width's bits
     wire [CFG_W-1:0] cfg_used = RUNTIME_CONFIG != 0 ? cfg : CFG_RESET;
+    /* verilator lint_on UNUSEDSIGNAL */
+    // Its fields, cfg_<register name>, each of its own width (generated from the register map).
+`define EVCLUST_CONFIG_FIELDS
+`include "evclust_params.vh"
+`undef EVCLUST_CONFIG_FIELDS
 
     // ---------------------------------------------------------------- formats and constants
     localparam integer FP = CENTRE_FRAC, FR = HALF_SIZE_FRAC, FA = ACTIVITY_FRAC, FV = V_MCM_FRAC;
@@ -89,20 +95,20 @@ module evclust_core #(
     localparam signed [63:0] MAX_VI = (64'sd1 <<< (V_INT_W - 1)) - 1, MIN_VI = -(64'sd1 <<< (V_INT_W - 1));
     localparam signed [63:0] MAX_STEP = (64'sd1 <<< (CENTRE_STEP_W - 1)) - 1, MIN_STEP = -(64'sd1 <<< (CENTRE_STEP_W - 1));
     localparam signed [63:0] H_MAX = (64'sd1 <<< HIST_W) - 1;
-    wire signed [63:0] K_B_POS = $signed({{(64 - BETA_POS_W){1'b0}}, cfg_used[32 * CFG_BETA_POS +: BETA_POS_W]}), K_B_SIZE = $signed({{(64 - BETA_SIZE_W){1'b0}}, cfg_used[32 * CFG_BETA_SIZE +: BETA_SIZE_W]});
-    wire signed [63:0] K_B_VM = $signed({{(64 - BETA_VEL_MCM_W){1'b0}}, cfg_used[32 * CFG_BETA_VEL_MCM +: BETA_VEL_MCM_W]}), K_B_VI = $signed({{(64 - BETA_VEL_INT_W){1'b0}}, cfg_used[32 * CFG_BETA_VEL_INT +: BETA_VEL_INT_W]});
-    wire signed [63:0] K_B_LUM = $signed({{(64 - BETA_LUM_W){1'b0}}, cfg_used[32 * CFG_BETA_LUM +: BETA_LUM_W]}), K_B_CHRO = $signed({{(64 - BETA_CHRO_W){1'b0}}, cfg_used[32 * CFG_BETA_CHRO +: BETA_CHRO_W]});
-    wire signed [63:0] K_B_BG = $signed({{(64 - BETA_BG_W){1'b0}}, cfg_used[32 * CFG_BETA_BG +: BETA_BG_W]}), K_GAIN = $signed({{(64 - SIZE_GAIN_W){1'b0}}, cfg_used[32 * CFG_SIZE_GAIN +: SIZE_GAIN_W]});
-    wire signed [63:0] K_GAMMA_GLOBAL = $signed({{(64 - GAMMA_GLOBAL_W){1'b0}}, cfg_used[32 * CFG_GAMMA_GLOBAL +: GAMMA_GLOBAL_W]}), K_GPA = $signed({{(64 - GAMMA_PER_ACTIVITY_W){1'b0}}, cfg_used[32 * CFG_GAMMA_PER_ACTIVITY +: GAMMA_PER_ACTIVITY_W]});
-    wire signed [63:0] K_INV_P = $signed({{(64 - INV_P_W){1'b0}}, cfg_used[32 * CFG_INV_P +: INV_P_W]});
-    wire signed [63:0] K_R_MIN = $signed({{(64 - R_MIN_W){1'b0}}, cfg_used[32 * CFG_R_MIN +: R_MIN_W]});
-    wire signed [63:0] K_R_MAX = $signed({{(64 - R_MAX_W){1'b0}}, cfg_used[32 * CFG_R_MAX +: R_MAX_W]}), K_SEEK = $signed({{(64 - SEEK_MARGIN_W){1'b0}}, cfg_used[32 * CFG_SEEK_MARGIN +: SEEK_MARGIN_W]});
-    wire signed [63:0] K_EXIT_M = $signed({{(64 - EXIT_MARGIN_W){1'b0}}, cfg_used[32 * CFG_EXIT_MARGIN +: EXIT_MARGIN_W]}), K_A_MIN = $signed({{(64 - A_MIN_W){1'b0}}, cfg_used[32 * CFG_A_MIN +: A_MIN_W]});
-    wire signed [63:0] K_A_VALID = $signed({{(64 - A_VALID_W){1'b0}}, cfg_used[32 * CFG_A_VALID +: A_VALID_W]}), K_V_MIN_SQ = $signed({{(64 - V_MIN_SQ_W){1'b0}}, cfg_used[32 * CFG_V_MIN_SQ +: V_MIN_SQ_W]});
-    wire signed [63:0] K_V_EXIT_SQ = $signed({{(64 - V_EXIT_SQ_W){1'b0}}, cfg_used[32 * CFG_V_EXIT_SQ +: V_EXIT_SQ_W]}), K_COS_SQ = $signed({{(64 - COS_SQ_EXIT_W){1'b0}}, cfg_used[32 * CFG_COS_SQ_EXIT +: COS_SQ_EXIT_W]});
+    wire signed [63:0] K_B_POS = $signed({{(64 - CFG_BETA_POS_W){1'b0}}, cfg_beta_pos}), K_B_SIZE = $signed({{(64 - CFG_BETA_SIZE_W){1'b0}}, cfg_beta_size});
+    wire signed [63:0] K_B_VM = $signed({{(64 - CFG_BETA_VEL_MCM_W){1'b0}}, cfg_beta_vel_mcm}), K_B_VI = $signed({{(64 - CFG_BETA_VEL_INT_W){1'b0}}, cfg_beta_vel_int});
+    wire signed [63:0] K_B_LUM = $signed({{(64 - CFG_BETA_LUM_W){1'b0}}, cfg_beta_lum}), K_B_CHRO = $signed({{(64 - CFG_BETA_CHRO_W){1'b0}}, cfg_beta_chro});
+    wire signed [63:0] K_B_BG = $signed({{(64 - CFG_BETA_BG_W){1'b0}}, cfg_beta_bg}), K_GAIN = $signed({{(64 - CFG_SIZE_GAIN_W){1'b0}}, cfg_size_gain});
+    wire signed [63:0] K_GAMMA_GLOBAL = $signed({{(64 - CFG_GAMMA_GLOBAL_W){1'b0}}, cfg_gamma_global}), K_GPA = $signed({{(64 - CFG_GAMMA_PER_ACTIVITY_W){1'b0}}, cfg_gamma_per_activity});
+    wire signed [63:0] K_INV_P = $signed({{(64 - CFG_INV_P_W){1'b0}}, cfg_inv_p});
+    wire signed [63:0] K_R_MIN = $signed({{(64 - CFG_R_MIN_W){1'b0}}, cfg_r_min});
+    wire signed [63:0] K_R_MAX = $signed({{(64 - CFG_R_MAX_W){1'b0}}, cfg_r_max}), K_SEEK = $signed({{(64 - CFG_SEEK_MARGIN_W){1'b0}}, cfg_seek_margin});
+    wire signed [63:0] K_EXIT_M = $signed({{(64 - CFG_EXIT_MARGIN_W){1'b0}}, cfg_exit_margin}), K_A_MIN = $signed({{(64 - CFG_A_MIN_W){1'b0}}, cfg_a_min});
+    wire signed [63:0] K_A_VALID = $signed({{(64 - CFG_A_VALID_W){1'b0}}, cfg_a_valid}), K_V_MIN_SQ = $signed({{(64 - CFG_V_MIN_SQ_W){1'b0}}, cfg_v_min_sq});
+    wire signed [63:0] K_V_EXIT_SQ = $signed({{(64 - CFG_V_EXIT_SQ_W){1'b0}}, cfg_v_exit_sq}), K_COS_SQ = $signed({{(64 - CFG_COS_SQ_EXIT_W){1'b0}}, cfg_cos_sq_exit});
     wire signed [63:0] HI_X = (($signed({32'd0, SENSOR_WIDTH[31:0]}) - 64'sd1) <<< FP) - K_EXIT_M;
     wire signed [63:0] HI_Y = (($signed({32'd0, SENSOR_HEIGHT[31:0]}) - 64'sd1) <<< FP) - K_EXIT_M;
-    wire [63:0] TAU = {{(64 - TAU_PHASE_W){1'b0}}, cfg_used[32 * CFG_TAU_US +: TAU_PHASE_W]};
+    wire [63:0] TAU = {{(64 - CFG_TAU_US_W){1'b0}}, cfg_tau_us};
     localparam integer LAST_SLOT_I = N - 1, LAST_SWEEP_I = SWEEP_LEN + TAIL - 1;
     localparam [SWEEP_W-1:0] LAST_SLOT = LAST_SLOT_I[SWEEP_W-1:0];
     localparam [SWEEP_W-1:0] LAST_SWEEP = LAST_SWEEP_I[SWEEP_W-1:0];
@@ -111,39 +117,31 @@ module evclust_core #(
     localparam [SWEEP_W-1:0] N_SLOTS = N[SWEEP_W-1:0], N_ENTRIES = P[SWEEP_W-1:0];
     localparam integer COS_SQ_F = COS_SQ_EXIT_FRAC;
     // One cluster per object (beyond the paper): scaled seek, merging, noise gate, creation support.
-    wire signed [63:0] K_SEEK_SCALE = $signed({{(64 - SEEK_SCALE_W){1'b0}}, cfg_used[32 * CFG_SEEK_SCALE +: SEEK_SCALE_W]});
-    wire signed [63:0] K_MERGE_SCALE = $signed({{(64 - MERGE_SCALE_W){1'b0}}, cfg_used[32 * CFG_MERGE_SCALE +: MERGE_SCALE_W]});
-    wire signed [63:0] K_MERGE_V_TOL = $signed({{(64 - MERGE_V_TOL_W){1'b0}}, cfg_used[32 * CFG_MERGE_V_TOL +: MERGE_V_TOL_W]});
-    wire signed [63:0] K_MERGE_V_REL = $signed({{(64 - MERGE_V_REL_W){1'b0}}, cfg_used[32 * CFG_MERGE_V_REL +: MERGE_V_REL_W]});
-    wire signed [63:0] K_NOISE_GATE = $signed({{(64 - NOISE_GATE_W){1'b0}}, cfg_used[32 * CFG_NOISE_GATE +: NOISE_GATE_W]});
-    wire [31:0] K_SUPPORT_WINDOW = {{(32 - SUPPORT_WINDOW_W){1'b0}}, cfg_used[32 * CFG_SUPPORT_WINDOW +: SUPPORT_WINDOW_W]};
+    wire signed [63:0] K_SEEK_SCALE = $signed({{(64 - CFG_SEEK_SCALE_W){1'b0}}, cfg_seek_scale});
+    wire signed [63:0] K_MERGE_SCALE = $signed({{(64 - CFG_MERGE_SCALE_W){1'b0}}, cfg_merge_scale});
+    wire signed [63:0] K_MERGE_V_TOL = $signed({{(64 - CFG_MERGE_V_TOL_W){1'b0}}, cfg_merge_v_tol});
+    wire signed [63:0] K_MERGE_V_REL = $signed({{(64 - CFG_MERGE_V_REL_W){1'b0}}, cfg_merge_v_rel});
+    wire signed [63:0] K_NOISE_GATE = $signed({{(64 - CFG_NOISE_GATE_W){1'b0}}, cfg_noise_gate});
+    wire [31:0] K_SUPPORT_WINDOW = {{(32 - CFG_SUPPORT_WINDOW_W){1'b0}}, cfg_support_window};
     // Run-time values and switches (registers, docs/REGISTERS.md); their widths are the build's.
-    wire [INV_T_HALF_W-1:0]    K_INV_T_HALF = cfg_used[32 * CFG_INV_T_HALF +: INV_T_HALF_W];
-    wire [LUMA_WEIGHT_W-1:0]   K_LUMA_WEIGHT = cfg_used[32 * CFG_LUMA_WEIGHT +: LUMA_WEIGHT_W];
-    wire [MIXING_TOLERANCE_W-1:0] K_MIXING_TOLERANCE = cfg_used[32 * CFG_MIXING_TOLERANCE +: MIXING_TOLERANCE_W];
-    wire [HALF_SIZE_W-1:0]     K_R_INIT = cfg_used[32 * CFG_R_INIT +: HALF_SIZE_W];
-    wire [FRAME_PER_TAU_W-1:0] K_FRAME_PER_TAU = cfg_used[32 * CFG_FRAME_PER_TAU +: FRAME_PER_TAU_W];
-    wire [EVERY_W-1:0]         K_FILTER_EVERY = cfg_used[32 * CFG_FILTER_EVERY +: EVERY_W];
-    wire [1:0]                 gamma_mode = cfg_used[32 * CFG_GAMMA_MODE +: 2];
-    wire                       warm_start = cfg_used[32 * CFG_WARM_START];
-    wire                       mcm_correct = cfg_used[32 * CFG_MCM_CORRECT];
-    wire                       vote_contrast = cfg_used[32 * CFG_VOTE_CONTRAST];
-    wire                       mixing = cfg_used[32 * CFG_MIXING];
-    wire                       bg_fixed = cfg_used[32 * CFG_BG_FIXED];
-    wire [P-1:0]               background_mask = cfg_used[32 * CFG_BACKGROUND_MASK +: P];
-    wire [BACKGROUND_W-1:0]    bg_init_y = cfg_used[32 * CFG_BG_INIT_Y +: BACKGROUND_W];
-    wire [BACKGROUND_W-1:0]    bg_init_cb = cfg_used[32 * CFG_BG_INIT_CB +: BACKGROUND_W];
-    wire [BACKGROUND_W-1:0]    bg_init_cr = cfg_used[32 * CFG_BG_INIT_CR +: BACKGROUND_W];
+    wire [INV_T_HALF_W-1:0]    K_INV_T_HALF = cfg_inv_t_half;
+    wire [LUMA_WEIGHT_W-1:0]   K_LUMA_WEIGHT = cfg_luma_weight;
+    wire [MIXING_TOLERANCE_W-1:0] K_MIXING_TOLERANCE = cfg_mixing_tolerance;
+    wire [HALF_SIZE_W-1:0]     K_R_INIT = cfg_r_init;
+    wire [FRAME_PER_TAU_W-1:0] K_FRAME_PER_TAU = cfg_frame_per_tau;
+    wire [EVERY_W-1:0]         K_FILTER_EVERY = cfg_filter_every;
+    wire [1:0]                 gamma_mode = cfg_gamma_mode;
+    wire                       warm_start = cfg_warm_start;
+    wire                       mcm_correct = cfg_mcm_correct;
+    wire                       vote_contrast = cfg_vote_contrast;
+    wire                       mixing = cfg_mixing;
+    wire                       bg_fixed = cfg_bg_fixed;
+    wire [P-1:0]               background_mask = cfg_background_mask;
+    wire [BACKGROUND_W-1:0]    bg_init_y = cfg_bg_init_y;
+    wire [BACKGROUND_W-1:0]    bg_init_cb = cfg_bg_init_cb;
+    wire [BACKGROUND_W-1:0]    bg_init_cr = cfg_bg_init_cr;
     // The palette, entry j in bits [8j +: 8] (its registers are Y, Cb, Cr for each entry in turn).
-    wire [8*P-1:0]             palette_y, palette_cb, palette_cr;
-    genvar pj;
-    generate
-        for (pj = 0; pj < P; pj = pj + 1) begin : palette_entry
-            assign palette_y[8*pj +: 8] = cfg_used[32 * (CFG_PALETTE_0_Y + 3 * pj) +: 8];
-            assign palette_cb[8*pj +: 8] = cfg_used[32 * (CFG_PALETTE_0_CB + 3 * pj) +: 8];
-            assign palette_cr[8*pj +: 8] = cfg_used[32 * (CFG_PALETTE_0_CR + 3 * pj) +: 8];
-        end
-    endgenerate
+    wire [8*P-1:0]             palette_y = cfg_palette_y, palette_cb = cfg_palette_cb, palette_cr = cfg_palette_cr;
     localparam signed [63:0] LAST_X = ($signed({32'd0, SENSOR_WIDTH[31:0]}) - 64'sd1) <<< FP;  // the last column, in P's format
     localparam signed [63:0] LAST_Y = ($signed({32'd0, SENSOR_HEIGHT[31:0]}) - 64'sd1) <<< FP;
     localparam signed [63:0] SENSOR_PIXELS = $signed({32'd0, SENSOR_WIDTH[31:0]}) * $signed({32'd0, SENSOR_HEIGHT[31:0]});
@@ -166,24 +164,30 @@ module evclust_core #(
         end
     endfunction
 
-    // The seek margin of a slot in P's format: S + seek_scale * max(Rx, Ry) (model: _margin).
-    function automatic signed [63:0] margin;
-        input [HALF_SIZE_W-1:0] r_x;
-        input [HALF_SIZE_W-1:0] r_y;
+    // A slot's seek window along one axis in P's format: R + S + seek_scale * max(Rx, Ry)
+    // (model: _margin), from the larger half-size's product, taken once as the slot is written.
+    function automatic signed [63:0] reach;
+        input [HALF_SIZE_W-1:0] r;
         input signed [63:0]     seek;
-        input signed [63:0]     seek_scale;
-        reg   [HALF_SIZE_W-1:0] r;
+        input signed [63:0]     scaled_r;  // seek_scale * max(Rx, Ry), unaligned
         begin
-            r = r_x > r_y ? r_x : r_y;
-            margin = seek + align(u64({{(63 - HALF_SIZE_W){1'b0}}, r}) * seek_scale, SEEK_SCALE_FRAC + FR, FP);
+            reach = (u64({{(63 - HALF_SIZE_W){1'b0}}, r}) <<< (FP - FR)) + seek + align(scaled_r, SEEK_SCALE_FRAC + FR, FP);
         end
     endfunction
 
     // The interval filter's warm-up gain 1/n (model: FormatTable.warmup_gains), for 2 <= n < VI_CAP.
     function automatic signed [63:0] warmup_gain;
         input [INTERVAL_UPDATES_W-1:0] n;
+        integer g;
+        reg [GAIN_W-1:0] gain;
         begin
-            warmup_gain = $signed({{(64 - GAIN_W){1'b0}}, WARMUP_GAINS[n * GAIN_W +: GAIN_W]});
+            // A multiplexer over the entries: an index times the entry width would be a multiply
+            // that synthesis maps to a DSP block.
+            gain = {GAIN_W{1'b0}};
+            for (g = 0; g < (1 << INTERVAL_UPDATES_W); g = g + 1)
+                if ({{(32 - INTERVAL_UPDATES_W){1'b0}}, n} == g)
+                    gain = WARMUP_GAINS[g * GAIN_W +: GAIN_W];
+            warmup_gain = $signed({{(64 - GAIN_W){1'b0}}, gain});
         end
     endfunction
 
@@ -255,30 +259,72 @@ module evclust_core #(
 
     // ---------------------------------------------------------------- the cluster table
     reg                            valid         [0:N-1];
-    reg [ID_W-1:0]                 id            [0:N-1];
     reg [CENTRE_W-1:0]             px            [0:N-1];
     reg [CENTRE_W-1:0]             py            [0:N-1];
-    reg [CENTRE_W-1:0]             ppx           [0:N-1];
-    reg [CENTRE_W-1:0]             ppy           [0:N-1];
     reg [HALF_SIZE_W-1:0]          rx            [0:N-1];
     reg [HALF_SIZE_W-1:0]          ry            [0:N-1];
-    reg [ACTIVITY_W-1:0]           act           [0:N-1];
-    reg [DECAY_RESIDUAL_W-1:0]     residual      [0:N-1];
-    reg [T_LAST_W-1:0]             t_last        [0:N-1];
-    reg [GAMMA_W-1:0]              gamma         [0:N-1];
-    reg [V_MCM_W-1:0]              vmx           [0:N-1];
-    reg [V_MCM_W-1:0]              vmy           [0:N-1];
-    reg [MCM_NORM_W-1:0]           norm          [0:N-1];
     reg [V_INT_W-1:0]              vix           [0:N-1];
     reg [V_INT_W-1:0]              viy           [0:N-1];
     reg [INTERVAL_UPDATES_W-1:0]   vi_count      [0:N-1];  // interval measurements + 1, up to the warm-up's end
-    reg [EVENTS_IN_INTERVAL_W-1:0] ev_count      [0:N-1];
-    reg [COLOUR_W-1:0]             col_y         [0:N-1];
-    reg [COLOUR_W-1:0]             col_cb        [0:N-1];
-    reg [COLOUR_W-1:0]             col_cr        [0:N-1];
     reg                            reported      [0:N-1];
     reg                            ever_reported [0:N-1];
-    reg [HIST_W-1:0]               hist          [0:N*P-1];
+    // Derived once as the slot is written, for the searches that compare every slot at once
+    // (no multiply per slot): the seek window's reach per axis in P's format, and for merging
+    // merge_scale * max(Rx, Ry) and merge_v_rel * (|Vx| + |Vy|), both unaligned.
+    localparam integer SCALED_SEEK_W = SEEK_SCALE_W + HALF_SIZE_W + (FP > SEEK_SCALE_FRAC + FR ? FP - SEEK_SCALE_FRAC - FR : 0);
+    localparam integer REACH_BASE_W = HALF_SIZE_W + FP - FR > SEEK_MARGIN_W ? HALF_SIZE_W + FP - FR : SEEK_MARGIN_W;
+    localparam integer REACH_W = (REACH_BASE_W > SCALED_SEEK_W ? REACH_BASE_W : SCALED_SEEK_W) + 2;
+    localparam integer GROW_W = MERGE_SCALE_W + HALF_SIZE_W;
+    localparam integer VREL_W = MERGE_V_REL_W + V_INT_W + 1;
+    reg [REACH_W-1:0]              reach_x       [0:N-1];
+    reg [REACH_W-1:0]              reach_y       [0:N-1];
+    reg [GROW_W-1:0]               grow          [0:N-1];
+    reg [VREL_W-1:0]               vrel          [0:N-1];
+
+    // The rest of a slot, one row per slot in RAM (evclust_slot_ram), fields at ROW_*: one write
+    // port (an update, a creation, a merge or the sweep's stage 0, each in its own state) and two
+    // read ports, A at the event's slot (EXEC) or the swept, scanned or merging slot k, B at the
+    // sweep tail's slot t or the slot a merge absorbs. Only the searches need every slot at once.
+    localparam integer ROW_ID = 0;
+    localparam integer ROW_PPX = ROW_ID + ID_W;
+    localparam integer ROW_PPY = ROW_PPX + CENTRE_W;
+    localparam integer ROW_ACT = ROW_PPY + CENTRE_W;
+    localparam integer ROW_RESIDUAL = ROW_ACT + ACTIVITY_W;
+    localparam integer ROW_T_LAST = ROW_RESIDUAL + DECAY_RESIDUAL_W;
+    localparam integer ROW_GAMMA = ROW_T_LAST + T_LAST_W;
+    localparam integer ROW_VMX = ROW_GAMMA + GAMMA_W;
+    localparam integer ROW_VMY = ROW_VMX + V_MCM_W;
+    localparam integer ROW_NORM = ROW_VMY + V_MCM_W;
+    localparam integer ROW_EV_COUNT = ROW_NORM + MCM_NORM_W;
+    localparam integer ROW_COL_Y = ROW_EV_COUNT + EVENTS_IN_INTERVAL_W;
+    localparam integer ROW_COL_CB = ROW_COL_Y + COLOUR_W;
+    localparam integer ROW_COL_CR = ROW_COL_CB + COLOUR_W;
+    localparam integer ROW_HIST = ROW_COL_CR + COLOUR_W;  // entry c at ROW_HIST + c * HIST_W
+    localparam integer ROW_W = ROW_HIST + P * HIST_W;
+    wire [SLOT_W-1:0] row_a_slot, row_b_slot;
+    wire [ROW_W-1:0]  row_a, row_b;
+    reg               row_we;
+    reg  [SLOT_W-1:0] row_w_slot;
+    reg  [ROW_W-1:0]  row_w;
+    evclust_slot_ram #(.DEPTH(N), .WIDTH(ROW_W), .ADDR_W(SLOT_W)) slot_rows (
+        .clk(clk), .we(row_we), .waddr(row_w_slot), .wdata(row_w),
+        .raddr_a(row_a_slot), .rdata_a(row_a), .raddr_b(row_b_slot), .rdata_b(row_b)
+    );
+    wire [ID_W-1:0]                 id_b = row_b[ROW_ID +: ID_W];  // (port A's id: a merge copies the whole row)
+    wire [CENTRE_W-1:0]             ppx_a = row_a[ROW_PPX +: CENTRE_W], ppx_b = row_b[ROW_PPX +: CENTRE_W];
+    wire [CENTRE_W-1:0]             ppy_a = row_a[ROW_PPY +: CENTRE_W], ppy_b = row_b[ROW_PPY +: CENTRE_W];
+    wire [ACTIVITY_W-1:0]           act_a = row_a[ROW_ACT +: ACTIVITY_W], act_b = row_b[ROW_ACT +: ACTIVITY_W];
+    wire [DECAY_RESIDUAL_W-1:0]     residual_a = row_a[ROW_RESIDUAL +: DECAY_RESIDUAL_W];
+    wire [T_LAST_W-1:0]             t_last_a = row_a[ROW_T_LAST +: T_LAST_W];
+    wire [GAMMA_W-1:0]              gamma_a = row_a[ROW_GAMMA +: GAMMA_W];
+    wire [V_MCM_W-1:0]              vmx_a = row_a[ROW_VMX +: V_MCM_W], vmx_b = row_b[ROW_VMX +: V_MCM_W];
+    wire [V_MCM_W-1:0]              vmy_a = row_a[ROW_VMY +: V_MCM_W], vmy_b = row_b[ROW_VMY +: V_MCM_W];
+    wire [MCM_NORM_W-1:0]           norm_a = row_a[ROW_NORM +: MCM_NORM_W];
+    wire [EVENTS_IN_INTERVAL_W-1:0] ev_count_a = row_a[ROW_EV_COUNT +: EVENTS_IN_INTERVAL_W], ev_count_b = row_b[ROW_EV_COUNT +: EVENTS_IN_INTERVAL_W];
+    wire [COLOUR_W-1:0]             col_y_a = row_a[ROW_COL_Y +: COLOUR_W], col_y_b = row_b[ROW_COL_Y +: COLOUR_W];
+    wire [COLOUR_W-1:0]             col_cb_a = row_a[ROW_COL_CB +: COLOUR_W], col_cb_b = row_b[ROW_COL_CB +: COLOUR_W];
+    wire [COLOUR_W-1:0]             col_cr_a = row_a[ROW_COL_CR +: COLOUR_W], col_cr_b = row_b[ROW_COL_CR +: COLOUR_W];
+    wire [P*HIST_W-1:0]             hist_a = row_a[ROW_HIST +: P * HIST_W], hist_b = row_b[ROW_HIST +: P * HIST_W];
 
     // ---------------------------------------------------------------- globals
     reg [BACKGROUND_W-1:0]     bg_y, bg_cb, bg_cr;
@@ -348,6 +394,23 @@ module evclust_core #(
     localparam integer SEEK_KEY_W = 1 + DIST_W + SLOT_W;
     localparam integer FREE_KEY_W = 1 + SLOT_W;
 
+    // |(x << FP) - c| of an event coordinate and a centre, subtracted at their own width (a
+    // difference of 64-bit words would need a 64-bit carry chain per slot for its sign).
+    localparam integer SEEK_XY_W = EV_XY_W + FP > CENTRE_W ? EV_XY_W + FP : CENTRE_W;
+    function automatic [SEEK_XY_W-1:0] seek_gap;
+        input [EV_XY_W-1:0]  x;
+        input [CENTRE_W-1:0] c;
+        reg signed [63:0] x64, c64w;
+        reg [SEEK_XY_W-1:0] xs, cs;
+        begin
+            x64 = u64({{(63 - EV_XY_W){1'b0}}, x}) <<< FP;
+            c64w = u64({{(63 - CENTRE_W){1'b0}}, c});
+            xs = x64[SEEK_XY_W-1:0];
+            cs = c64w[SEEK_XY_W-1:0];
+            seek_gap = xs > cs ? xs - cs : cs - xs;
+        end
+    endfunction
+
     // The seek key of a slot for an event at (x, y): {not in the window, L1 distance, slot}.
     // The slot's fields come in as arguments (a function's body is outside @*'s sensitivity).
     function automatic [SEEK_KEY_W-1:0] seek_key;
@@ -356,19 +419,17 @@ module evclust_core #(
         input                   live;
         input [CENTRE_W-1:0]    c_x;
         input [CENTRE_W-1:0]    c_y;
-        input [HALF_SIZE_W-1:0] r_x;
-        input [HALF_SIZE_W-1:0] r_y;
+        input [REACH_W-1:0]     reach_x_in;
+        input [REACH_W-1:0]     reach_y_in;
         input [SLOT_W-1:0]      slot;
-        input signed [63:0]     seek;
-        input signed [63:0]     seek_scale;
         reg signed [63:0] dx, dy;
         reg hit;
         begin
-            dx = abs64((u64({{(63 - EV_XY_W){1'b0}}, x}) <<< FP) - u64({{(63 - CENTRE_W){1'b0}}, c_x}));
-            dy = abs64((u64({{(63 - EV_XY_W){1'b0}}, y}) <<< FP) - u64({{(63 - CENTRE_W){1'b0}}, c_y}));
+            dx = u64({{(63 - SEEK_XY_W){1'b0}}, seek_gap(x, c_x)});
+            dy = u64({{(63 - SEEK_XY_W){1'b0}}, seek_gap(y, c_y)});
             hit = live
-                && dx <= (u64({{(63 - HALF_SIZE_W){1'b0}}, r_x}) <<< (FP - FR)) + margin(r_x, r_y, seek, seek_scale)
-                && dy <= (u64({{(63 - HALF_SIZE_W){1'b0}}, r_y}) <<< (FP - FR)) + margin(r_x, r_y, seek, seek_scale);
+                && dx <= u64({{(63 - REACH_W){1'b0}}, reach_x_in})
+                && dy <= u64({{(63 - REACH_W){1'b0}}, reach_y_in});
             seek_key = {!hit, hit ? dx[DIST_W-1:0] + dy[DIST_W-1:0] : {DIST_W{1'b0}}, slot};
         end
     endfunction
@@ -378,7 +439,7 @@ module evclust_core #(
     reg [N*FREE_KEY_W-1:0] free_keys;
     always @* begin
         for (s = 0; s < N; s = s + 1) begin
-            seek_keys[s*SEEK_KEY_W +: SEEK_KEY_W] = seek_key(a_x, a_y, valid[s], px[s], py[s], rx[s], ry[s], s[SLOT_W-1:0], K_SEEK, K_SEEK_SCALE);
+            seek_keys[s*SEEK_KEY_W +: SEEK_KEY_W] = seek_key(a_x, a_y, valid[s], px[s], py[s], reach_x[s], reach_y[s], s[SLOT_W-1:0]);
             free_keys[s*FREE_KEY_W +: FREE_KEY_W] = {valid[s], s[SLOT_W-1:0]};
         end
     end
@@ -392,7 +453,7 @@ module evclust_core #(
     reg [SEEK_KEY_W-1:0] e_seek_first, e_seek_second;
     reg [FREE_KEY_W-1:0] e_free_first, e_free_second;
     reg [SLOT_W-1:0]     seek_w;
-    wire [SEEK_KEY_W-1:0] w_key = seek_key(e_x, e_y, valid[seek_w], px[seek_w], py[seek_w], rx[seek_w], ry[seek_w], seek_w, K_SEEK, K_SEEK_SCALE);
+    wire [SEEK_KEY_W-1:0] w_key = seek_key(e_x, e_y, valid[seek_w], px[seek_w], py[seek_w], reach_x[seek_w], reach_y[seek_w], seek_w);
     wire [SEEK_KEY_W-1:0] other_key = e_seek_first[SLOT_W-1:0] == seek_w ? e_seek_second : e_seek_first;
     wire [SEEK_KEY_W-1:0] chosen_key = w_key < other_key ? w_key : other_key;
     wire [FREE_KEY_W-1:0] w_free_key = {valid[seek_w], seek_w};
@@ -404,15 +465,14 @@ module evclust_core #(
     wire [SLOT_W-1:0] e_free_slot = chosen_free_key[SLOT_W-1:0];
 
     // ---------------------------------------------------------------- the decay unit
-    // Shared: the updated slot (EXEC), the scanned slot (SCAN, without the residual, as the
-    // model's eviction compares), the swept or merging slot (SWEEP, MERGE).
-    wire [SLOT_W-1:0] dec_slot = state == ST_EXEC ? e_slot : index[SLOT_W-1:0];
+    // Shared, on the slot row's port A: the updated slot (EXEC), the scanned slot (SCAN, without
+    // the residual, as the model's eviction compares), the swept or merging slot (SWEEP, MERGE).
     wire [ACTIVITY_W-1:0] dec_a;
     wire [DECAY_RESIDUAL_W-1:0] dec_residual;
     evclust_decay #(.ACTIVITY_BITS(ACTIVITY_W), .DT_BITS(DT_W), .RESIDUAL_BITS(DECAY_RESIDUAL_W), .INV_T_HALF_BITS(INV_T_HALF_W)) decay_unit (
-        .activity(act[dec_slot]),
-        .dt(e_t - t_last[dec_slot]),
-        .residual(residual[dec_slot]),
+        .activity(act_a),
+        .dt(e_t - t_last_a),
+        .residual(residual_a),
         .use_residual(state != ST_SCAN),
         .inv_t_half(K_INV_T_HALF),
         .decayed(dec_a),
@@ -503,7 +563,7 @@ module evclust_core #(
         u_rx = saturate(alpha_step(u64({{(63 - HALF_SIZE_W){1'b0}}, rx[e_slot]}), u_gx, K_B_SIZE, BETA_SIZE_FRAC, 0, 1'b0), K_R_MIN, K_R_MAX);
         u_ry = saturate(alpha_step(u64({{(63 - HALF_SIZE_W){1'b0}}, ry[e_slot]}), u_gy, K_B_SIZE, BETA_SIZE_FRAC, 0, 1'b0), K_R_MIN, K_R_MAX);
         // 3d. MCM velocity and its bias-correction weight.
-        u_gamma = u64({{(63 - GAMMA_W){1'b0}}, gamma[e_slot]});
+        u_gamma = u64({{(63 - GAMMA_W){1'b0}}, gamma_a});
         u_step_x_full = u_px_new - u_px;
         u_step_y_full = u_py_new - u_py;
         u_step_x = saturate(u_step_x_full, MIN_STEP, MAX_STEP);
@@ -513,22 +573,22 @@ module evclust_core #(
         u_uy_full = align(u_gamma * $signed({{(64 - CENTRE_STEP_W){u_step_y[CENTRE_STEP_W-1]}}, u_step_y[CENTRE_STEP_W-1:0]}), FG + FP, FV);
         u_ux = saturate(u_ux_full, MIN_V, MAX_V);
         u_uy = saturate(u_uy_full, MIN_V, MAX_V);
-        u_vmx = alpha_step($signed({{(64 - V_MCM_W){vmx[e_slot][V_MCM_W-1]}}, vmx[e_slot]}), u_ux, K_B_VM, BETA_VEL_MCM_FRAC, 0, 1'b1);
-        u_vmy = alpha_step($signed({{(64 - V_MCM_W){vmy[e_slot][V_MCM_W-1]}}, vmy[e_slot]}), u_uy, K_B_VM, BETA_VEL_MCM_FRAC, 0, 1'b1);
-        u_norm = alpha_step(u64({{(63 - MCM_NORM_W){1'b0}}, norm[e_slot]}), 64'sd1, K_B_VM, BETA_VEL_MCM_FRAC, FW, 1'b1);
+        u_vmx = alpha_step($signed({{(64 - V_MCM_W){vmx_a[V_MCM_W-1]}}, vmx_a}), u_ux, K_B_VM, BETA_VEL_MCM_FRAC, 0, 1'b1);
+        u_vmy = alpha_step($signed({{(64 - V_MCM_W){vmy_a[V_MCM_W-1]}}, vmy_a}), u_uy, K_B_VM, BETA_VEL_MCM_FRAC, 0, 1'b1);
+        u_norm = alpha_step(u64({{(63 - MCM_NORM_W){1'b0}}, norm_a}), 64'sd1, K_B_VM, BETA_VEL_MCM_FRAC, FW, 1'b1);
         // 3e. Colour.
-        u_cy = alpha_step(u64({{(63 - COLOUR_W){1'b0}}, col_y[e_slot]}), u64({{(63 - CW){1'b0}}, e_lum}), K_B_LUM, BETA_LUM_FRAC, FC, 1'b0);
-        u_ccb = alpha_step(u64({{(63 - COLOUR_W){1'b0}}, col_cb[e_slot]}), u64({{(63 - CW){1'b0}}, e_cb}), K_B_CHRO, BETA_CHRO_FRAC, FC, 1'b0);
-        u_ccr = alpha_step(u64({{(63 - COLOUR_W){1'b0}}, col_cr[e_slot]}), u64({{(63 - CW){1'b0}}, e_cr}), K_B_CHRO, BETA_CHRO_FRAC, FC, 1'b0);
+        u_cy = alpha_step(u64({{(63 - COLOUR_W){1'b0}}, col_y_a}), u64({{(63 - CW){1'b0}}, e_lum}), K_B_LUM, BETA_LUM_FRAC, FC, 1'b0);
+        u_ccb = alpha_step(u64({{(63 - COLOUR_W){1'b0}}, col_cb_a}), u64({{(63 - CW){1'b0}}, e_cb}), K_B_CHRO, BETA_CHRO_FRAC, FC, 1'b0);
+        u_ccr = alpha_step(u64({{(63 - COLOUR_W){1'b0}}, col_cr_a}), u64({{(63 - CW){1'b0}}, e_cr}), K_B_CHRO, BETA_CHRO_FRAC, FC, 1'b0);
         // 3f. Palette histogram: a saturating counter; reaching the top halves the row.
         for (c = 0; c < P; c = c + 1)
-            u_hist[c] = u64({{(63 - HIST_W){1'b0}}, hist[e_slot * P + c]});
+            u_hist[c] = u64({{(63 - HIST_W){1'b0}}, hist_a[c*HIST_W +: HIST_W]});
         u_hist[vote_class] = min64(u_hist[vote_class] + u64({{(63 - VOTE_W){1'b0}}, vote}), H_MAX);
         u_halve = u_hist[vote_class] >= H_MAX;
         for (c = 0; c < P; c = c + 1)
             if (u_halve)
                 u_hist[c] = u_hist[c] >>> 1;
-        u_evc_full = u64({{(63 - EVENTS_IN_INTERVAL_W){1'b0}}, ev_count[e_slot]}) + 1;
+        u_evc_full = u64({{(63 - EVENTS_IN_INTERVAL_W){1'b0}}, ev_count_a}) + 1;
         u_evc = saturate(u_evc_full, 0, MAX_EVCOUNT);
     end
 
@@ -547,8 +607,8 @@ module evclust_core #(
         f_per_frame = u64({{(63 - FRAME_PER_TAU_W){1'b0}}, per_frame});
         f_expire = a_decayed < K_A_MIN;
         f_vi_count = vi_count[k];
-        f_gamma = u64({{(63 - GAMMA_W){1'b0}}, gamma[k]});
-        f_evc = u64({{(63 - EVENTS_IN_INTERVAL_W){1'b0}}, ev_count[k]});
+        f_gamma = u64({{(63 - GAMMA_W){1'b0}}, gamma_a});
+        f_evc = u64({{(63 - EVENTS_IN_INTERVAL_W){1'b0}}, ev_count_a});
         f_gamma_activity = gamma_from_activity(a_decayed, gamma_mode, K_GAMMA_GLOBAL, K_GPA);
         f_gamma_count = (f_evc * f_per_frame) >>> (FPT_F - FG);
         f_gamma_by_activity = gamma_mode != GAMMA_MODE_COUNT[1:0] || vi_count[k] == VI_NONE;
@@ -557,8 +617,8 @@ module evclust_core #(
             f_gamma = saturate(f_gamma_activity, 0, MAX_GAMMA);
         f_vix = $signed({{(64 - V_INT_W){vix[k][V_INT_W-1]}}, vix[k]});
         f_viy = $signed({{(64 - V_INT_W){viy[k][V_INT_W-1]}}, viy[k]});
-        f_mx_full = align((u64({{(63 - CENTRE_W){1'b0}}, px[k]}) - u64({{(63 - CENTRE_W){1'b0}}, ppx[k]})) * f_per_frame, FP + FPT_F, FI);
-        f_my_full = align((u64({{(63 - CENTRE_W){1'b0}}, py[k]}) - u64({{(63 - CENTRE_W){1'b0}}, ppy[k]})) * f_per_frame, FP + FPT_F, FI);
+        f_mx_full = align((u64({{(63 - CENTRE_W){1'b0}}, px[k]}) - u64({{(63 - CENTRE_W){1'b0}}, ppx_a})) * f_per_frame, FP + FPT_F, FI);
+        f_my_full = align((u64({{(63 - CENTRE_W){1'b0}}, py[k]}) - u64({{(63 - CENTRE_W){1'b0}}, ppy_a})) * f_per_frame, FP + FPT_F, FI);
         f_mx = saturate(f_mx_full, MIN_VI, MAX_VI);
         f_my = saturate(f_my_full, MIN_VI, MAX_VI);
         if (boundaries != 33'd0) begin
@@ -584,7 +644,7 @@ module evclust_core #(
     reg [SLOT_W-1:0]  p_slot;
     reg [V_MCM_W-1:0] p_vmx, p_vmy;
     reg [W20_W-1:0]   p_w20;
-    wire [MCM_NORM_W-1:0] norm_cut = norm[k] >> (FW - MCM_WEIGHT_FRAC);  // w floored to mcm_weight's format
+    wire [MCM_NORM_W-1:0] norm_cut = norm_a >> (FW - MCM_WEIGHT_FRAC);  // w floored to mcm_weight's format
     wire [QUOTIENT_W-1:0] p_mag_x = floor_magnitude(p_vmx, p_w20);
     wire [QUOTIENT_W-1:0] p_mag_y = floor_magnitude(p_vmy, p_w20);
     wire              p_correct = mcm_correct && p_w20 != {W20_W{1'b0}};
@@ -656,15 +716,15 @@ module evclust_core #(
     reg [7:0]         f_class;
     reg [3:0]         f_flags;
     always @* begin
-        f_act = u64({{(63 - ACTIVITY_W){1'b0}}, act[t]});
+        f_act = u64({{(63 - ACTIVITY_W){1'b0}}, act_b});
         f_px = u64({{(63 - CENTRE_W){1'b0}}, px[t]});
         f_py = u64({{(63 - CENTRE_W){1'b0}}, py[t]});
         f_vix_t = $signed({{(64 - V_INT_W){vix[t][V_INT_W-1]}}, vix[t]});
         f_viy_t = $signed({{(64 - V_INT_W){viy[t][V_INT_W-1]}}, viy[t]});
-        f_vmx_raw = $signed({{(64 - V_MCM_W){vmx[t][V_MCM_W-1]}}, vmx[t]});
-        f_vmy_raw = $signed({{(64 - V_MCM_W){vmy[t][V_MCM_W-1]}}, vmy[t]});
-        f_vmx = corrected_v(vmx[t], t_correct, t_neg_x, t_sat_x, t_qx);
-        f_vmy = corrected_v(vmy[t], t_correct, t_neg_y, t_sat_y, t_qy);
+        f_vmx_raw = $signed({{(64 - V_MCM_W){vmx_b[V_MCM_W-1]}}, vmx_b});
+        f_vmy_raw = $signed({{(64 - V_MCM_W){vmy_b[V_MCM_W-1]}}, vmy_b});
+        f_vmx = corrected_v(vmx_b, t_correct, t_neg_x, t_sat_x, t_qx);
+        f_vmy = corrected_v(vmy_b, t_correct, t_neg_y, t_sat_y, t_qy);
         // Exit prediction on the squared speed.
         f_sq_x = square(f_vmx, FV);
         f_sq_y = square(f_vmy, FV);
@@ -693,8 +753,8 @@ module evclust_core #(
         f_class = 8'hff;
         f_best = 0;
         for (cls = 0; cls < P; cls = cls + 1) begin
-            if (!background_mask[cls] && u64({{(63 - HIST_W){1'b0}}, hist[t * P + cls]}) > f_best) begin
-                f_best = u64({{(63 - HIST_W){1'b0}}, hist[t * P + cls]});
+            if (!background_mask[cls] && u64({{(63 - HIST_W){1'b0}}, hist_b[cls*HIST_W +: HIST_W]}) > f_best) begin
+                f_best = u64({{(63 - HIST_W){1'b0}}, hist_b[cls*HIST_W +: HIST_W]});
                 f_class = cls[7:0];
             end
         end
@@ -703,19 +763,19 @@ module evclust_core #(
     end
 
     // The record of slot t, in the layout of expected.hex.
-    wire signed [63:0] r_cy = corrected(u64({{(63 - COLOUR_W){1'b0}}, col_y[t]}), u64({{(63 - BACKGROUND_W){1'b0}}, bg_y}), K_INV_P);
-    wire signed [63:0] r_cb = corrected(u64({{(63 - COLOUR_W){1'b0}}, col_cb[t]}), u64({{(63 - BACKGROUND_W){1'b0}}, bg_cb}), K_INV_P);
-    wire signed [63:0] r_cr = corrected(u64({{(63 - COLOUR_W){1'b0}}, col_cr[t]}), u64({{(63 - BACKGROUND_W){1'b0}}, bg_cr}), K_INV_P);
+    wire signed [63:0] r_cy = corrected(u64({{(63 - COLOUR_W){1'b0}}, col_y_b}), u64({{(63 - BACKGROUND_W){1'b0}}, bg_y}), K_INV_P);
+    wire signed [63:0] r_cb = corrected(u64({{(63 - COLOUR_W){1'b0}}, col_cb_b}), u64({{(63 - BACKGROUND_W){1'b0}}, bg_cb}), K_INV_P);
+    wire signed [63:0] r_cr = corrected(u64({{(63 - COLOUR_W){1'b0}}, col_cr_b}), u64({{(63 - BACKGROUND_W){1'b0}}, bg_cr}), K_INV_P);
     wire [REC_W-1:0] record;  // the fields at the layout's REC_* places
     assign record[REC_T_US_LSB +: REC_T_US_W] = e_t;
     assign record[REC_STEP_LSB +: REC_STEP_W] = step;
     assign record[REC_SLOT_LSB +: REC_SLOT_W] = t;
-    assign record[REC_ID_LSB +: REC_ID_W] = id[t];
+    assign record[REC_ID_LSB +: REC_ID_W] = id_b;
     assign record[REC_X_LSB +: REC_X_W] = px[t];
     assign record[REC_Y_LSB +: REC_Y_W] = py[t];
     assign record[REC_RX_LSB +: REC_RX_W] = rx[t];
     assign record[REC_RY_LSB +: REC_RY_W] = ry[t];
-    assign record[REC_ACTIVITY_LSB +: REC_ACTIVITY_W] = act[t];
+    assign record[REC_ACTIVITY_LSB +: REC_ACTIVITY_W] = act_b;
     assign record[REC_VX_MCM_LSB +: REC_VX_MCM_W] = f_vmx[V_MCM_W-1:0];
     assign record[REC_VY_MCM_LSB +: REC_VY_MCM_W] = f_vmy[V_MCM_W-1:0];
     assign record[REC_VX_INT_LSB +: REC_VX_INT_W] = vix[t];
@@ -748,6 +808,23 @@ module evclust_core #(
             r64 = u64({{(63 - HALF_SIZE_W){1'b0}}, v});
         end
     endfunction
+    // |a - b| at the words' own width (see seek_gap): two centres, two v_int words.
+    function automatic [CENTRE_W-1:0] centre_gap;
+        input [CENTRE_W-1:0] a;
+        input [CENTRE_W-1:0] b;
+        begin
+            centre_gap = a > b ? a - b : b - a;
+        end
+    endfunction
+    function automatic [V_INT_W:0] v_gap;
+        input [V_INT_W-1:0] a;
+        input [V_INT_W-1:0] b;
+        reg signed [V_INT_W:0] d;
+        begin
+            d = $signed({a[V_INT_W-1], a}) - $signed({b[V_INT_W-1], b});
+            v_gap = d[V_INT_W] ? -d : d;  // |d| < 2^V_INT_W
+        end
+    endfunction
     integer mj;
     reg signed [63:0] m_dx, m_dy, m_sx, m_sy, m_grow, m_dv, m_fast_k, m_fast_j;
     reg               m_ok, merge_found;
@@ -756,17 +833,19 @@ module evclust_core #(
         merge_found = 1'b0;
         merge_j = {SLOT_W{1'b0}};
         for (mj = N - 1; mj >= 0; mj = mj - 1) begin
-            m_dx = abs64(c64(px[k]) - c64(px[mj]));
-            m_dy = abs64(c64(py[k]) - c64(py[mj]));
+            m_dx = c64(centre_gap(px[k], px[mj]));
+            m_dy = c64(centre_gap(py[k], py[mj]));
             m_sx = (r64(rx[k]) + r64(rx[mj])) <<< UP;
             m_sy = (r64(ry[k]) + r64(ry[mj])) <<< UP;
-            m_grow = align(K_MERGE_SCALE * (r64(rx[k] > ry[k] ? rx[k] : ry[k]) + r64(rx[mj] > ry[mj] ? rx[mj] : ry[mj])), MERGE_SCALE_FRAC + FR, FP);
-            m_dv = abs64(s64v(vix[k]) - s64v(vix[mj])) + abs64(s64v(viy[k]) - s64v(viy[mj]));
-            m_fast_k = abs64(s64v(vix[k])) + abs64(s64v(viy[k]));
-            m_fast_j = abs64(s64v(vix[mj])) + abs64(s64v(viy[mj]));
+            // merge_scale * (max R_k + max R_j) and merge_v_rel * max(speed_k, speed_j), from the
+            // products each slot keeps (merge_v_rel >= 0, so the larger product is the faster one's).
+            m_grow = align(u64({{(63 - GROW_W){1'b0}}, grow[k]}) + u64({{(63 - GROW_W){1'b0}}, grow[mj]}), MERGE_SCALE_FRAC + FR, FP);
+            m_dv = u64({{(63 - V_INT_W - 1){1'b0}}, v_gap(vix[k], vix[mj])}) + u64({{(63 - V_INT_W - 1){1'b0}}, v_gap(viy[k], viy[mj])});
+            m_fast_k = u64({{(63 - VREL_W){1'b0}}, vrel[k]});
+            m_fast_j = u64({{(63 - VREL_W){1'b0}}, vrel[mj]});
             m_ok = m_dx <= m_sx + m_grow && m_dy <= m_sy + m_grow;
             if (vi_count[k] >= VI_MEASURED && vi_count[mj] >= VI_MEASURED)
-                m_ok = m_ok && m_dv <= K_MERGE_V_TOL + ((K_MERGE_V_REL * (m_fast_k > m_fast_j ? m_fast_k : m_fast_j)) >>> MERGE_V_REL_FRAC);
+                m_ok = m_ok && m_dv <= K_MERGE_V_TOL + ((m_fast_k > m_fast_j ? m_fast_k : m_fast_j) >>> MERGE_V_REL_FRAC);
             else
                 m_ok = m_ok && m_dx <= m_sx && m_dy <= m_sy;
             if (MERGE != 0 && mj > k && valid[mj] && m_ok) begin
@@ -780,7 +859,7 @@ module evclust_core #(
     localparam integer MOMENT_W = MERGE_MOMENT_W;
     reg  [SLOT_W-1:0]     m_j;          // the slot being absorbed
     reg                   m_started;    // MERGE: the dividers have their operands
-    wire signed [63:0]    m_act_j = u64({{(63 - ACTIVITY_W){1'b0}}, act[m_j]});
+    wire signed [63:0]    m_act_j = u64({{(63 - ACTIVITY_W){1'b0}}, act_b});
     wire signed [63:0]    m_weight = a_decayed + m_act_j;
     wire signed [63:0]    m_moment_x = a_decayed * c64(px[k]) + m_act_j * c64(px[m_j]);
     wire signed [63:0]    m_moment_y = a_decayed * c64(py[k]) + m_act_j * c64(py[m_j]);
@@ -822,10 +901,10 @@ module evclust_core #(
     wire signed [63:0]    m_hi_y = -min64(-(c64(py[k]) + (r64(ry[k]) <<< UP)), -(c64(py[m_j]) + (r64(ry[m_j]) <<< UP)));
     wire signed [63:0]    m_rx = min64((m_hi_x - m_lo_x) >>> (UP + 1), K_R_MAX);
     wire signed [63:0]    m_ry = min64((m_hi_y - m_lo_y) >>> (UP + 1), K_R_MAX);
-    wire signed [63:0]    m_ppx = saturate(c64(ppx[m_surv]) + m_px - c64(px[m_surv]), 0, LAST_X);  // inside the sensor
-    wire signed [63:0]    m_ppy = saturate(c64(ppy[m_surv]) + m_py - c64(py[m_surv]), 0, LAST_Y);
+    wire signed [63:0]    m_ppx = saturate(c64(m_from_j ? ppx_b : ppx_a) + m_px - c64(px[m_surv]), 0, LAST_X);  // inside the sensor
+    wire signed [63:0]    m_ppy = saturate(c64(m_from_j ? ppy_b : ppy_a) + m_py - c64(py[m_surv]), 0, LAST_Y);
     wire signed [63:0]    m_act = saturate(m_weight, 0, MAX_ACT);
-    wire signed [63:0]    m_evc_full = u64({{(63 - EVENTS_IN_INTERVAL_W){1'b0}}, ev_count[k]}) + u64({{(63 - EVENTS_IN_INTERVAL_W){1'b0}}, ev_count[m_j]});
+    wire signed [63:0]    m_evc_full = u64({{(63 - EVENTS_IN_INTERVAL_W){1'b0}}, ev_count_a}) + u64({{(63 - EVENTS_IN_INTERVAL_W){1'b0}}, ev_count_b});
     wire signed [63:0]    m_evc = saturate(m_evc_full, 0, MAX_EVCOUNT);
 
     // The end of a filter step, held until the object unit takes it; the next step waits in
@@ -948,6 +1027,22 @@ module evclust_core #(
     wire sweep_slot = sweep_live && !sweep_merge;
     assign tail_en = sweep_advance && !sweep_merge;
 
+    // ---------------------------------------------------------------- derived slot fields
+    // At most one slot's size is written per cycle (an update, a creation or a merge, each in
+    // its own state), so one multiplier per product serves them all, and the interval
+    // velocity changes only at a filter step's stage 0 (a merge copies the survivor's product).
+    wire                   size_write = do_update || do_create || m_write;
+    wire [SLOT_W-1:0]      size_slot = m_write ? k : (do_update ? e_slot : create_slot);
+    wire [HALF_SIZE_W-1:0] size_rx = m_write ? m_rx[HALF_SIZE_W-1:0] : (do_update ? u_rx[HALF_SIZE_W-1:0] : K_R_INIT);
+    wire [HALF_SIZE_W-1:0] size_ry = m_write ? m_ry[HALF_SIZE_W-1:0] : (do_update ? u_ry[HALF_SIZE_W-1:0] : K_R_INIT);
+    wire [HALF_SIZE_W-1:0] size_r = size_rx > size_ry ? size_rx : size_ry;
+    wire signed [63:0]     d_scaled_seek = r64(size_r) * K_SEEK_SCALE;
+    wire signed [63:0]     d_reach_x = reach(size_rx, K_SEEK, d_scaled_seek);
+    wire signed [63:0]     d_reach_y = reach(size_ry, K_SEEK, d_scaled_seek);
+    wire signed [63:0]     d_grow = r64(size_r) * K_MERGE_SCALE;
+    wire signed [63:0]     d_speed = abs64(s64v(f_vix[V_INT_W-1:0])) + abs64(s64v(f_viy[V_INT_W-1:0]));  // of the words written: <= 2^V_INT_W
+    wire signed [63:0]     d_vrel = K_MERGE_V_REL * u64({{(63 - V_INT_W - 1){1'b0}}, d_speed[V_INT_W:0]});
+
     // The pipeline: stage A takes an event whenever it is empty or hands its event to stage B
     // in the same cycle; B (EXEC) takes it when B is empty (IDLE) or finishes an event that
     // starts no filter step. B writes at most one slot as it finishes, w, which the next
@@ -1027,6 +1122,82 @@ module evclust_core #(
         inc[COUNT_SAT_V_MCM * COUNTER_INC_W +: 2] = tail_out && t_correct ? {1'b0, t_over_x} + {1'b0, t_over_y} : 2'd0;
     end
     assign idle = state == ST_IDLE && !a_valid && !rec_valid && !step_pending;
+
+    // ---------------------------------------------------------------- the slot row's write port
+    // One writer per cycle; the fields it leaves keep their value, read at port A (the written
+    // slot's, for an update, a merge or the sweep; a creation writes every field).
+    assign row_a_slot = state == ST_EXEC ? e_slot : k;
+    assign row_b_slot = state == ST_MERGE ? m_j : t;
+    integer wi;
+    always @* begin
+        row_we = 1'b0;
+        row_w_slot = k;
+        row_w = row_a;
+        if (do_update) begin
+            row_we = 1'b1;
+            row_w_slot = e_slot;
+            row_w[ROW_ACT +: ACTIVITY_W] = u_act[ACTIVITY_W-1:0];
+            row_w[ROW_RESIDUAL +: DECAY_RESIDUAL_W] = dec_residual;
+            row_w[ROW_T_LAST +: T_LAST_W] = e_t;
+            row_w[ROW_VMX +: V_MCM_W] = u_vmx[V_MCM_W-1:0];
+            row_w[ROW_VMY +: V_MCM_W] = u_vmy[V_MCM_W-1:0];
+            row_w[ROW_NORM +: MCM_NORM_W] = u_norm[MCM_NORM_W-1:0];
+            row_w[ROW_COL_Y +: COLOUR_W] = u_cy[COLOUR_W-1:0];
+            row_w[ROW_COL_CB +: COLOUR_W] = u_ccb[COLOUR_W-1:0];
+            row_w[ROW_COL_CR +: COLOUR_W] = u_ccr[COLOUR_W-1:0];
+            for (wi = 0; wi < P; wi = wi + 1)
+                row_w[ROW_HIST + wi * HIST_W +: HIST_W] = u_hist[wi][HIST_W-1:0];
+            row_w[ROW_EV_COUNT +: EVENTS_IN_INTERVAL_W] = u_evc[EVENTS_IN_INTERVAL_W-1:0];
+        end
+        if (do_create) begin
+            row_we = 1'b1;
+            row_w_slot = create_slot;
+            row_w[ROW_ID +: ID_W] = next_id;
+            row_w[ROW_PPX +: CENTRE_W] = {{(CENTRE_W - EV_XY_W - FP){1'b0}}, e_x, {FP{1'b0}}};
+            row_w[ROW_PPY +: CENTRE_W] = {{(CENTRE_W - EV_XY_W - FP){1'b0}}, e_y, {FP{1'b0}}};
+            row_w[ROW_ACT +: ACTIVITY_W] = ONE_A[ACTIVITY_W-1:0];
+            row_w[ROW_RESIDUAL +: DECAY_RESIDUAL_W] = {DECAY_RESIDUAL_W{1'b0}};
+            row_w[ROW_T_LAST +: T_LAST_W] = e_t;
+            row_w[ROW_GAMMA +: GAMMA_W] = gamma_new[GAMMA_W-1:0];
+            row_w[ROW_VMX +: V_MCM_W] = {V_MCM_W{1'b0}};
+            row_w[ROW_VMY +: V_MCM_W] = {V_MCM_W{1'b0}};
+            row_w[ROW_NORM +: MCM_NORM_W] = {MCM_NORM_W{1'b0}};
+            row_w[ROW_EV_COUNT +: EVENTS_IN_INTERVAL_W] = {EVENTS_IN_INTERVAL_W{1'b0}};
+            row_w[ROW_COL_Y +: COLOUR_W] = {e_lum, {FC{1'b0}}};
+            row_w[ROW_COL_CB +: COLOUR_W] = {e_cb, {FC{1'b0}}};
+            row_w[ROW_COL_CR +: COLOUR_W] = {e_cr, {FC{1'b0}}};
+            row_w[ROW_HIST +: P * HIST_W] = {(P * HIST_W){1'b0}};
+        end
+        if (m_write) begin  // k absorbs m_j: the survivor's identity, velocity, colour and histogram
+            row_we = 1'b1;
+            row_w_slot = k;
+            if (m_from_j)
+                row_w = row_b;
+            row_w[ROW_ACT +: ACTIVITY_W] = m_act[ACTIVITY_W-1:0];
+            row_w[ROW_RESIDUAL +: DECAY_RESIDUAL_W] = dec_residual;
+            row_w[ROW_T_LAST +: T_LAST_W] = e_t;
+            row_w[ROW_PPX +: CENTRE_W] = m_ppx[CENTRE_W-1:0];
+            row_w[ROW_PPY +: CENTRE_W] = m_ppy[CENTRE_W-1:0];
+            row_w[ROW_EV_COUNT +: EVENTS_IN_INTERVAL_W] = m_evc[EVENTS_IN_INTERVAL_W-1:0];
+        end
+        if (sweep_slot) begin  // stage 0
+            row_we = 1'b1;
+            row_w_slot = k;
+            row_w[ROW_ACT +: ACTIVITY_W] = dec_a;
+            row_w[ROW_RESIDUAL +: DECAY_RESIDUAL_W] = dec_residual;
+            row_w[ROW_T_LAST +: T_LAST_W] = e_t;
+            if (!f_expire) begin
+                row_w[ROW_GAMMA +: GAMMA_W] = f_gamma[GAMMA_W-1:0];
+                row_w[ROW_EV_COUNT +: EVENTS_IN_INTERVAL_W] = f_evc[EVENTS_IN_INTERVAL_W-1:0];
+                if (boundaries != 33'd0) begin
+                    row_w[ROW_PPX +: CENTRE_W] = px[k];
+                    row_w[ROW_PPY +: CENTRE_W] = py[k];
+                end
+            end
+        end
+        if (dp_rst)
+            row_we = 1'b0;
+    end
 
     integer i;
     always @(posedge clk) begin
@@ -1207,110 +1378,72 @@ module evclust_core #(
                 a_valid <= 1'b0;
 
             if (do_update) begin
-                act[e_slot] <= u_act[ACTIVITY_W-1:0];
-                residual[e_slot] <= dec_residual;
-                t_last[e_slot] <= e_t;
                 px[e_slot] <= u_px_new[CENTRE_W-1:0];
                 py[e_slot] <= u_py_new[CENTRE_W-1:0];
                 rx[e_slot] <= u_rx[HALF_SIZE_W-1:0];
                 ry[e_slot] <= u_ry[HALF_SIZE_W-1:0];
-                vmx[e_slot] <= u_vmx[V_MCM_W-1:0];
-                vmy[e_slot] <= u_vmy[V_MCM_W-1:0];
-                norm[e_slot] <= u_norm[MCM_NORM_W-1:0];
-                col_y[e_slot] <= u_cy[COLOUR_W-1:0];
-                col_cb[e_slot] <= u_ccb[COLOUR_W-1:0];
-                col_cr[e_slot] <= u_ccr[COLOUR_W-1:0];
-                for (i = 0; i < P; i = i + 1)
-                    hist[e_slot * P + i] <= u_hist[i][HIST_W-1:0];
-                ev_count[e_slot] <= u_evc[EVENTS_IN_INTERVAL_W-1:0];
             end
 
             if (do_create) begin
                 valid[create_slot] <= 1'b1;
-                id[create_slot] <= next_id;
                 next_id <= next_id + 1'b1;
                 px[create_slot] <= {{(CENTRE_W - EV_XY_W - FP){1'b0}}, e_x, {FP{1'b0}}};
                 py[create_slot] <= {{(CENTRE_W - EV_XY_W - FP){1'b0}}, e_y, {FP{1'b0}}};
-                ppx[create_slot] <= {{(CENTRE_W - EV_XY_W - FP){1'b0}}, e_x, {FP{1'b0}}};
-                ppy[create_slot] <= {{(CENTRE_W - EV_XY_W - FP){1'b0}}, e_y, {FP{1'b0}}};
                 rx[create_slot] <= K_R_INIT;
                 ry[create_slot] <= K_R_INIT;
-                act[create_slot] <= ONE_A[ACTIVITY_W-1:0];
-                residual[create_slot] <= {DECAY_RESIDUAL_W{1'b0}};
-                gamma[create_slot] <= gamma_new[GAMMA_W-1:0];
-                t_last[create_slot] <= e_t;
-                vmx[create_slot] <= {V_MCM_W{1'b0}};
-                vmy[create_slot] <= {V_MCM_W{1'b0}};
-                norm[create_slot] <= {MCM_NORM_W{1'b0}};
                 vix[create_slot] <= {V_INT_W{1'b0}};
                 viy[create_slot] <= {V_INT_W{1'b0}};
                 vi_count[create_slot] <= {INTERVAL_UPDATES_W{1'b0}};
-                ev_count[create_slot] <= {EVENTS_IN_INTERVAL_W{1'b0}};
-                col_y[create_slot] <= {e_lum, {FC{1'b0}}};
-                col_cb[create_slot] <= {e_cb, {FC{1'b0}}};
-                col_cr[create_slot] <= {e_cr, {FC{1'b0}}};
                 reported[create_slot] <= 1'b0;
                 ever_reported[create_slot] <= 1'b0;
-                for (i = 0; i < P; i = i + 1)
-                    hist[create_slot * P + i] <= {HIST_W{1'b0}};
             end
 
             if (m_write) begin  // k absorbs m_j
-                act[k] <= m_act[ACTIVITY_W-1:0];
-                residual[k] <= dec_residual;
-                t_last[k] <= e_t;
                 px[k] <= m_px[CENTRE_W-1:0];
                 py[k] <= m_py[CENTRE_W-1:0];
-                ppx[k] <= m_ppx[CENTRE_W-1:0];
-                ppy[k] <= m_ppy[CENTRE_W-1:0];
                 rx[k] <= m_rx[HALF_SIZE_W-1:0];
                 ry[k] <= m_ry[HALF_SIZE_W-1:0];
-                ev_count[k] <= m_evc[EVENTS_IN_INTERVAL_W-1:0];
-                if (m_from_j) begin
-                    id[k] <= id[m_j];
-                    gamma[k] <= gamma[m_j];
-                    vmx[k] <= vmx[m_j];
-                    vmy[k] <= vmy[m_j];
-                    norm[k] <= norm[m_j];
+                if (m_from_j) begin  // the survivor's velocities and flags (its row: slot_row_write)
                     vix[k] <= vix[m_j];
                     viy[k] <= viy[m_j];
                     vi_count[k] <= vi_count[m_j];
-                    col_y[k] <= col_y[m_j];
-                    col_cb[k] <= col_cb[m_j];
-                    col_cr[k] <= col_cr[m_j];
                     reported[k] <= reported[m_j];
                     ever_reported[k] <= ever_reported[m_j];
-                    for (i = 0; i < P; i = i + 1)
-                        hist[k * P + i] <= hist[m_j * P + i];
                 end
                 valid[m_j] <= 1'b0;
             end
 
+            if (size_write) begin
+                reach_x[size_slot] <= d_reach_x[REACH_W-1:0];
+                reach_y[size_slot] <= d_reach_y[REACH_W-1:0];
+                grow[size_slot] <= d_grow[GROW_W-1:0];
+            end
+            if (sweep_slot && !f_expire)
+                vrel[k] <= d_vrel[VREL_W-1:0];
+            else if (do_create)
+                vrel[create_slot] <= {VREL_W{1'b0}};
+            else if (m_write && m_from_j)
+                vrel[k] <= vrel[m_j];
+
             if (sweep_slot) begin  // stage 0
-                act[k] <= dec_a;
-                residual[k] <= dec_residual;
-                t_last[k] <= e_t;
                 if (f_expire) begin
                     valid[k] <= 1'b0;
                 end else begin
-                    gamma[k] <= f_gamma[GAMMA_W-1:0];
-                    ev_count[k] <= f_evc[EVENTS_IN_INTERVAL_W-1:0];
                     vix[k] <= f_vix[V_INT_W-1:0];
                     viy[k] <= f_viy[V_INT_W-1:0];
                     vi_count[k] <= f_vi_count;
                     if (boundaries != 33'd0) begin
-                        ppx[k] <= px[k];
-                        ppy[k] <= py[k];
                     end
                 end
             end
-            if (inv_en && inv_out_live)  // a mixing entry out of its divider
-                inv_ww[inv_out_j * INV_WW_W +: INV_WW_W] <= refreshed;
+            for (i = 0; i < P; i = i + 1)  // a mixing entry out of its divider
+                if (inv_en && inv_out_live && {{(32 - CLASS_W){1'b0}}, inv_out_j} == i)
+                    inv_ww[i * INV_WW_W +: INV_WW_W] <= refreshed;
             if (tail_en) begin  // the tail's first register
                 p_live <= sweep_slot && !f_expire;
                 p_slot <= k;
-                p_vmx <= vmx[k];
-                p_vmy <= vmy[k];
+                p_vmx <= vmx_a;
+                p_vmy <= vmy_a;
                 p_w20 <= norm_cut[W20_W-1:0];
             end
             if (tail_en && t_live) begin  // the tail's last stage

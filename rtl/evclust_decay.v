@@ -39,7 +39,16 @@ module evclust_decay #(
     wire [63:0] m = steps >> DROP;
     wire [63:0] halvings = m >> DECAY_TABLE_BITS;
     wire [DECAY_TABLE_BITS-1:0] index = m[DECAY_TABLE_BITS-1:0];
-    wire [ENTRY_W-1:0] fraction = DECAY_TABLE[index * ENTRY_W +: ENTRY_W];
+    // A multiplexer over the entries: an index times the entry width would be a multiply that
+    // synthesis maps to a DSP block.
+    reg [ENTRY_W-1:0] fraction;
+    integer e;
+    always @* begin
+        fraction = {ENTRY_W{1'b0}};
+        for (e = 0; e < (1 << DECAY_TABLE_BITS); e = e + 1)
+            if ({{(32 - DECAY_TABLE_BITS){1'b0}}, index} == e)
+                fraction = DECAY_TABLE[e * ENTRY_W +: ENTRY_W];
+    end
     wire [ACTIVITY_W+ENTRY_W-1:0] scaled = activity * fraction;
     wire [6:0] shift = {1'b0, halvings[5:0]} + FRACTION_SHIFT;  // <= 62 where used
     wire [ACTIVITY_W+ENTRY_W-1:0] shifted = scaled >> shift;

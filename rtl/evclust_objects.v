@@ -73,26 +73,32 @@ module evclust_objects #(
     localparam signed [63:0] LAST_Y = ($signed({32'd0, SENSOR_HEIGHT[31:0]}) - 64'sd1) <<< FP;
 
     // ---------------------------------------------------------------- configuration
+    /* verilator lint_off UNUSEDSIGNAL */  // a field's word holds only its width's bits
     wire [CFG_W-1:0] cfg_used = RUNTIME_CONFIG != 0 ? cfg : CFG_RESET;
+    /* verilator lint_on UNUSEDSIGNAL */
+    // Its fields, cfg_<register name>, each of its own width (generated from the register map).
+`define EVCLUST_CONFIG_FIELDS
+`include "evclust_params.vh"
+`undef EVCLUST_CONFIG_FIELDS
     function automatic signed [63:0] field;  // an unsigned configuration field as a 64-bit value
         input [63:0] bits;
         begin
             field = $signed(bits);
         end
     endfunction
-    wire signed [63:0] K_INV_T_FRAME = field({{(64 - INV_T_FRAME_W){1'b0}}, cfg_used[32 * CFG_INV_T_FRAME +: INV_T_FRAME_W]});
-    wire signed [63:0] K_GATE = field({{(64 - OBJECT_GATE_W){1'b0}}, cfg_used[32 * CFG_OBJECT_GATE +: OBJECT_GATE_W]});
-    wire signed [63:0] K_LINK = field({{(64 - OBJECT_LINK_ALONG_W){1'b0}}, cfg_used[32 * CFG_OBJECT_LINK_ALONG +: OBJECT_LINK_ALONG_W]});
-    wire signed [63:0] K_V_TOL = field({{(64 - OBJECT_V_TOL_W){1'b0}}, cfg_used[32 * CFG_OBJECT_V_TOL +: OBJECT_V_TOL_W]});
-    wire signed [63:0] K_V_REL = field({{(64 - OBJECT_V_REL_W){1'b0}}, cfg_used[32 * CFG_OBJECT_V_REL +: OBJECT_V_REL_W]});
-    wire signed [63:0] K_INV_TRACK = field({{(64 - OBJECT_INV_TRACK_W){1'b0}}, cfg_used[32 * CFG_OBJECT_INV_TRACK +: OBJECT_INV_TRACK_W]});
-    wire signed [63:0] K_INV_RATE = field({{(64 - OBJECT_INV_RATE_W){1'b0}}, cfg_used[32 * CFG_OBJECT_INV_RATE +: OBJECT_INV_RATE_W]});
-    wire signed [63:0] K_INV_VELOCITY = field({{(64 - OBJECT_INV_VELOCITY_W){1'b0}}, cfg_used[32 * CFG_OBJECT_INV_VELOCITY +: OBJECT_INV_VELOCITY_W]});
-    wire signed [63:0] K_INV_SIZE = field({{(64 - OBJECT_INV_SIZE_W){1'b0}}, cfg_used[32 * CFG_OBJECT_INV_SIZE +: OBJECT_INV_SIZE_W]});
-    wire signed [63:0] K_INV_COLOUR = field({{(64 - OBJECT_INV_COLOUR_W){1'b0}}, cfg_used[32 * CFG_OBJECT_INV_COLOUR +: OBJECT_INV_COLOUR_W]});
-    wire [31:0] K_BIRTH = {{(32 - OBJECT_BIRTH_US_W){1'b0}}, cfg_used[32 * CFG_OBJECT_BIRTH_US +: OBJECT_BIRTH_US_W]};
-    wire [31:0] K_COAST = {{(32 - OBJECT_COAST_US_W){1'b0}}, cfg_used[32 * CFG_OBJECT_COAST_US +: OBJECT_COAST_US_W]};
-    wire [31:0] K_KEEP = {{(32 - OBJECT_KEEP_US_W){1'b0}}, cfg_used[32 * CFG_OBJECT_KEEP_US +: OBJECT_KEEP_US_W]};
+    wire signed [63:0] K_INV_T_FRAME = field({{(64 - CFG_INV_T_FRAME_W){1'b0}}, cfg_inv_t_frame});
+    wire signed [63:0] K_GATE = field({{(64 - CFG_OBJECT_GATE_W){1'b0}}, cfg_object_gate});
+    wire signed [63:0] K_LINK = field({{(64 - CFG_OBJECT_LINK_ALONG_W){1'b0}}, cfg_object_link_along});
+    wire signed [63:0] K_V_TOL = field({{(64 - CFG_OBJECT_V_TOL_W){1'b0}}, cfg_object_v_tol});
+    wire signed [63:0] K_V_REL = field({{(64 - CFG_OBJECT_V_REL_W){1'b0}}, cfg_object_v_rel});
+    wire signed [63:0] K_INV_TRACK = field({{(64 - CFG_OBJECT_INV_TRACK_W){1'b0}}, cfg_object_inv_track});
+    wire signed [63:0] K_INV_RATE = field({{(64 - CFG_OBJECT_INV_RATE_W){1'b0}}, cfg_object_inv_rate});
+    wire signed [63:0] K_INV_VELOCITY = field({{(64 - CFG_OBJECT_INV_VELOCITY_W){1'b0}}, cfg_object_inv_velocity});
+    wire signed [63:0] K_INV_SIZE = field({{(64 - CFG_OBJECT_INV_SIZE_W){1'b0}}, cfg_object_inv_size});
+    wire signed [63:0] K_INV_COLOUR = field({{(64 - CFG_OBJECT_INV_COLOUR_W){1'b0}}, cfg_object_inv_colour});
+    wire [31:0] K_BIRTH = {{(32 - CFG_OBJECT_BIRTH_US_W){1'b0}}, cfg_object_birth_us};
+    wire [31:0] K_COAST = {{(32 - CFG_OBJECT_COAST_US_W){1'b0}}, cfg_object_coast_us};
+    wire [31:0] K_KEEP = {{(32 - CFG_OBJECT_KEEP_US_W){1'b0}}, cfg_object_keep_us};
 
     // ---------------------------------------------------------------- the one multiplier
     reg  signed [63:0] mul_a, mul_b;  // chosen by the state below; every operand fits 36 bits

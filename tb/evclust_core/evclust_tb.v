@@ -32,6 +32,11 @@ module evclust_tb #(
     output reg  [31:0] object_wait_cycles,  // filter-step cycles the core waits on the object unit
     output reg  [31:0] object_busy_cycles,  // cycles the object unit works on a step
     output reg  [31:0] object_drain_cycles, // ... of them with the core idle (the last step of a batch)
+    // Latency, in clock edges from the one that takes an event to the one that writes its slot
+    // (the trace word leaves on that edge): the smallest, the largest and the sum over the batch.
+    output reg  [31:0] latency_min,
+    output reg  [31:0] latency_max,
+    output reg  [31:0] latency_sum,
     output wire        idle,
     output wire        irq,
     // AXI4-Lite: the register file
@@ -65,6 +70,8 @@ module evclust_tb #(
     reg [OBJ_W-1:0] obj_mem   [0:REC_DEPTH-1];
     reg [31:0]      obj_tag   [0:REC_DEPTH-1];
     reg [TRACE_WORD_W-1:0] trace_mem [0:DEPTH-1];
+    reg [31:0]      taken_at  [0:DEPTH-1];  // `cycles` when event i was taken
+    wire [31:0]     latency = cycles - taken_at[traced[$clog2(DEPTH)-1:0]] - 32'd1;  // trace_valid follows the write by one edge
 
     reg              running;
     reg [31:0]       random;
@@ -210,6 +217,9 @@ module evclust_tb #(
             object_wait_cycles <= 32'd0;
             object_busy_cycles <= 32'd0;
             object_drain_cycles <= 32'd0;
+            latency_min <= 32'hffffffff;
+            latency_max <= 32'd0;
+            latency_sum <= 32'd0;
             filter_was_active <= 1'b0;
         end else if (running) begin
             random <= next_random;
@@ -228,8 +238,10 @@ module evclust_tb #(
             if (!objects_idle && core_idle)
                 object_drain_cycles <= object_drain_cycles + 32'd1;
             // Input: hold an offered event until it is taken (valid may not drop before ready).
-            if (ev_valid && ev_ready)
+            if (ev_valid && ev_ready) begin
                 accepted <= accepted + 32'd1;
+                taken_at[accepted[$clog2(DEPTH)-1:0]] <= cycles;
+            end
             if (!ev_valid || ev_ready) begin
                 ev_valid <= offer;
                 // Junk while not valid, so a core that samples ev_data at the wrong time fails.
@@ -238,6 +250,11 @@ module evclust_tb #(
             if (trace_valid) begin
                 trace_mem[traced[$clog2(DEPTH)-1:0]] <= trace_data;
                 traced <= traced + 32'd1;
+                latency_sum <= latency_sum + latency;
+                if (latency < latency_min)
+                    latency_min <= latency;
+                if (latency > latency_max)
+                    latency_max <= latency;
             end
             if (rec_valid && rec_ready) begin
                 if (captured < REC_DEPTH) begin

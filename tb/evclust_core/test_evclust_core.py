@@ -54,7 +54,7 @@ class Harness:
         self.ev_mem = [dut.ev_mem[i] for i in range(self.depth)]
         self.filter_every = filter_every
         self.stats = {"cycles": 0, "filter_cycles": 0, "filter_steps": 0, "object_wait_cycles": 0, "object_busy_cycles": 0,
-                      "object_drain_cycles": 0, "events": 0, "wall_s": 0.0}
+                      "object_drain_cycles": 0, "events": 0, "wall_s": 0.0, "latency_min": None, "latency_max": 0, "latency_sum": 0}
 
     async def reset(self, cycles: int = 3):
         self.dut.rst.value = 1
@@ -104,8 +104,11 @@ class Harness:
             objects = int(dut.objects_captured.value)
             self.objects += [int(dut.obj_mem[i].value) for i in range(objects)]
             self.object_tags += [lo + int(dut.obj_tag[i].value) for i in range(objects)]
-            for name in ("cycles", "filter_cycles", "filter_steps", "object_wait_cycles", "object_busy_cycles", "object_drain_cycles"):
+            for name in ("cycles", "filter_cycles", "filter_steps", "object_wait_cycles", "object_busy_cycles", "object_drain_cycles", "latency_sum"):
                 self.stats[name] += int(getattr(dut, name).value)
+            low = int(dut.latency_min.value)
+            self.stats["latency_min"] = low if self.stats["latency_min"] is None else min(self.stats["latency_min"], low)
+            self.stats["latency_max"] = max(self.stats["latency_max"], int(dut.latency_max.value))
             self.stats["events"] += len(batch)
         self.stats["wall_s"] += time.perf_counter() - start
         return trace, records, tags
@@ -545,6 +548,13 @@ def test_one_cycle_per_event_and_max_n_p_plus_the_tail_per_sweep(sim):
     # that outlasts the events between two steps.
     assert stats["object_busy_cycles"] > stats["filter_steps"] * 8
     assert stats["object_wait_cycles"] <= stats["object_busy_cycles"]
+    # Latency: the edge after the one that takes an event moves it into EXEC, the next writes its
+    # slot. An event taken as a filter step starts waits in stage A for the whole step (its
+    # phase cycle, the sweep and its tail, the object unit's hold) and re-enters the seek.
+    assert stats["latency_min"] == 2
+    step = 1 + max(manifest["n_clusters"], manifest["palette_size"]) + tail
+    assert 2 < stats["latency_max"] <= 2 + step + stats["object_wait_cycles"] + 1
+    assert 2 * stats["events"] <= stats["latency_sum"] <= 2 * stats["events"] + stats["filter_steps"] * (step + 1) + stats["object_wait_cycles"]
 
 
 @pytest.mark.parametrize("sim", SIMS)

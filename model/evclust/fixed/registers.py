@@ -197,6 +197,7 @@ def verilog_lines(table: FormatTable) -> list[str]:
     out = [f"localparam integer CFG_WORDS = {words};  // the configuration block: 32-bit words from 0x{CONFIG_BASE:03x}"]
     for field in fields:
         out.append(f"localparam integer CFG_{field.name} = {field.word};  // word index; bits [{field.width - 1}:0]")
+        out.append(f"localparam integer CFG_{field.name}_W = {field.width};")
     resets = []
     for field in fields:
         for i in range(field.words):
@@ -209,6 +210,20 @@ def verilog_lines(table: FormatTable) -> list[str]:
         out.append(f"localparam integer COUNT_{name.upper()} = {i};")
     out.append(f"localparam [31:0] REG_ID_VALUE = 32'h{ID_VALUE:08x};")
     out.append(f"localparam integer REG_VERSION_VALUE = {VERSION};")
+    return out
+
+
+def verilog_field_lines(table: FormatTable) -> list[str]:
+    """With EVCLUST_CONFIG_FIELDS defined, evclust_params.vh declares the configuration block's
+    fields as named wires of their own widths, read from the including module's `cfg_used`: the
+    register map types them, so no module slices the flat block by hand."""
+    out = ["// verilator lint_off UNUSEDSIGNAL"]
+    for field in config_fields(table):
+        out.append(f"wire [CFG_{field.name}_W-1:0] cfg_{field.name.lower()} = cfg_used[32 * CFG_{field.name} +: CFG_{field.name}_W];")
+    for channel in ("Y", "CB", "CR"):  # the palette packed, entry j in bits [8j +: 8]
+        entries = ", ".join(f"cfg_palette_{j}_{channel.lower()}" for j in reversed(range(table.palette_size)))
+        out.append(f"wire [8*PALETTE_SIZE-1:0] cfg_palette_{channel.lower()} = {{{entries}}};")
+    out.append("// verilator lint_on UNUSEDSIGNAL")
     return out
 
 

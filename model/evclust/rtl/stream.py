@@ -28,6 +28,14 @@ class RtlRun:
     total_s: float  # the whole co-simulation: simulator start, the model and the comparison too
     object_busy_cycles: int = 0  # cycles the object unit worked on a step
     object_wait_cycles: int = 0  # filter-step cycles the core waited for the object unit
+    # Clock edges from the one that takes an event to the one that writes its slot.
+    latency_min: int = 0
+    latency_max: int = 0
+    latency_sum: int = 0
+
+    @property
+    def latency_mean(self) -> float:
+        return self.latency_sum / self.events
 
     @property
     def cycles_per_event(self) -> float:
@@ -60,4 +68,5 @@ def run_stream(
     result = run(sim, header, "model_in_the_loop", config)
     total = time.perf_counter() - start
     return RtlRun(sim, result["events"], result["records"], result["cycles"], result["filter_cycles"], result["filter_steps"], result["wall_s"], total,
-                  result.get("object_busy_cycles", 0), result.get("object_wait_cycles", 0))  # fmt: skip
+                  result.get("object_busy_cycles", 0), result.get("object_wait_cycles", 0),
+                  result.get("latency_min") or 0, result.get("latency_max", 0), result.get("latency_sum", 0))  # fmt: skip
