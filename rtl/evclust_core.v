@@ -1130,6 +1130,7 @@ module evclust_core #(
     assign row_b_slot = state == ST_MERGE ? m_j : t;
     integer wi;
     always @* begin
+        wi = 0;  // the loop below runs only on an update: no latch for its variable
         row_we = 1'b0;
         row_w_slot = k;
         row_w = row_a;
