@@ -119,7 +119,6 @@ module evclust_core #(
     // One cluster per object (beyond the paper): scaled seek, merging, noise gate, creation support.
     wire signed [63:0] K_SEEK_SCALE = $signed({{(64 - CFG_SEEK_SCALE_W){1'b0}}, cfg_seek_scale});
     wire signed [63:0] K_MERGE_SCALE = $signed({{(64 - CFG_MERGE_SCALE_W){1'b0}}, cfg_merge_scale});
-    wire signed [63:0] K_MERGE_V_TOL = $signed({{(64 - CFG_MERGE_V_TOL_W){1'b0}}, cfg_merge_v_tol});
     wire signed [63:0] K_MERGE_V_REL = $signed({{(64 - CFG_MERGE_V_REL_W){1'b0}}, cfg_merge_v_rel});
     wire signed [63:0] K_NOISE_GATE = $signed({{(64 - CFG_NOISE_GATE_W){1'b0}}, cfg_noise_gate});
     wire [31:0] K_SUPPORT_WINDOW = {{(32 - CFG_SUPPORT_WINDOW_W){1'b0}}, cfg_support_window};
@@ -394,66 +393,41 @@ module evclust_core #(
     localparam integer SEEK_KEY_W = 1 + DIST_W + SLOT_W;
     localparam integer FREE_KEY_W = 1 + SLOT_W;
 
-    // |(x << FP) - c| of an event coordinate and a centre, subtracted at their own width (a
-    // difference of 64-bit words would need a 64-bit carry chain per slot for its sign).
-    localparam integer SEEK_XY_W = EV_XY_W + FP > CENTRE_W ? EV_XY_W + FP : CENTRE_W;
-    function automatic [SEEK_XY_W-1:0] seek_gap;
-        input [EV_XY_W-1:0]  x;
-        input [CENTRE_W-1:0] c;
-        reg signed [63:0] x64, c64w;
-        reg [SEEK_XY_W-1:0] xs, cs;
-        begin
-            x64 = u64({{(63 - EV_XY_W){1'b0}}, x}) <<< FP;
-            c64w = u64({{(63 - CENTRE_W){1'b0}}, c});
-            xs = x64[SEEK_XY_W-1:0];
-            cs = c64w[SEEK_XY_W-1:0];
-            seek_gap = xs > cs ? xs - cs : cs - xs;
-        end
-    endfunction
-
-    // The seek key of a slot for an event at (x, y): {not in the window, L1 distance, slot}.
-    // The slot's fields come in as arguments (a function's body is outside @*'s sensitivity).
-    function automatic [SEEK_KEY_W-1:0] seek_key;
-        input [EV_XY_W-1:0]     x;
-        input [EV_XY_W-1:0]     y;
-        input                   live;
-        input [CENTRE_W-1:0]    c_x;
-        input [CENTRE_W-1:0]    c_y;
-        input [REACH_W-1:0]     reach_x_in;
-        input [REACH_W-1:0]     reach_y_in;
-        input [SLOT_W-1:0]      slot;
-        reg signed [63:0] dx, dy;
-        reg hit;
-        begin
-            dx = u64({{(63 - SEEK_XY_W){1'b0}}, seek_gap(x, c_x)});
-            dy = u64({{(63 - SEEK_XY_W){1'b0}}, seek_gap(y, c_y)});
-            hit = live
-                && dx <= u64({{(63 - REACH_W){1'b0}}, reach_x_in})
-                && dy <= u64({{(63 - REACH_W){1'b0}}, reach_y_in});
-            seek_key = {!hit, hit ? dx[DIST_W-1:0] + dy[DIST_W-1:0] : {DIST_W{1'b0}}, slot};
-        end
-    endfunction
-
+    // Every slot's key, and the two smallest of the seek and free-slot keys (evclust_seek).
+    reg  [N-1:0]            valid_bits;
+    reg  [N*CENTRE_W-1:0]   px_bits, py_bits;
+    reg  [N*REACH_W-1:0]    reach_x_bits, reach_y_bits;
     integer s;
-    reg [N*SEEK_KEY_W-1:0] seek_keys;
-    reg [N*FREE_KEY_W-1:0] free_keys;
     always @* begin
         for (s = 0; s < N; s = s + 1) begin
-            seek_keys[s*SEEK_KEY_W +: SEEK_KEY_W] = seek_key(a_x, a_y, valid[s], px[s], py[s], reach_x[s], reach_y[s], s[SLOT_W-1:0]);
-            free_keys[s*FREE_KEY_W +: FREE_KEY_W] = {valid[s], s[SLOT_W-1:0]};
+            valid_bits[s] = valid[s];
+            px_bits[s*CENTRE_W +: CENTRE_W] = px[s];
+            py_bits[s*CENTRE_W +: CENTRE_W] = py[s];
+            reach_x_bits[s*REACH_W +: REACH_W] = reach_x[s];
+            reach_y_bits[s*REACH_W +: REACH_W] = reach_y[s];
         end
     end
     wire [SEEK_KEY_W-1:0] seek_first, seek_second;
     wire [FREE_KEY_W-1:0] free_first, free_second;
-    evclust_top2 #(.N(N), .KEY_W(SEEK_KEY_W)) seek_tree (.keys(seek_keys), .first(seek_first), .second(seek_second));
-    evclust_top2 #(.N(N), .KEY_W(FREE_KEY_W)) free_tree (.keys(free_keys), .first(free_first), .second(free_second));
+    evclust_seek #(
+        .N(N), .XY_BITS(EV_XY_W), .CENTRE_BITS(CENTRE_W), .REACH_BITS(REACH_W), .SLOT_BITS(SLOT_W), .KEY_BITS(SEEK_KEY_W)
+    ) seek (
+        .x(a_x), .y(a_y), .valid(valid_bits), .centre_x(px_bits), .centre_y(py_bits), .reach_x(reach_x_bits), .reach_y(reach_y_bits),
+        .seek_first(seek_first), .seek_second(seek_second), .free_first(free_first), .free_second(free_second)
+    );
 
     // Stage B (EXEC): the search's result with the slot written as the event entered, w,
     // tested on its new state; the search's runner-up stands in when its winner was w.
     reg [SEEK_KEY_W-1:0] e_seek_first, e_seek_second;
     reg [FREE_KEY_W-1:0] e_free_first, e_free_second;
     reg [SLOT_W-1:0]     seek_w;
-    wire [SEEK_KEY_W-1:0] w_key = seek_key(e_x, e_y, valid[seek_w], px[seek_w], py[seek_w], reach_x[seek_w], reach_y[seek_w], seek_w);
+    wire [SEEK_KEY_W-1:0] w_key;
+    evclust_seek_key #(
+        .XY_BITS(EV_XY_W), .CENTRE_BITS(CENTRE_W), .REACH_BITS(REACH_W), .SLOT_BITS(SLOT_W), .KEY_BITS(SEEK_KEY_W)
+    ) seek_w_key (
+        .x(e_x), .y(e_y), .live(valid[seek_w]), .centre_x(px[seek_w]), .centre_y(py[seek_w]),
+        .reach_x(reach_x[seek_w]), .reach_y(reach_y[seek_w]), .slot(seek_w), .key(w_key)
+    );
     wire [SEEK_KEY_W-1:0] other_key = e_seek_first[SLOT_W-1:0] == seek_w ? e_seek_second : e_seek_first;
     wire [SEEK_KEY_W-1:0] chosen_key = w_key < other_key ? w_key : other_key;
     wire [FREE_KEY_W-1:0] w_free_key = {valid[seek_w], seek_w};
@@ -787,9 +761,8 @@ module evclust_core #(
     assign record[REC_FLAGS_LSB +: REC_FLAGS_W] = f_flags;
 
     // ---------------------------------------------------------------- merging (model: _mergeable, _merge)
-    // The swept slot k absorbs the lowest later slot j that is the same object: boxes that
-    // overlap (velocities not disagreeing), or boxes grown by merge_scale * max(R) that overlap
-    // with measured velocities that agree. k stays in the sweep until no such j is left.
+    // The swept slot k absorbs the lowest later slot j that is the same object (evclust_merge_search).
+    // k stays in the sweep until no such j is left.
     function automatic signed [63:0] s64v;  // a v_int word, sign-extended
         input [V_INT_W-1:0] v;
         begin
@@ -808,52 +781,33 @@ module evclust_core #(
             r64 = u64({{(63 - HALF_SIZE_W){1'b0}}, v});
         end
     endfunction
-    // |a - b| at the words' own width (see seek_gap): two centres, two v_int words.
-    function automatic [CENTRE_W-1:0] centre_gap;
-        input [CENTRE_W-1:0] a;
-        input [CENTRE_W-1:0] b;
-        begin
-            centre_gap = a > b ? a - b : b - a;
-        end
-    endfunction
-    function automatic [V_INT_W:0] v_gap;
-        input [V_INT_W-1:0] a;
-        input [V_INT_W-1:0] b;
-        reg signed [V_INT_W:0] d;
-        begin
-            d = $signed({a[V_INT_W-1], a}) - $signed({b[V_INT_W-1], b});
-            v_gap = d[V_INT_W] ? -d : d;  // |d| < 2^V_INT_W
-        end
-    endfunction
+    reg  [N*HALF_SIZE_W-1:0]        rx_bits, ry_bits;
+    reg  [N*V_INT_W-1:0]            vix_bits, viy_bits;
+    reg  [N*INTERVAL_UPDATES_W-1:0] vi_count_bits;
+    reg  [N*GROW_W-1:0]             grow_bits;
+    reg  [N*VREL_W-1:0]             vrel_bits;
     integer mj;
-    reg signed [63:0] m_dx, m_dy, m_sx, m_sy, m_grow, m_dv, m_fast_k, m_fast_j;
-    reg               m_ok, merge_found;
-    reg [SLOT_W-1:0]  merge_j;
     always @* begin
-        merge_found = 1'b0;
-        merge_j = {SLOT_W{1'b0}};
-        for (mj = N - 1; mj >= 0; mj = mj - 1) begin
-            m_dx = c64(centre_gap(px[k], px[mj]));
-            m_dy = c64(centre_gap(py[k], py[mj]));
-            m_sx = (r64(rx[k]) + r64(rx[mj])) <<< UP;
-            m_sy = (r64(ry[k]) + r64(ry[mj])) <<< UP;
-            // merge_scale * (max R_k + max R_j) and merge_v_rel * max(speed_k, speed_j), from the
-            // products each slot keeps (merge_v_rel >= 0, so the larger product is the faster one's).
-            m_grow = align(u64({{(63 - GROW_W){1'b0}}, grow[k]}) + u64({{(63 - GROW_W){1'b0}}, grow[mj]}), MERGE_SCALE_FRAC + FR, FP);
-            m_dv = u64({{(63 - V_INT_W - 1){1'b0}}, v_gap(vix[k], vix[mj])}) + u64({{(63 - V_INT_W - 1){1'b0}}, v_gap(viy[k], viy[mj])});
-            m_fast_k = u64({{(63 - VREL_W){1'b0}}, vrel[k]});
-            m_fast_j = u64({{(63 - VREL_W){1'b0}}, vrel[mj]});
-            m_ok = m_dx <= m_sx + m_grow && m_dy <= m_sy + m_grow;
-            if (vi_count[k] >= VI_MEASURED && vi_count[mj] >= VI_MEASURED)
-                m_ok = m_ok && m_dv <= K_MERGE_V_TOL + ((m_fast_k > m_fast_j ? m_fast_k : m_fast_j) >>> MERGE_V_REL_FRAC);
-            else
-                m_ok = m_ok && m_dx <= m_sx && m_dy <= m_sy;
-            if (MERGE != 0 && mj > k && valid[mj] && m_ok) begin
-                merge_found = 1'b1;
-                merge_j = mj[SLOT_W-1:0];
-            end
+        for (mj = 0; mj < N; mj = mj + 1) begin
+            rx_bits[mj*HALF_SIZE_W +: HALF_SIZE_W] = rx[mj];
+            ry_bits[mj*HALF_SIZE_W +: HALF_SIZE_W] = ry[mj];
+            vix_bits[mj*V_INT_W +: V_INT_W] = vix[mj];
+            viy_bits[mj*V_INT_W +: V_INT_W] = viy[mj];
+            vi_count_bits[mj*INTERVAL_UPDATES_W +: INTERVAL_UPDATES_W] = vi_count[mj];
+            grow_bits[mj*GROW_W +: GROW_W] = grow[mj];
+            vrel_bits[mj*VREL_W +: VREL_W] = vrel[mj];
         end
     end
+    wire              merge_found;
+    wire [SLOT_W-1:0] merge_j;
+    evclust_merge_search #(
+        .N(N), .SLOT_BITS(SLOT_W), .CENTRE_BITS(CENTRE_W), .HALF_BITS(HALF_SIZE_W), .V_BITS(V_INT_W), .COUNT_BITS(INTERVAL_UPDATES_W),
+        .V_TOL_BITS(CFG_MERGE_V_TOL_W), .GROW_BITS(GROW_W), .VREL_BITS(VREL_W)
+    ) merge_search (
+        .k(k), .valid(valid_bits), .centre_x(px_bits), .centre_y(py_bits), .half_x(rx_bits), .half_y(ry_bits),
+        .v_x(vix_bits), .v_y(viy_bits), .measured(vi_count_bits), .grow(grow_bits), .vrel(vrel_bits), .v_tol(cfg_merge_v_tol),
+        .found(merge_found), .j(merge_j)
+    );
 
     // The weighted centre (A_k P_k + A_j P_j) / (A_k + A_j), floored, by two iterative dividers.
     localparam integer MOMENT_W = MERGE_MOMENT_W;

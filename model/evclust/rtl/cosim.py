@@ -27,6 +27,8 @@ BENCHES = {
     "evclust_axis": ((), TB_DIR.parent / "evclust_axis", "test_evclust_axis"),
     "evclust_decay": ((), TB_DIR.parent / "evclust_decay", "test_evclust_decay"),
     "evclust_palette": ((), TB_DIR.parent / "evclust_palette", "test_evclust_palette"),
+    "evclust_merge_search": ((), TB_DIR.parent / "evclust_merge_search", "test_evclust_merge_search"),
+    "evclust_seek": ((), TB_DIR.parent / "evclust_seek", "test_evclust_seek"),
     "evclust_slot_ram": ((), TB_DIR.parent / "evclust_slot_ram", "test_evclust_slot_ram"),
     "evclust_top2": ((), TB_DIR.parent / "evclust_top2", "test_evclust_top2"),
 }

@@ -1,0 +1,186 @@
+"""evclust_seek, step 1 (every slot's key and the comparator trees), against the fixed model's
+`_seek` (the nearest live slot in reach, ties to the lower one; none) and its lowest free slot,
+under Icarus and Verilator.
+
+Random tables around each event: live and free slots, centres near the event and far from it,
+half-sizes over their format, equal distances (ties). Each slot's reach comes from the model's
+`_margin`, as the core derives it when the slot is written. Two builds: the defaults with a
+scaled seek (seek_scale > 0, so the reach grows with max(Rx, Ry)) at N = 16, and the traffic
+preset (a fixed margin) at N = 4.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import random
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+try:
+    import cocotb
+    from cocotb.triggers import Timer
+except ImportError:  # collected by pytest without cocotb: the pytest half still reports why
+    cocotb = None
+
+TABLES = 1500
+BUILDS = {"scaled_seek": (160, 120, 16666.0, 16), "traffic": (480, 270, 50000.0, 4)}
+
+
+def build_params(name: str):
+    from cosim import configuration_params
+
+    width, height, t_frame, n = BUILDS[name]
+    if name == "scaled_seek":
+        from evclust.clusterer import ClustererParams
+
+        return ClustererParams(n_clusters=n, seek_scale=0.75, seek_margin=4.0), width, height, t_frame
+    return configuration_params(name, n), width, height, t_frame
+
+
+def model_for(name: str):
+    from evclust.fixed.model import FixedClusterer
+
+    params, width, height, t_frame = build_params(name)
+    return FixedClusterer(params, width, height, t_frame), width, height
+
+
+def tables(model, width: int, height: int, seed: int):
+    """(event x, y, slot table S) triples: centres near the event (some at equal distances) and far."""
+    from evclust.clusterer.layout import PX, PY, RX, RY, SLOT_COLUMNS, VALID
+
+    rng = random.Random(seed)
+    fp, fr = model.table["centre"].frac_bits, model.table["half_size"].frac_bits
+    r_max = (1 << model.table["half_size"].word_bits) - 1
+    n = model.params.n_clusters
+    for _ in range(TABLES):
+        x, y = rng.randrange(width), rng.randrange(height)
+        S = np.zeros((n, len(SLOT_COLUMNS)), dtype=np.int64)
+        tie = rng.randrange(1, 40) << fp
+        crowd = rng.choice((0.0, 0.1, 0.8))  # how many slots sit near the event: none, few, most
+        live = rng.choice((0.1, 0.8, 1.0))  # how many slots are live: a sparse, a busy, a full table
+        for s in range(n):
+            S[s, VALID] = rng.random() < live
+            kind = rng.random() * 0.8 / crowd if crowd else 1.0
+            if kind < 0.3:  # the same distance as others: ties go to the lower slot
+                S[s, PX], S[s, PY] = min(max(0, (x << fp) + rng.choice((-tie, tie))), (width - 1) << fp), y << fp
+            elif kind < 0.8:  # near
+                S[s, PX] = min(max(0, (x << fp) + rng.randrange(-60 << fp, 60 << fp)), (width - 1) << fp)
+                S[s, PY] = min(max(0, (y << fp) + rng.randrange(-60 << fp, 60 << fp)), (height - 1) << fp)
+            else:  # anywhere
+                S[s, PX], S[s, PY] = rng.randrange(width << fp), rng.randrange(height << fp)
+            S[s, RX] = rng.randrange(r_max + 1) if rng.random() < 0.2 else rng.randrange(1 << fr, 30 << fr)
+            S[s, RY] = rng.randrange(r_max + 1) if rng.random() < 0.2 else rng.randrange(1 << fr, 30 << fr)
+        yield x, y, S
+
+
+def model_choice(model, x: int, y: int, S) -> tuple[int, int]:
+    """(the model's slot or -1, the lowest free slot or -1)."""
+    from evclust.clusterer.layout import VALID
+    from evclust.fixed import fixed_model
+
+    fp = model.table["centre"].frac_bits
+    free = [s for s in range(S.shape[0]) if not S[s, VALID]]
+    return int(fixed_model._seek(S, x << fp, y << fp, model.k)), (free[0] if free else -1)
+
+
+def reaches(model, S) -> list[tuple[int, int]]:
+    """Each slot's reach per axis in P's format, from the model's margin."""
+    from evclust.clusterer.layout import RX, RY
+    from evclust.fixed import fixed_model
+
+    up = model.table["centre"].frac_bits - model.table["half_size"].frac_bits
+    return [(int(S[s, RX] << up) + int(fixed_model._margin(S, s, model.k)), int(S[s, RY] << up) + int(fixed_model._margin(S, s, model.k)))
+            for s in range(S.shape[0])]  # fmt: skip
+
+
+if cocotb is not None:
+
+    @cocotb.test()
+    async def seek_vectors(dut):
+        config = json.loads(os.environ["EVCLUST_TB"])
+        try:
+            error, checked = await _seek_vectors(dut, config)
+        except Exception as exc:
+            error, checked = f"{type(exc).__name__}: {exc}", 0
+        Path(config["out"]).write_text(json.dumps({"checked": checked, "error": error}))
+        assert error is None, error
+
+    async def _seek_vectors(dut, config):
+        from evclust.clusterer.layout import PX, PY, VALID
+
+        model, width, height = model_for(config["build"])
+        centre_w, reach_w, slot_w, key_w = config["centre_w"], config["reach_w"], config["slot_w"], config["key_w"]
+        checked = 0
+        for x, y, S in tables(model, width, height, config["seed"]):
+            n = S.shape[0]
+            reach = reaches(model, S)
+            dut.x.value, dut.y.value = x, y
+            dut.valid.value = sum(int(S[s, VALID]) << s for s in range(n))
+            dut.centre_x.value = sum(int(S[s, PX]) << (s * centre_w) for s in range(n))
+            dut.centre_y.value = sum(int(S[s, PY]) << (s * centre_w) for s in range(n))
+            dut.reach_x.value = sum(r[0] << (s * reach_w) for s, r in enumerate(reach))
+            dut.reach_y.value = sum(r[1] << (s * reach_w) for s, r in enumerate(reach))
+            await Timer(1, unit="ns")
+            first, free = int(dut.seek_first.value), int(dut.free_first.value)
+            got = (-1 if first >> (key_w - 1) else first & ((1 << slot_w) - 1), -1 if free >> slot_w else free & ((1 << slot_w) - 1))
+            want = model_choice(model, x, y, S)
+            checked += 1
+            if got != want:
+                return f"event ({x}, {y}): RTL (slot, free slot) {got}, model {want}; table {S.tolist()}", checked
+        return None, checked
+
+
+# ------------------------------------------------------------------------------------------
+# pytest: build, launch, check.
+
+from cosim import run, selected_simulators  # noqa: E402
+
+
+def widths(name: str) -> dict:
+    """The core's widths for the module's parameters: REACH_W as evclust_core computes it."""
+    from evclust.rtl.sources import params_header
+
+    model, _, _ = model_for(name)
+    f, c = model.table.formats, model.table.constants
+    fp, fr, r_w = f["centre"].frac_bits, f["half_size"].frac_bits, f["half_size"].word_bits
+    scale_w = c["seek_scale"].fmt.word_bits if "seek_scale" in c else 1
+    scale_f = c["seek_scale"].fmt.frac_bits if "seek_scale" in c else 0
+    scaled = scale_w + r_w + max(0, fp - scale_f - fr)
+    base = max(r_w + fp - fr, c["seek_margin"].fmt.word_bits)
+    n = model.params.n_clusters
+    slot_w = max(1, (n - 1).bit_length())
+    params, width, height, t_frame = build_params(name)
+    return {"header": params_header(params, width, height, t_frame), "n": n, "xy_w": f["ev_xy"].word_bits,
+            "centre_w": f["centre"].word_bits, "reach_w": max(base, scaled) + 2, "slot_w": slot_w,
+            "key_w": 1 + f["seek_distance"].word_bits + slot_w}  # fmt: skip
+
+
+@pytest.mark.parametrize("build", sorted(BUILDS))
+@pytest.mark.parametrize("sim", selected_simulators())
+def test_the_seek_chooses_the_models_slot_and_the_lowest_free_one(sim, build):
+    w = widths(build)
+    parameters = {"N": w["n"], "XY_BITS": w["xy_w"], "CENTRE_BITS": w["centre_w"], "REACH_BITS": w["reach_w"], "SLOT_BITS": w["slot_w"],
+                  "KEY_BITS": w["key_w"]}  # fmt: skip
+    header = w.pop("header")
+    result = run(sim, header, "seek_vectors", {"build": build, "seed": 3} | w, toplevel="evclust_seek", parameters=parameters)
+    assert result["checked"] == TABLES
+
+
+def test_the_tables_hit_miss_and_fill_the_table():
+    """The generated tables reach the cases that matter: hits, misses, no free slot."""
+    from evclust.clusterer.layout import VALID
+
+    model, width, height = model_for("scaled_seek")
+    hits = misses = full = 0
+    for x, y, S in tables(model, width, height, 3):
+        slot, free = model_choice(model, x, y, S)
+        hits += slot >= 0
+        misses += slot < 0
+        full += free < 0 and bool(S[:, VALID].all())
+    assert hits > TABLES // 4 and misses > TABLES // 50 and full > TABLES // 50
