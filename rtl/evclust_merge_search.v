@@ -47,11 +47,13 @@ module evclust_merge_search #(
     localparam integer FP = CENTRE_FRAC, FR = HALF_SIZE_FRAC, UP = FP - FR;
     localparam [COUNT_BITS-1:0] MEASURED = 2;  // two interval measurements: vi_count >= 2
 
-    function automatic [CENTRE_BITS-1:0] centre_gap;  // |a - b| of two centres
+    function automatic [CENTRE_BITS-1:0] centre_gap;  // |a - b| of two centres: a subtraction, negated if it borrowed
         input [CENTRE_BITS-1:0] a;
         input [CENTRE_BITS-1:0] b;
+        reg [CENTRE_BITS:0] d;
         begin
-            centre_gap = a > b ? a - b : b - a;
+            d = {1'b0, a} - {1'b0, b};
+            centre_gap = d[CENTRE_BITS] ? ~d[CENTRE_BITS-1:0] + 1'b1 : d[CENTRE_BITS-1:0];
         end
     endfunction
     function automatic [V_BITS:0] v_gap;  // |a - b| of two v_int words, < 2^V_BITS
@@ -63,12 +65,6 @@ module evclust_merge_search #(
             v_gap = d[V_BITS] ? -d : d;
         end
     endfunction
-    function automatic signed [63:0] w64;  // an unsigned word of up to 63 bits, as the model's int64
-        input [62:0] v;
-        begin
-            w64 = {1'b0, v};
-        end
-    endfunction
 
     // Slot k's fields.
     wire [CENTRE_BITS-1:0] kx = centre_x[k*CENTRE_BITS +: CENTRE_BITS], ky = centre_y[k*CENTRE_BITS +: CENTRE_BITS];
@@ -78,21 +74,51 @@ module evclust_merge_search #(
     wire [GROW_BITS-1:0]   kgrow = grow[k*GROW_BITS +: GROW_BITS];
     wire [VREL_BITS-1:0]   kvrel = vrel[k*VREL_BITS +: VREL_BITS];
 
+    // Every quantity is non-negative: the comparators work at widths that hold them (a 64-bit
+    // comparison per slot would cost a 64-bit carry chain each).
+    localparam integer SHIFT_UP = FP - MERGE_SCALE_FRAC - FR;  // the grown reach's alignment to P
+    localparam integer GROWN_W = SHIFT_UP >= 0 ? GROW_BITS + 1 + SHIFT_UP : GROW_BITS + 1;
+    localparam integer BOX_W = HALF_BITS + 1 + UP;
+    localparam integer POS_W = (CENTRE_BITS > BOX_W ? (CENTRE_BITS > GROWN_W ? CENTRE_BITS : GROWN_W) : (BOX_W > GROWN_W ? BOX_W : GROWN_W)) + 1;
+    localparam integer VEL_W = (V_BITS + 2 > V_TOL_BITS ? (V_BITS + 2 > VREL_BITS ? V_BITS + 2 : VREL_BITS) : (V_TOL_BITS > VREL_BITS ? V_TOL_BITS : VREL_BITS)) + 1;
+    function automatic [POS_W-1:0] pos;  // an unsigned word at the position comparators' width
+        input [62:0] v;
+        /* verilator lint_off UNUSEDSIGNAL */  // the bits above the width are zero
+        reg [63:0] wide;
+        /* verilator lint_on UNUSEDSIGNAL */
+        begin
+            wide = {1'b0, v};
+            pos = wide[POS_W-1:0];
+        end
+    endfunction
+    function automatic [VEL_W-1:0] vel;  // ... at the velocity comparators' width
+        input [62:0] v;
+        /* verilator lint_off UNUSEDSIGNAL */  // the bits above the width are zero
+        reg [63:0] wide;
+        /* verilator lint_on UNUSEDSIGNAL */
+        begin
+            wide = {1'b0, v};
+            vel = wide[VEL_W-1:0];
+        end
+    endfunction
+
     integer s;
-    reg signed [63:0] dx, dy, sx, sy, grown, dv, fast, tolerance;
-    reg               ok;
+    reg [POS_W-1:0] dx, dy, sx, sy, grow_sum, grown;
+    reg [VEL_W-1:0] dv, fast, tolerance;
+    reg             ok;
     always @* begin
         found = 1'b0;
         j = {SLOT_BITS{1'b0}};
         for (s = N - 1; s >= 0; s = s - 1) begin  // downwards: the lowest match is the last written
-            dx = w64({{(63 - CENTRE_BITS){1'b0}}, centre_gap(kx, centre_x[s*CENTRE_BITS +: CENTRE_BITS])});
-            dy = w64({{(63 - CENTRE_BITS){1'b0}}, centre_gap(ky, centre_y[s*CENTRE_BITS +: CENTRE_BITS])});
-            sx = (w64({{(63 - HALF_BITS){1'b0}}, krx}) + w64({{(63 - HALF_BITS){1'b0}}, half_x[s*HALF_BITS +: HALF_BITS]})) <<< UP;
-            sy = (w64({{(63 - HALF_BITS){1'b0}}, kry}) + w64({{(63 - HALF_BITS){1'b0}}, half_y[s*HALF_BITS +: HALF_BITS]})) <<< UP;
-            grown = align(w64({{(63 - GROW_BITS){1'b0}}, kgrow}) + w64({{(63 - GROW_BITS){1'b0}}, grow[s*GROW_BITS +: GROW_BITS]}), MERGE_SCALE_FRAC + FR, FP);
-            dv = w64({{(63 - V_BITS - 1){1'b0}}, v_gap(kvx, v_x[s*V_BITS +: V_BITS])}) + w64({{(63 - V_BITS - 1){1'b0}}, v_gap(kvy, v_y[s*V_BITS +: V_BITS])});
-            fast = kvrel > vrel[s*VREL_BITS +: VREL_BITS] ? w64({{(63 - VREL_BITS){1'b0}}, kvrel}) : w64({{(63 - VREL_BITS){1'b0}}, vrel[s*VREL_BITS +: VREL_BITS]});
-            tolerance = w64({{(63 - V_TOL_BITS){1'b0}}, v_tol}) + (fast >>> MERGE_V_REL_FRAC);
+            dx = pos({{(63 - CENTRE_BITS){1'b0}}, centre_gap(kx, centre_x[s*CENTRE_BITS +: CENTRE_BITS])});
+            dy = pos({{(63 - CENTRE_BITS){1'b0}}, centre_gap(ky, centre_y[s*CENTRE_BITS +: CENTRE_BITS])});
+            sx = (pos({{(63 - HALF_BITS){1'b0}}, krx}) + pos({{(63 - HALF_BITS){1'b0}}, half_x[s*HALF_BITS +: HALF_BITS]})) << UP;
+            sy = (pos({{(63 - HALF_BITS){1'b0}}, kry}) + pos({{(63 - HALF_BITS){1'b0}}, half_y[s*HALF_BITS +: HALF_BITS]})) << UP;
+            grow_sum = pos({{(63 - GROW_BITS){1'b0}}, kgrow}) + pos({{(63 - GROW_BITS){1'b0}}, grow[s*GROW_BITS +: GROW_BITS]});
+            grown = SHIFT_UP >= 0 ? grow_sum << SHIFT_UP : grow_sum >> (-SHIFT_UP);  // align, floored
+            dv = vel({{(63 - V_BITS - 1){1'b0}}, v_gap(kvx, v_x[s*V_BITS +: V_BITS])}) + vel({{(63 - V_BITS - 1){1'b0}}, v_gap(kvy, v_y[s*V_BITS +: V_BITS])});
+            fast = kvrel > vrel[s*VREL_BITS +: VREL_BITS] ? vel({{(63 - VREL_BITS){1'b0}}, kvrel}) : vel({{(63 - VREL_BITS){1'b0}}, vrel[s*VREL_BITS +: VREL_BITS]});
+            tolerance = vel({{(63 - V_TOL_BITS){1'b0}}, v_tol}) + (fast >> MERGE_V_REL_FRAC);
             ok = dx <= sx + grown && dy <= sy + grown;
             if (kn >= MEASURED && measured[s*COUNT_BITS +: COUNT_BITS] >= MEASURED)
                 ok = ok && dv <= tolerance;

@@ -50,7 +50,6 @@ module evclust_palette #(
     localparam integer FB = BACKGROUND_FRAC;
     wire signed [63:0] W_Y = $signed({{(64 - LUMA_WEIGHT_W){1'b0}}, luma_weight});
     wire signed [63:0] TOLERANCE = $signed({{(64 - MIXING_TOLERANCE_W){1'b0}}, mixing_tolerance}) <<< FW;
-    localparam signed [63:0] FAR = 64'sd1 <<< 62;
 
     wire signed [63:0] e_y = $signed({{(64 - EV_COLOUR_W){1'b0}}, lum});
     wire signed [63:0] e_cb = $signed({{(64 - EV_COLOUR_W){1'b0}}, cb});
@@ -69,12 +68,15 @@ module evclust_palette #(
     // Operands are sized to their ranges so that synthesis builds small multipliers: colour
     // differences fit 9 bits, u.w fits 19, q fits 17 bits (0..2^16), the residual 27.
     integer j;
-    reg signed [63:0] p_y, p_cb, p_cr, t_y, t_cb, t_cr, d_end, d_line, nearest_d, mixed_d;
+    reg signed [63:0] p_y, p_cb, p_cr, t_y, t_cb, t_cr, d_end;
+    /* verilator lint_off UNUSEDSIGNAL */  // compared at CMP_W bits, above which it is zero
+    reg signed [63:0] d_line;
+    /* verilator lint_on UNUSEDSIGNAL */
     reg [7:0]         ad_y, ad_cb, ad_cr;
     reg signed [9:0]  w_y, w_cb, w_cr;
     reg signed [19:0] dot;
     /* verilator lint_off UNUSEDSIGNAL */  // products by addition: only the product's bits are used
-    reg signed [63:0] wy_ad, wy_t, dot_y, dot_cb, dot_cr, qw_y, qw_cb, qw_cr;
+    reg signed [63:0] wy_ad, wy_t, qw_y, qw_cb, qw_cr;
     /* verilator lint_on UNUSEDSIGNAL */
     localparam integer QF = MIXING_Q_FRAC;
     localparam integer PROD_W = 18 + INV_WW_W;  // u.w (positive, 18 bits) x 2^32 / |w|^2
@@ -86,27 +88,55 @@ module evclust_palette #(
     reg [CLASS_W-1:0] nearest, mixed;
     reg mixed_found;
 
+    // The distances compared at a width that holds them all (64-bit comparisons would cost a
+    // 64-bit carry chain each, per entry): w_Y|dY| + (|dCb| + |dCr|) << F_w, the line distance
+    // before its shift, and the tolerance; "far" is all ones, above every distance.
+    localparam integer D_END_W = (LUMA_WEIGHT_W + 8 > 9 + FW ? LUMA_WEIGHT_W + 8 : 9 + FW) + 1;
+    localparam integer D_LINE_W = (LUMA_WEIGHT_W + RES_W > RES_W + 1 + FW ? LUMA_WEIGHT_W + RES_W : RES_W + 1 + FW) + 1;
+    localparam integer D_W = D_END_W > D_LINE_W ? D_END_W : D_LINE_W;
+    localparam integer CMP_W = (D_W > MIXING_TOLERANCE_W + FW ? D_W : MIXING_TOLERANCE_W + FW) + 1;
+    localparam [CMP_W-1:0] FAR_C = {CMP_W{1'b1}};
+    /* verilator lint_off UNUSEDSIGNAL */  // the bits above CMP_W are zero
+    wire [63:0] tolerance_bits = TOLERANCE;
+    /* verilator lint_on UNUSEDSIGNAL */
+    wire [CMP_W-1:0] TOLERANCE_C = tolerance_bits[CMP_W-1:0];
+    reg  [CMP_W-1:0] d_end_c, d_line_c, nearest_d, mixed_d;
+
+    function automatic [7:0] byte_gap;  // |a - b| of two bytes: a subtraction, negated if it borrowed
+        input [7:0] a;
+        input [7:0] b;
+        reg [8:0] d;
+        begin
+            d = {1'b0, a} - {1'b0, b};
+            byte_gap = d[8] ? ~d[7:0] + 1'b1 : d[7:0];
+        end
+    endfunction
+    function automatic [RES_W-1:0] residual_size;  // |r| of a RES_W-bit r
+        input signed [RES_W-1:0] r;
+        begin
+            residual_size = r[RES_W-1] ? ~r + 1'b1 : r;
+        end
+    endfunction
+
     always @* begin
         nearest = {CLASS_W{1'b0}};
-        nearest_d = FAR;
+        nearest_d = FAR_C;
         mixed = {CLASS_W{1'b0}};
-        mixed_d = FAR;
+        mixed_d = FAR_C;
         mixed_found = 1'b0;
         for (j = 0; j < P; j = j + 1) begin
             p_y = $signed({56'd0, palette_y[j*8 +: 8]});
             p_cb = $signed({56'd0, palette_cb[j*8 +: 8]});
             p_cr = $signed({56'd0, palette_cr[j*8 +: 8]});
-            t_y = abs64(e_y - p_y);
-            t_cb = abs64(e_cb - p_cb);
-            t_cr = abs64(e_cr - p_cr);
-            ad_y = t_y[7:0];
-            ad_cb = t_cb[7:0];
-            ad_cr = t_cr[7:0];
+            ad_y = byte_gap(lum, palette_y[j*8 +: 8]);
+            ad_cb = byte_gap(cb, palette_cb[j*8 +: 8]);
+            ad_cr = byte_gap(cr, palette_cr[j*8 +: 8]);
             wy_ad = mul_by_addition($signed({56'd0, ad_y}), W_Y, LUMA_WEIGHT_W + 1);
             d_end = $signed({{(64 - LUMA_WEIGHT_W - 8){1'b0}}, wy_ad[LUMA_WEIGHT_W+7:0]}) + (($signed({56'd0, ad_cb}) + $signed({56'd0, ad_cr})) <<< FW);
-            if (d_end < nearest_d) begin
+            d_end_c = d_end[CMP_W-1:0];
+            if (d_end_c < nearest_d) begin
                 nearest = j[CLASS_W-1:0];
-                nearest_d = d_end;
+                nearest_d = d_end_c;
             end
             t_y = p_y - bi_y;
             t_cb = p_cb - bi_cb;
@@ -114,10 +144,7 @@ module evclust_palette #(
             w_y = t_y[9:0];
             w_cb = t_cb[9:0];
             w_cr = t_cr[9:0];
-            dot_y = mul_by_addition({{54{u_y10[9]}}, u_y10}, {{54{w_y[9]}}, w_y}, 10);
-            dot_cb = mul_by_addition({{54{u_cb10[9]}}, u_cb10}, {{54{w_cb[9]}}, w_cb}, 10);
-            dot_cr = mul_by_addition({{54{u_cr10[9]}}, u_cr10}, {{54{w_cr[9]}}, w_cr}, 10);
-            dot = dot_y[19:0] + dot_cb[19:0] + dot_cr[19:0];
+            dot = u_y10 * w_y + u_cb10 * w_cb + u_cr10 * w_cr;  // three DSP blocks: by addition they cost more cells than the part spares
             q_wide = {{(PROD_W - 18){1'b0}}, dot[17:0]} * {{(PROD_W - INV_WW_W){1'b0}}, inv_ww[j*INV_WW_W +: INV_WW_W]};
             // mixing_q, clamped to 1
             q = dot <= 20'sd0 ? {MIXING_Q_W{1'b0}} : (q_wide[PROD_W-1:QF] > {{(PROD_W - QF - MIXING_Q_W){1'b0}}, ONE_Q} ? ONE_Q : q_wide[QF +: MIXING_Q_W]);
@@ -127,17 +154,17 @@ module evclust_palette #(
             r_y = ($signed({{(RES_W - 10){u_y10[9]}}, u_y10}) <<< QF) - qw_y[RES_W-1:0];
             r_cb = ($signed({{(RES_W - 10){u_cb10[9]}}, u_cb10}) <<< QF) - qw_cb[RES_W-1:0];
             r_cr = ($signed({{(RES_W - 10){u_cr10[9]}}, u_cr10}) <<< QF) - qw_cr[RES_W-1:0];
-            t_y = abs64({{(64 - RES_W){r_y[RES_W-1]}}, r_y});
-            t_cb = abs64({{(64 - RES_W){r_cb[RES_W-1]}}, r_cb});
-            t_cr = abs64({{(64 - RES_W){r_cr[RES_W-1]}}, r_cr});
             // |r| of a RES_W-bit r fits RES_W bits: the product with w_Y stays a small multiplier.
-            t_y = $signed({{(64 - RES_W){1'b0}}, t_y[RES_W-1:0]});
+            t_y = $signed({{(64 - RES_W){1'b0}}, residual_size(r_y)});
+            t_cb = $signed({{(64 - RES_W){1'b0}}, residual_size(r_cb)});
+            t_cr = $signed({{(64 - RES_W){1'b0}}, residual_size(r_cr)});
             wy_t = mul_by_addition(t_y, W_Y, LUMA_WEIGHT_W + 1);
             d_line = background_mask[j] ? d_end
                    : ($signed({{(64 - LUMA_WEIGHT_W - RES_W){1'b0}}, wy_t[LUMA_WEIGHT_W+RES_W-1:0]}) + ((t_cb + t_cr) <<< FW)) >>> QF;
-            if (d_line <= TOLERANCE && d_end < mixed_d) begin
+            d_line_c = d_line[CMP_W-1:0];
+            if (d_line_c <= TOLERANCE_C && d_end_c < mixed_d) begin
                 mixed = j[CLASS_W-1:0];
-                mixed_d = d_end;
+                mixed_d = d_end_c;
                 mixed_found = 1'b1;
             end
         end

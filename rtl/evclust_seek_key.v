@@ -42,8 +42,11 @@ module evclust_seek_key #(
     wire [GAP_W-1:0] ey = {{(GAP_W - XY_BITS){1'b0}}, y} << FP;
     wire [GAP_W-1:0] cx = {{(GAP_W - CENTRE_BITS){1'b0}}, centre_x};
     wire [GAP_W-1:0] cy = {{(GAP_W - CENTRE_BITS){1'b0}}, centre_y};
-    wire [GAP_W-1:0] dx = ex > cx ? ex - cx : cx - ex;
-    wire [GAP_W-1:0] dy = ey > cy ? ey - cy : cy - ey;
+    // |a - b| as one subtraction and a negation when it borrowed (two carry chains, not three).
+    wire [GAP_W:0]   sub_x = {1'b0, ex} - {1'b0, cx};
+    wire [GAP_W:0]   sub_y = {1'b0, ey} - {1'b0, cy};
+    wire [GAP_W-1:0] dx = sub_x[GAP_W] ? ~sub_x[GAP_W-1:0] + 1'b1 : sub_x[GAP_W-1:0];
+    wire [GAP_W-1:0] dy = sub_y[GAP_W] ? ~sub_y[GAP_W-1:0] + 1'b1 : sub_y[GAP_W-1:0];
     wire hit = live && dx <= {{(GAP_W - REACH_BITS){1'b0}}, reach_x} && dy <= {{(GAP_W - REACH_BITS){1'b0}}, reach_y};
     wire [DIST_W-1:0] distance = dx[DIST_W-1:0] + dy[DIST_W-1:0];
     assign key = {!hit, hit ? distance : {DIST_W{1'b0}}, slot};
