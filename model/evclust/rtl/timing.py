@@ -69,7 +69,9 @@ def nextpnr_args(out: Path, route: bool) -> list[str]:
     return PART["nextpnr"] + [
         "--json", str(out / "netlist.json"), "--out-of-context", "--freq", str(TARGET_MHZ),
         "--timing-allow-fail", "--detailed-timing-report", "--report", str(out / "report.json"),
-        "--seed", "1", "-q", "-l", str(out / "nextpnr.log"),
+        # router2: router1 took over 30 minutes on the defaults at N = 16 (84 % of the logic cells)
+        # and was not near done; router2 routes congested designs in a fraction of that.
+        "--router", "router2", "--seed", "1", "-q", "-l", str(out / "nextpnr.log"),
     ] + ([] if route else ["--no-route"])  # fmt: skip
 
 
