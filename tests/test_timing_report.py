@@ -83,3 +83,49 @@ def test_a_design_too_large_for_the_part_is_a_result_with_its_utilisation(tmp_pa
     assert figures["resources"]["mult18"] == 144 and figures["resources"]["ff"] == 17129
     (tmp_path / "nextpnr.log").write_text("ERROR: something else\n")
     assert _unplaced(tmp_path) is None  # any other failure stays an error
+
+
+def test_the_tools_see_their_run_folder_by_relative_paths_only(tmp_path, monkeypatch):
+    """yowasp maps its own temporary folder over /tmp, so a clone under /tmp could not run `make
+    timing` while the tools were given absolute paths: every path they see is relative to their
+    run folder (the place-and-route step is stubbed out; the scripts and arguments are real)."""
+    from evclust.rtl import timing
+
+    build = tmp_path / "clone" / "build"  # an absolute path, like a clone in the system temporary folder
+    seen = []
+
+    def fake_run(tool, args, out, log, heartbeat):
+        seen.append((tool, args, (out / "synth.ys").read_text()))
+        raise timing.EvclustError("stop here")
+
+    monkeypatch.setattr(timing, "BUILD", build)
+    monkeypatch.setattr(timing, "tool_identity", lambda: "yowasp (stub)")
+    monkeypatch.setattr(timing, "_run", fake_run)
+    try:
+        timing.place_and_route("// header\n", "check", snapshot=({"evclust_core.v": "module m; endmodule\n"}, "abc1234"))
+    except timing.EvclustError:
+        pass
+    (tool, args, script), = seen
+    assert tool == "yosys"
+    text = " ".join(args) + "\n" + script
+    assert str(tmp_path) not in text and "/tmp" not in text
+    assert "read_verilog -defer -Isrc src/" in script and " src/evclust_core.v" in script and "-json netlist.json" in script
+    assert all(not a.startswith("/") for a in timing.nextpnr_args(timing.Path("."), True))
+
+
+def test_a_run_may_stop_after_placement():
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "synth"))
+    import timing as script
+
+    assert script.parse_run("defaults:64:placed") == ("defaults", 64, True)
+    assert script.parse_run("paper:16") == ("paper", 16, False)
+    for bad in ("defaults", "defaults:x", "nope:16", "paper:16:routed"):
+        try:
+            script.parse_run(bad)
+        except Exception as exc:  # argparse.ArgumentTypeError: a one-line reason
+            assert bad in str(exc)
+        else:
+            raise AssertionError(f"{bad!r} accepted")
