@@ -58,9 +58,10 @@ def defaults_section(rows) -> str:
         "",
         table(rows),
         "",
-        "- The additions cost the N parallel merge comparators (each with a constant multiply for the grown reach and one "
-        "for the velocity tolerance), a seek-margin multiply per slot, the merge's two moment products and iterative "
-        "dividers, the noise gate's products and a second decay unit. On an LFE5U-85F they do not fit at N = 16 (99,560 logic cells, 285 multipliers: docs/RTL.md, Datasheet).",
+        "- The additions cost the N parallel merge comparators (each adding and comparing the products `merge_scale·max(R)` "
+        "and `merge_v_rel·speed` that every slot stores when it is written: no multiply per slot), the seek reach stored per "
+        "slot, the merge's two moment products and iterative dividers, the noise gate's products and a second decay unit. "
+        "Placed on an LFE5U-85F with the parameters in run-time registers: docs/RTL.md, Datasheet.",
         DEFAULTS_END,
         "",
     ])  # fmt: skip
