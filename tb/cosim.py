@@ -68,3 +68,18 @@ def random_config(name: str, n_clusters: int, seed: int, count: int, formats: di
               "width": width, "height": height, "t_frame_us": t_frame, "seed": seed, "count": count,
               "gap": 0, "stall": 0, "formats": formats} | extra  # fmt: skip
     return header, config
+
+
+async def checked_vectors(dut, body) -> None:
+    """A unit testbench's cocotb side: `await body(dut, config)` gives (error or None, cases
+    checked); both go where the pytest side reads them (config["out"]), and an error fails the test."""
+    import json
+    from pathlib import Path
+
+    config = json.loads(os.environ["EVCLUST_TB"])
+    try:
+        error, checked = await body(dut, config)
+    except Exception as exc:
+        error, checked = f"{type(exc).__name__}: {exc}", 0
+    Path(config["out"]).write_text(json.dumps({"checked": checked, "error": error}))
+    assert error is None, error

@@ -15,8 +15,6 @@ and launches it through `cocotb_tools.runner`, as tb/evclust_core/test_evclust_c
 
 from __future__ import annotations
 
-import json
-import os
 import random
 import sys
 from pathlib import Path
@@ -27,6 +25,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 try:
     import cocotb
+
+    from cosim import checked_vectors
     from cocotb.triggers import Timer
 except ImportError:  # collected by pytest without cocotb: the pytest half still reports why
     cocotb = None
@@ -75,13 +75,7 @@ if cocotb is not None:
     @cocotb.test()
     async def decay_vectors(dut):
         """Every case through the combinational module; the first difference from the model fails."""
-        config = json.loads(os.environ["EVCLUST_TB"])
-        try:
-            error, checked = await _decay_vectors(dut, config)
-        except Exception as exc:
-            error, checked = f"{type(exc).__name__}: {exc}", 0
-        Path(config["out"]).write_text(json.dumps({"checked": checked, "error": error}))
-        assert error is None, error
+        await checked_vectors(dut, _decay_vectors)
 
     async def _decay_vectors(dut, config):
         widths = config["widths"] | {"table": config["table"]}

@@ -11,8 +11,6 @@ writes a slot.
 
 from __future__ import annotations
 
-import json
-import os
 import random
 import sys
 from pathlib import Path
@@ -24,6 +22,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 try:
     import cocotb
+
+    from cosim import checked_vectors
     from cocotb.triggers import Timer
 except ImportError:  # collected by pytest without cocotb: the pytest half still reports why
     cocotb = None
@@ -90,13 +90,7 @@ if cocotb is not None:
 
     @cocotb.test()
     async def merge_search_vectors(dut):
-        config = json.loads(os.environ["EVCLUST_TB"])
-        try:
-            error, checked = await _merge_search_vectors(dut, config)
-        except Exception as exc:
-            error, checked = f"{type(exc).__name__}: {exc}", 0
-        Path(config["out"]).write_text(json.dumps({"checked": checked, "error": error}))
-        assert error is None, error
+        await checked_vectors(dut, _merge_search_vectors)
 
     async def _merge_search_vectors(dut, config):
         from evclust.clusterer.layout import PX, PY, RX, RY, VALID, VI_COUNT, VIX, VIY
