@@ -109,9 +109,11 @@ report: $(SYNTH_STAMP)
 
 # The generalization suite's test split (held out from all tuning) through the default and the
 # paper's configurations, float and fixed: docs/GENERALIZATION.md and its picture. Scenes and
-# events are kept in build/suite for the next run.
+# events are kept in build/suite for the next run. docs/PIPELINE.md: what the pipeline semantics
+# (update_delay) cost, paired over small perturbations of the defaults, test and tuning splits.
 generalize: $(STAMP)
 	$(VENV)/bin/evclust generalize --split test -o docs/GENERALIZATION.md
+	$(VENV)/bin/evclust generalize --pipeline -o docs/PIPELINE.md
 
 # A real video end to end (outside CI): OpenCV's vtest.avi (768x576, 795 frames of people walking,
 # from Debian's opencv-doc package; fetched, not committed) simulated and tracked in one pass (no

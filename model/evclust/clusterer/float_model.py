@@ -14,7 +14,8 @@ import numpy as np
 from evclust.clusterer.layout import (
     ACT, BG_ACT, BG_CB, BG_CR, BG_T, BG_Y, CCB, CCR, MERGED, UNSUPPORTED, CREATED, CY, DROPPED, EV_COUNT, EVENTS, EVER_REPORTED, EVICTED, EXITED,
     EXPIRED, T_FIRST, FLAG_BORDER, FLAG_MOVING_INT, FLAG_MOVING_MCM, FLAG_NEW, GAMMA, ID, MCM_NORM, NEXT_ID, NOISE, PPX, PPY, PX,
-    PY, RECORD_COLUMNS, REPORTED, RX, RY, SINCE_FILTER, STEP, T_FILTER, T_LAST, VALID, VI_COUNT, VIX, VIY, VMX,
+    PD_BG, PD_BG_CB, PD_BG_CR, PD_BG_Y, PD_CCB, PD_CCR, PD_CLASS, PD_CY, PD_LIVE, PD_NORM, PD_PX, PD_PY, PD_RX, PD_RY, PD_SLOT,
+    PD_T, PD_VMX, PD_VMY, PD_VOTE, PY, RECORD_COLUMNS, REPORTED, RX, RY, SINCE_FILTER, STEP, T_FILTER, T_LAST, VALID, VI_COUNT, VIX, VIY, VMX,
     VMY,
 )  # fmt: skip
 from evclust.jit import njit
@@ -187,47 +188,89 @@ def _create(S, H, G, s, t, x, y, lum, cb, cr, k, precision):
 
 
 @njit(cache=True, nogil=True)
-def _update(S, H, G, s, t, x, y, lum, cb, cr, k, palette, background_mask, precision):
-    """Step 3: mean-shift update of the chosen cluster."""
-    a = _q(_decayed(S[s, ACT], t - S[s, T_LAST], k[K_T_HALF], precision), Q_ACT, precision) + 1.0
-    S[s, ACT] = _q(a, Q_ACT, precision)
+def _increments(S, G, s, t, x, y, lum, cb, cr, k, palette, background_mask, precision, row):
+    """Step 3, read half: the mean-shift update of the chosen cluster as increments computed from
+    the state the event reads (the table D events ago in a pipelined core), into `row`."""
+    row[PD_LIVE], row[PD_SLOT], row[PD_T] = 1.0, s, t
     px, py = S[s, PX], S[s, PY]
     # Eq. (1) on the centre: P_new = P + β_P (e - P).
-    px_new = px + k[B_POS] * (x - px)
-    py_new = py + k[B_POS] * (y - py)
-    # Size: R += β_R (g_R |e - P| - R), clamped.
-    rx = S[s, RX] + k[B_SIZE] * (k[K_GAIN] * abs(x - px) - S[s, RX])
-    ry = S[s, RY] + k[B_SIZE] * (k[K_GAIN] * abs(y - py) - S[s, RY])
-    S[s, RX] = min(max(_q(rx, Q_HALF, precision), k[K_R_MIN]), k[K_R_MAX])
-    S[s, RY] = min(max(_q(ry, Q_HALF, precision), k[K_R_MIN]), k[K_R_MAX])
+    row[PD_PX] = k[B_POS] * (x - px)
+    row[PD_PY] = k[B_POS] * (y - py)
+    # Size: R += β_R (g_R |e - P| - R), clamped when committed.
+    row[PD_RX] = k[B_SIZE] * (k[K_GAIN] * abs(x - px) - S[s, RX])
+    row[PD_RY] = k[B_SIZE] * (k[K_GAIN] * abs(y - py) - S[s, RY])
     # Eq. (5), MCM: V += β_vm (γ (P_new - P) - V).
     gamma = S[s, GAMMA]
-    px_new, py_new = _q(px_new, Q_CENTRE, precision), _q(py_new, Q_CENTRE, precision)
-    S[s, VMX] = _q(S[s, VMX] + k[B_VM] * (gamma * (px_new - px) - S[s, VMX]), Q_VM, precision)
-    S[s, VMY] = _q(S[s, VMY] + k[B_VM] * (gamma * (py_new - py) - S[s, VMY]), Q_VM, precision)
+    px_new, py_new = _q(px + row[PD_PX], Q_CENTRE, precision), _q(py + row[PD_PY], Q_CENTRE, precision)
+    row[PD_VMX] = k[B_VM] * (gamma * (px_new - px) - S[s, VMX])
+    row[PD_VMY] = k[B_VM] * (gamma * (py_new - py) - S[s, VMY])
     # The same filter on a constant 1 gives 1 - α^n: the weight V has gathered since V = 0.
-    S[s, MCM_NORM] = _q(S[s, MCM_NORM] + k[B_VM] * (1.0 - S[s, MCM_NORM]), Q_NORM, precision)
-    S[s, PX], S[s, PY] = px_new, py_new
+    row[PD_NORM] = k[B_VM] * (1.0 - S[s, MCM_NORM])
     if k[K_COLOUR] != 0.0:
         # Eq. (10): colour mean shift, luminance and chrominance with their own β.
-        S[s, CY] = _q(S[s, CY] + k[B_LUM] * (lum - S[s, CY]), Q_COLOUR, precision)
-        S[s, CCB] = _q(S[s, CCB] + k[B_CHRO] * (cb - S[s, CCB]), Q_COLOUR, precision)
-        S[s, CCR] = _q(S[s, CCR] + k[B_CHRO] * (cr - S[s, CCR]), Q_COLOUR, precision)
-        # §7.2.2: count the event's palette class; halve all counters when one saturates.
+        row[PD_CY] = k[B_LUM] * (lum - S[s, CY])
+        row[PD_CCB] = k[B_CHRO] * (cb - S[s, CCB])
+        row[PD_CCR] = k[B_CHRO] * (cr - S[s, CCR])
+        # §7.2.2: the event's palette class and vote.
         if k[K_ASSIGN_MIXING] != 0.0:
-            c = _mixing_palette(lum, cb, cr, G[BG_Y], G[BG_CB], G[BG_CR], palette, background_mask, k[K_LUMA_W], k[K_MIX_TOL])
+            row[PD_CLASS] = _mixing_palette(lum, cb, cr, G[BG_Y], G[BG_CB], G[BG_CR], palette, background_mask, k[K_LUMA_W], k[K_MIX_TOL])
         else:
-            c = _nearest_palette(lum, cb, cr, palette, k[K_LUMA_W])
-        vote = 1
+            row[PD_CLASS] = _nearest_palette(lum, cb, cr, palette, k[K_LUMA_W])
+        row[PD_VOTE] = 1.0
         if k[K_VOTE_CONTRAST] != 0.0:
-            vote = int(abs(lum - G[BG_Y]) + abs(cb - G[BG_CB]) + abs(cr - G[BG_CR]) + 0.5)
-        h_max = np.int64(k[K_H_MAX])
-        H[s, c] = min(H[s, c] + vote, h_max)
-        if H[s, c] >= h_max:
-            for j in range(H.shape[1]):
-                H[s, j] >>= 1
-    S[s, EV_COUNT] += 1.0
-    S[s, T_LAST] = t
+            row[PD_VOTE] = int(abs(lum - G[BG_Y]) + abs(cb - G[BG_CB]) + abs(cr - G[BG_CR]) + 0.5)
+
+
+@njit(cache=True, nogil=True)
+def _commit(S, H, G, row, k, precision):
+    """Step 3, write half: an event's increments added to the slot as it is now (in a pipelined
+    core, other events' commits may have landed since the event read it); with no delay, the
+    paper's update exactly. Then the event's background-colour update (step 4)."""
+    if row[PD_LIVE] != 0.0:
+        s, t = int(row[PD_SLOT]), row[PD_T]
+        a = _q(_decayed(S[s, ACT], t - S[s, T_LAST], k[K_T_HALF], precision), Q_ACT, precision) + 1.0
+        S[s, ACT] = _q(a, Q_ACT, precision)
+        S[s, RX] = min(max(_q(S[s, RX] + row[PD_RX], Q_HALF, precision), k[K_R_MIN]), k[K_R_MAX])
+        S[s, RY] = min(max(_q(S[s, RY] + row[PD_RY], Q_HALF, precision), k[K_R_MIN]), k[K_R_MAX])
+        S[s, VMX] = _q(S[s, VMX] + row[PD_VMX], Q_VM, precision)
+        S[s, VMY] = _q(S[s, VMY] + row[PD_VMY], Q_VM, precision)
+        S[s, MCM_NORM] = _q(min(S[s, MCM_NORM] + row[PD_NORM], 1.0), Q_NORM, precision)  # (a weight: at most 1)
+        S[s, PX] = _q(S[s, PX] + row[PD_PX], Q_CENTRE, precision)
+        S[s, PY] = _q(S[s, PY] + row[PD_PY], Q_CENTRE, precision)
+        if k[K_COLOUR] != 0.0:
+            S[s, CY] = _q(S[s, CY] + row[PD_CY], Q_COLOUR, precision)
+            S[s, CCB] = _q(S[s, CCB] + row[PD_CCB], Q_COLOUR, precision)
+            S[s, CCR] = _q(S[s, CCR] + row[PD_CCR], Q_COLOUR, precision)
+            # Count the event's class; halve all counters when one saturates.
+            c, h_max = int(row[PD_CLASS]), np.int64(k[K_H_MAX])
+            H[s, c] = min(H[s, c] + np.int64(row[PD_VOTE]), h_max)
+            if H[s, c] >= h_max:
+                for j in range(H.shape[1]):
+                    H[s, j] >>= 1
+        S[s, EV_COUNT] += 1.0
+        S[s, T_LAST] = t
+        row[PD_LIVE] = 0.0
+    if row[PD_BG] != 0.0:
+        G[BG_Y] = _q(G[BG_Y] + row[PD_BG_Y], Q_BG, precision)
+        G[BG_CB] = _q(G[BG_CB] + row[PD_BG_CB], Q_BG, precision)
+        G[BG_CR] = _q(G[BG_CR] + row[PD_BG_CR], Q_BG, precision)
+        row[PD_BG] = 0.0
+
+
+@njit(cache=True, nogil=True)
+def _drain(S, H, G, line, k, precision):
+    """Commit every event still in the delay line, oldest first (before a filter step)."""
+    n = line.shape[0]
+    for m in range(n):
+        _commit(S, H, G, line[(int(G[EVENTS]) + 1 + m) % n], k, precision)
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _cancel(line, s):
+    """A slot taken by a new cluster: the updates still in flight for its old cluster are void."""
+    for r in range(line.shape[0]):
+        if line[r, PD_LIVE] != 0.0 and line[r, PD_SLOT] == s:
+            line[r, PD_LIVE] = 0.0
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -422,13 +465,16 @@ def _supported(support, cx, cy, t, window):
 
 
 @njit(cache=True, nogil=True)
-def run_events(S, H, G, k, palette, background_mask, support, t_us, xs, ys, lums, cbs, crs, out, steps, precision=None):
+def run_events(S, H, G, k, palette, background_mask, support, line, t_us, xs, ys, lums, cbs, crs, out, steps, precision=None):
     """Feed events through the table; write track records into `out`; return how many. Each
     filter step's time goes into `steps`, in order (the object layer's clock; G[STEP] counts
     them). With a `precision` table (PRECISION_SIGNALS x 4) each quantisation point rounds to
     its format. `support` is the creation-support map (layout.support_shape), each cell the time
-    of its latest event (-inf: none)."""
+    of its latest event (-inf: none). `line` is the update delay line (D + 1 rows of
+    layout.PENDING_COLUMNS): event n reads the table with the updates of events up to n - D - 1
+    committed (creations at once), and every filter step first commits all."""
     bits = int(k[K_SUPPORT_BITS])
+    delay = line.shape[0] - 1
     n_out = 0
     first_step = G[STEP]
     every = int(k[K_EVERY])
@@ -440,6 +486,8 @@ def run_events(S, H, G, k, palette, background_mask, support, t_us, xs, ys, lums
             G[T_FILTER] = t  # the filter-step clock and the τ boundaries start at the first event
             G[T_FIRST] = t
         G[EVENTS] += 1
+        row = line[int(G[EVENTS]) % (delay + 1)]  # it holds event n - D - 1: its turn to commit
+        _commit(S, H, G, row, k, precision)
         s = _seek(S, x, y, k)
         updated_reported = False
         cx, cy = (int(xs[i]) >> bits) + 1, (int(ys[i]) >> bits) + 1
@@ -449,11 +497,12 @@ def run_events(S, H, G, k, palette, background_mask, support, t_us, xs, ys, lums
             else:
                 s = _slot_for_new(S, G, t, k, precision)
                 if s >= 0:
+                    _cancel(line, s)
                     _create(S, H, G, s, t, x, y, lum, cb, cr, k, precision)
                 else:
                     G[DROPPED] += 1
         else:
-            _update(S, H, G, s, t, x, y, lum, cb, cr, k, palette, background_mask, precision)
+            _increments(S, G, s, t, x, y, lum, cb, cr, k, palette, background_mask, precision, row)
             updated_reported = S[s, REPORTED] != 0.0
         if k[K_SUPPORT] != 0.0:
             support[cy, cx] = t
@@ -462,12 +511,16 @@ def run_events(S, H, G, k, palette, background_mask, support, t_us, xs, ys, lums
             G[BG_ACT] = _q(_decayed(G[BG_ACT], t - G[BG_T], k[K_T_HALF], precision), Q_ACT, precision) + 1.0
             G[BG_T] = t
         if k[K_COLOUR] != 0.0 and k[K_BG_FIXED] == 0.0 and not updated_reported:
-            G[BG_Y] = _q(G[BG_Y] + k[B_BG] * (lum - G[BG_Y]), Q_BG, precision)
-            G[BG_CB] = _q(G[BG_CB] + k[B_BG] * (cb - G[BG_CB]), Q_BG, precision)
-            G[BG_CR] = _q(G[BG_CR] + k[B_BG] * (cr - G[BG_CR]), Q_BG, precision)
+            row[PD_BG] = 1.0
+            row[PD_BG_Y] = k[B_BG] * (lum - G[BG_Y])
+            row[PD_BG_CB] = k[B_BG] * (cb - G[BG_CB])
+            row[PD_BG_CR] = k[B_BG] * (cr - G[BG_CR])
+        if delay == 0:
+            _commit(S, H, G, row, k, precision)
         G[SINCE_FILTER] += 1
         if G[SINCE_FILTER] >= every:
             G[SINCE_FILTER] = 0
             steps[int(G[STEP] - first_step)] = t
+            _drain(S, H, G, line, k, precision)
             n_out = _filter_step(S, H, G, t, k, palette, background_mask, out, n_out, precision)
     return n_out

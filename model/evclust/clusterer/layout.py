@@ -31,6 +31,21 @@ GLOBAL_COLUMNS = (
     "merged", "unsupported",  # clusters merged into another; events that found no cluster and no support
 )  # fmt: skip
 
+# The update delay line (beyond the paper; ClustererParams.update_delay = D): a pipelined core
+# reads a slot when an event enters and writes it back D events later, so each event's update is
+# kept as increments computed from the state it read, and committed, in event order, with
+# additions. One row per event in flight; a row may hold a slot update, a background-colour
+# update, or both.
+(
+    PD_LIVE, PD_SLOT, PD_T, PD_PX, PD_PY, PD_RX, PD_RY, PD_VMX, PD_VMY, PD_NORM, PD_CY, PD_CCB, PD_CCR, PD_CLASS, PD_VOTE,
+    PD_BG, PD_BG_Y, PD_BG_CB, PD_BG_CR,
+) = range(19)  # fmt: skip
+PENDING_COLUMNS = (
+    "live", "slot", "t", "d_px", "d_py", "d_rx", "d_ry", "d_vmx", "d_vmy", "d_mcm_norm", "d_Y", "d_Cb", "d_Cr", "class", "vote",
+    "bg_live", "d_bg_Y", "d_bg_Cb", "d_bg_Cr",
+)  # fmt: skip
+
+
 # Track-record columns as the models write them (the order of evclust.tracks.TRACK_DTYPE).
 RECORD_COLUMNS = 18
 

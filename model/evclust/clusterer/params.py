@@ -50,6 +50,12 @@ class ClustererParams(BaseModel):
 
     # The cluster table and the seek region (§5.2).
     n_clusters: Annotated[int, Field(ge=1, le=1024)] = 16  # N slots
+    # Beyond the paper: pipeline semantics. A core that takes one event per clock at a high clock
+    # rate writes a slot back some events after it read it. With update_delay = D, event n reads
+    # the table with the updates of events up to n - D - 1 committed (creations at once), and
+    # each update is committed as increments added to the slot as it then is (docs/DESIGN.md,
+    # "Pipeline semantics"). 0: the paper's sequential update.
+    update_delay: Annotated[int, Field(ge=0, le=64)] = 0
     # The defaults hold across the generalization suite: they were tuned on its tuning split
     # (evclust tune --suite tuning, docs/TUNING.md), never on its test split.
     seek_margin: NonNegative = 2.7  # S, px: a cluster catches events within its box grown by S (+ seek_scale·max R)

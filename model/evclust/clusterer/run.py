@@ -10,7 +10,9 @@ import numpy as np
 from tqdm import tqdm
 
 from evclust.clusterer import float_model
-from evclust.clusterer.layout import BG_CB, BG_CR, BG_Y, GLOBAL_COLUMNS, RECORD_COLUMNS, SLOT_COLUMNS, STEP, run_stats, support_shape
+from evclust.clusterer.layout import (
+    BG_CB, BG_CR, BG_Y, GLOBAL_COLUMNS, PENDING_COLUMNS, RECORD_COLUMNS, SLOT_COLUMNS, STEP, run_stats, support_shape,
+)  # fmt: skip
 from evclust.clusterer.params import ClustererParams
 from evclust.choices import TRACK_MODELS
 from evclust.errors import EvclustError
@@ -72,6 +74,7 @@ class FloatClusterer:
         bg = params.background if params.background is not None else (128.0, 128.0, 128.0)
         self.globals[[BG_Y, BG_CB, BG_CR]] = bg
         self.support = np.full(support_shape(width, height, params.support_cell_bits), -np.inf)
+        self.delay_line = np.zeros((params.update_delay + 1, len(PENDING_COLUMNS)))  # the events in flight
         self.steps = np.zeros(0)  # the times of the filter steps the last feed completed
 
     def feed(self, events: np.ndarray) -> np.ndarray:
@@ -82,7 +85,7 @@ class FloatClusterer:
         steps = np.empty(events.size // every + 1)
         first = self.globals[STEP]
         n = float_model.run_events(
-            self.slots, self.hist, self.globals, self.k, self.palette, self.background_mask, self.support,
+            self.slots, self.hist, self.globals, self.k, self.palette, self.background_mask, self.support, self.delay_line,
             events["t"], events["x"], events["y"], events["Y"], events["Cb"], events["Cr"], out, steps, self.precision,
         )  # fmt: skip
         self.steps = steps[: int(self.globals[STEP] - first)]

@@ -316,9 +316,16 @@ def alpha_step(x, u, beta_raw, beta_frac_bits, guard_bits, mode):
 
 
 @njit(cache=True, inline="always")
+def alpha_increment_nb(x, u, beta_raw, beta_frac_bits, guard_bits, mode):
+    """What `alpha_step` adds to x: ``round(((u << g) - x) · β)``. A pipelined core computes it
+    from the state an event read and adds it to the state as it is when the event commits."""
+    return shift_round_nb(((u << guard_bits) - x) * beta_raw, beta_frac_bits, mode)
+
+
+@njit(cache=True, inline="always")
 def alpha_step_nb(x, u, beta_raw, beta_frac_bits, guard_bits, mode):
     """numba twin of `alpha_step`."""
-    return x + shift_round_nb(((u << guard_bits) - x) * beta_raw, beta_frac_bits, mode)
+    return x + alpha_increment_nb(x, u, beta_raw, beta_frac_bits, guard_bits, mode)
 
 
 def alpha_step_shift(x, u, k, guard_bits, mode):

@@ -14,10 +14,11 @@ from evclust.clusterer.layout import (
     ACT, BG_ACT, BG_CB, BG_CR, BG_RESIDUAL, BG_T, BG_Y, CCB, CCR, CREATED, CY, DROPPED, EV_COUNT, EVENTS, EVER_REPORTED, EVICTED,
     MERGED, UNSUPPORTED,
     DECAY_RESIDUAL, EXITED, EXPIRED, GLOBAL_COLUMNS, T_FIRST, FLAG_BORDER, FLAG_MOVING_INT, FLAG_MOVING_MCM, FLAG_NEW, GAMMA, ID, MCM_NORM,
-    NEXT_ID, NOISE, PPX, PPY, PX, PY, REPORTED, RX, RY, SINCE_FILTER, STEP, T_FILTER,
+    NEXT_ID, NOISE, PD_BG, PD_BG_CB, PD_BG_CR, PD_BG_Y, PD_CCB, PD_CCR, PD_CLASS, PD_CY, PD_LIVE, PD_NORM, PD_PX, PD_PY, PD_RX,
+    PD_RY, PD_SLOT, PD_T, PD_VMX, PD_VMY, PD_VOTE, PPX, PPY, PX, PY, REPORTED, RX, RY, SINCE_FILTER, STEP, T_FILTER,
     T_LAST, VALID, VI_COUNT, VIX, VIY, VMX, VMY,
 )  # fmt: skip
-from evclust.fixed.arith import FLOOR, NEAREST, alpha_step_nb, decay_apply_nb, decay_nb, decay_steps_nb
+from evclust.fixed.arith import FLOOR, NEAREST, alpha_increment_nb, alpha_step_nb, decay_apply_nb, decay_nb, decay_steps_nb
 from evclust.fixed.formats import DECAY_FRAC_BITS, DECAY_TABLE_BITS, GAMMA_MODES, NOISE_GATE_FRAC_BITS, SCALE_FRAC_BITS
 from evclust.jit import njit
 
@@ -51,9 +52,9 @@ SIGNALS = (
     C_MAX_EVCOUNT, C_V_FULL_BITS,
     C_SEEK_SCALE, C_MERGE, C_MERGE_SCALE, C_MERGE_V_TOL, C_MERGE_V_REL, C_SCALE_F, C_NOISE_GATE, C_NOISE_GATE_F,
     C_SUPPORT, C_SUPPORT_BITS, C_SUPPORT_WINDOW, C_R_MAX_RAW, C_VI_CAP,
-    C_MIN_STEP, C_MAX_STEP, C_FWD, C_FQ,
-) = range(86)  # fmt: skip
-N_CONSTANTS = 86
+    C_MIN_STEP, C_MAX_STEP, C_FWD, C_FQ, C_P_MAX, C_COLOUR_MAX, C_BG_MAX,
+) = range(89)  # fmt: skip
+N_CONSTANTS = 89
 
 
 def constant_vector(table, params, has_colour: bool) -> np.ndarray:
@@ -105,6 +106,8 @@ def constant_vector(table, params, has_colour: bool) -> np.ndarray:
     k[C_SUPPORT], k[C_SUPPORT_BITS], k[C_SUPPORT_WINDOW] = params.create_support, params.support_cell_bits, raw("support_window")
     k[C_R_MAX_RAW] = raw("r_max")
     k[C_VI_CAP] = params.interval_warmup()
+    # The tops of the formats a delayed commit saturates to (their bottoms are 0).
+    k[C_P_MAX], k[C_COLOUR_MAX], k[C_BG_MAX] = f["centre"].raw_max, f["colour"].raw_max, f["background"].raw_max
     return k
 
 
@@ -275,56 +278,99 @@ def _create(S, H, G, s, t, ex, ey, lum, cb, cr, k):
 
 
 @njit(cache=True, nogil=True)
-def _update(S, H, G, s, t, ex, ey, lum, cb, cr, k, table, palette, inv_ww, background_mask, log, ranges):
+def _increments(S, G, s, t, ex, ey, lum, cb, cr, k, palette, inv_ww, background_mask, log, ranges, row):
+    """Step 3, read half: the slot's update as increments from the state the event reads (in a
+    pipelined core, the table D events ago), into the delay-line row."""
     fp, fr = k[C_FP], k[C_FR]
-    # 3a. Activity: decay over (t - t_last) mod 2^32, then count the event.
-    _decay_slot(S, s, t, k, table)
-    S[s, ACT] = _store(S[s, ACT] + (np.int64(1) << k[C_FA]), 0, k[C_MAX_ACT], S_ACT, log, ranges)
+    row[PD_LIVE], row[PD_SLOT], row[PD_T] = 1, s, t
     # 3b. Centre: P += β_P (e - P), the event in P's format with all its fraction bits as guard.
     px, py = S[s, PX], S[s, PY]
-    px_new = alpha_step_nb(px, ex, k[C_B_POS], k[C_BB_POS], fp, FLOOR)
-    py_new = alpha_step_nb(py, ey, k[C_B_POS], k[C_BB_POS], fp, FLOOR)
-    # 3c. Size: R += β_R (g_R |e - P| - R), then the clamp.
+    row[PD_PX] = alpha_increment_nb(px, ex, k[C_B_POS], k[C_BB_POS], fp, FLOOR)
+    row[PD_PY] = alpha_increment_nb(py, ey, k[C_B_POS], k[C_BB_POS], fp, FLOOR)
+    # 3c. Size: R += β_R (g_R |e - P| - R); the clamp when committed.
     gx = (abs((ex << fp) - px) * k[C_GAIN]) >> (k[C_GAIN_F] + fp - fr)
     gy = (abs((ey << fp) - py) * k[C_GAIN]) >> (k[C_GAIN_F] + fp - fr)
     # No saturation: |e - P| < 2^coord and g_R < 2^bits(g_R), so the product fits size_target.
     gx = _seen(gx, S_SIZE_TARGET, ranges)
     gy = _seen(gy, S_SIZE_TARGET, ranges)
-    S[s, RX] = _seen(min(max(alpha_step_nb(S[s, RX], gx, k[C_B_SIZE], k[C_BB_SIZE], 0, FLOOR), k[C_R_MIN]), k[C_R_MAX]), S_HALF, ranges)
-    S[s, RY] = _seen(min(max(alpha_step_nb(S[s, RY], gy, k[C_B_SIZE], k[C_BB_SIZE], 0, FLOOR), k[C_R_MIN]), k[C_R_MAX]), S_HALF, ranges)
+    row[PD_RX] = alpha_increment_nb(S[s, RX], gx, k[C_B_SIZE], k[C_BB_SIZE], 0, FLOOR)
+    row[PD_RY] = alpha_increment_nb(S[s, RY], gy, k[C_B_SIZE], k[C_BB_SIZE], 0, FLOOR)
     # 3d. MCM: V += β_vm (γ (P_new - P) - V); the same filter on 1 gives the bias-correction weight.
-    step_x = _store(px_new - px, k[C_MIN_STEP], k[C_MAX_STEP], S_STEP, log, ranges)
-    step_y = _store(py_new - py, k[C_MIN_STEP], k[C_MAX_STEP], S_STEP, log, ranges)
+    step_x = _store(row[PD_PX], k[C_MIN_STEP], k[C_MAX_STEP], S_STEP, log, ranges)
+    step_y = _store(row[PD_PY], k[C_MIN_STEP], k[C_MAX_STEP], S_STEP, log, ranges)
     ux = _store(_align(S[s, GAMMA] * step_x, k[C_FG] + fp, k[C_FV]), k[C_MIN_V], k[C_MAX_V], S_MCM_IN, log, ranges)
     uy = _store(_align(S[s, GAMMA] * step_y, k[C_FG] + fp, k[C_FV]), k[C_MIN_V], k[C_MAX_V], S_MCM_IN, log, ranges)
     # Rounded to nearest: V's input is at V's own LSB, so a floor would drift one way.
-    S[s, VMX] = _seen(alpha_step_nb(S[s, VMX], ux, k[C_B_VM], k[C_BB_VM], 0, NEAREST), S_VM, ranges)
-    S[s, VMY] = _seen(alpha_step_nb(S[s, VMY], uy, k[C_B_VM], k[C_BB_VM], 0, NEAREST), S_VM, ranges)
+    row[PD_VMX] = alpha_increment_nb(S[s, VMX], ux, k[C_B_VM], k[C_BB_VM], 0, NEAREST)
+    row[PD_VMY] = alpha_increment_nb(S[s, VMY], uy, k[C_B_VM], k[C_BB_VM], 0, NEAREST)
     # w = 1 - α^n: the same filter on the integer 1, with all of w's fraction bits as guard.
-    S[s, MCM_NORM] = _seen(alpha_step_nb(S[s, MCM_NORM], 1, k[C_B_VM], k[C_BB_VM], k[C_FW], NEAREST), S_NORM, ranges)
-    S[s, PX] = _seen(px_new, S_CENTRE, ranges)
-    S[s, PY] = _seen(py_new, S_CENTRE, ranges)
+    row[PD_NORM] = alpha_increment_nb(S[s, MCM_NORM], 1, k[C_B_VM], k[C_BB_VM], k[C_FW], NEAREST)
     if k[C_COLOUR] != 0:
         # 3e. Colour: three α filters, the event's byte with all of C's fraction bits as guard.
         fc = k[C_FC]
-        S[s, CY] = _seen(alpha_step_nb(S[s, CY], lum, k[C_B_LUM], k[C_BB_LUM], fc, FLOOR), S_COLOUR, ranges)
-        S[s, CCB] = _seen(alpha_step_nb(S[s, CCB], cb, k[C_B_CHRO], k[C_BB_CHRO], fc, FLOOR), S_COLOUR, ranges)
-        S[s, CCR] = _seen(alpha_step_nb(S[s, CCR], cr, k[C_B_CHRO], k[C_BB_CHRO], fc, FLOOR), S_COLOUR, ranges)
-        # 3f. Palette vote.
+        row[PD_CY] = alpha_increment_nb(S[s, CY], lum, k[C_B_LUM], k[C_BB_LUM], fc, FLOOR)
+        row[PD_CCB] = alpha_increment_nb(S[s, CCB], cb, k[C_B_CHRO], k[C_BB_CHRO], fc, FLOOR)
+        row[PD_CCR] = alpha_increment_nb(S[s, CCR], cr, k[C_B_CHRO], k[C_BB_CHRO], fc, FLOOR)
+        # 3f. Palette vote: the event's class and weight.
         fb = k[C_FB]
         bg = (G[BG_Y] >> fb, G[BG_CB] >> fb, G[BG_CR] >> fb)
         if k[C_MIXING] != 0:
-            c = _mixing_palette(lum, cb, cr, bg, palette, inv_ww, background_mask, k)
+            row[PD_CLASS] = _mixing_palette(lum, cb, cr, bg, palette, inv_ww, background_mask, k)
         else:
-            c = _nearest_palette(lum, cb, cr, palette, k)
-        vote = palette_vote(lum, cb, cr, G, k)
-        # Saturating by design (SPEC §4): reaching the top halves every counter, so not an overflow.
-        H[s, c] = min(_seen(H[s, c] + vote, S_HIST, ranges), k[C_H_MAX])
-        if H[s, c] >= k[C_H_MAX]:
-            for j in range(H.shape[1]):
-                H[s, j] >>= 1
-    S[s, EV_COUNT] = _store(S[s, EV_COUNT] + 1, 0, k[C_MAX_EVCOUNT], S_EVCOUNT, log, ranges)
-    S[s, T_LAST] = t
+            row[PD_CLASS] = _nearest_palette(lum, cb, cr, palette, k)
+        row[PD_VOTE] = palette_vote(lum, cb, cr, G, k)
+
+
+@njit(cache=True, nogil=True)
+def _commit(S, H, G, row, k, table, log, ranges):
+    """Step 3, write half: the increments added to the slot as it is now, each saturated to its
+    format (with no delay the state read is the state now, and no saturation can act: the paper's
+    update exactly). 3a, the activity: decayed from the slot's own reference time, plus one (in
+    event order, so exact whatever the delay). Then the event's background-colour update."""
+    if row[PD_LIVE] != 0:
+        s, t = row[PD_SLOT], row[PD_T]
+        _decay_slot(S, s, t, k, table)
+        S[s, ACT] = _store(S[s, ACT] + (np.int64(1) << k[C_FA]), 0, k[C_MAX_ACT], S_ACT, log, ranges)
+        S[s, RX] = _seen(min(max(S[s, RX] + row[PD_RX], k[C_R_MIN]), k[C_R_MAX]), S_HALF, ranges)
+        S[s, RY] = _seen(min(max(S[s, RY] + row[PD_RY], k[C_R_MIN]), k[C_R_MAX]), S_HALF, ranges)
+        S[s, VMX] = _store(S[s, VMX] + row[PD_VMX], k[C_MIN_V], k[C_MAX_V], S_VM, log, ranges)
+        S[s, VMY] = _store(S[s, VMY] + row[PD_VMY], k[C_MIN_V], k[C_MAX_V], S_VM, log, ranges)
+        S[s, MCM_NORM] = _store(S[s, MCM_NORM] + row[PD_NORM], 0, np.int64(1) << k[C_FW], S_NORM, log, ranges)  # w <= 1
+        S[s, PX] = _store(S[s, PX] + row[PD_PX], 0, k[C_P_MAX], S_CENTRE, log, ranges)
+        S[s, PY] = _store(S[s, PY] + row[PD_PY], 0, k[C_P_MAX], S_CENTRE, log, ranges)
+        if k[C_COLOUR] != 0:
+            S[s, CY] = _store(S[s, CY] + row[PD_CY], 0, k[C_COLOUR_MAX], S_COLOUR, log, ranges)
+            S[s, CCB] = _store(S[s, CCB] + row[PD_CCB], 0, k[C_COLOUR_MAX], S_COLOUR, log, ranges)
+            S[s, CCR] = _store(S[s, CCR] + row[PD_CCR], 0, k[C_COLOUR_MAX], S_COLOUR, log, ranges)
+            # Saturating by design (SPEC §4): reaching the top halves every counter, so not an overflow.
+            c = row[PD_CLASS]
+            H[s, c] = min(_seen(H[s, c] + row[PD_VOTE], S_HIST, ranges), k[C_H_MAX])
+            if H[s, c] >= k[C_H_MAX]:
+                for j in range(H.shape[1]):
+                    H[s, j] >>= 1
+        S[s, EV_COUNT] = _store(S[s, EV_COUNT] + 1, 0, k[C_MAX_EVCOUNT], S_EVCOUNT, log, ranges)
+        row[PD_LIVE] = 0
+    if row[PD_BG] != 0:
+        G[BG_Y] = _store(G[BG_Y] + row[PD_BG_Y], 0, k[C_BG_MAX], S_BG, log, ranges)
+        G[BG_CB] = _store(G[BG_CB] + row[PD_BG_CB], 0, k[C_BG_MAX], S_BG, log, ranges)
+        G[BG_CR] = _store(G[BG_CR] + row[PD_BG_CR], 0, k[C_BG_MAX], S_BG, log, ranges)
+        row[PD_BG] = 0
+
+
+@njit(cache=True, nogil=True)
+def _drain(S, H, G, line, k, table, log, ranges):
+    """Commit every event still in the delay line, oldest first (before a filter step)."""
+    n = line.shape[0]
+    for m in range(n):
+        _commit(S, H, G, line[(G[EVENTS] + 1 + m) % n], k, table, log, ranges)
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _cancel(line, s):
+    """A slot taken by a new cluster: the updates still in flight for its old cluster are void."""
+    for r in range(line.shape[0]):
+        if line[r, PD_LIVE] != 0 and line[r, PD_SLOT] == s:
+            line[r, PD_LIVE] = 0
 
 
 @njit(cache=True, nogil=True)
@@ -555,13 +601,15 @@ def _supported(support, seen, cx, cy, t, window):
 
 
 @njit(cache=True, nogil=True)
-def run_events(S, H, G, k, table, gains, palette, inv_ww, background_mask, support, seen, t_us, xs, ys, lums, cbs, crs, out, steps,
+def run_events(S, H, G, k, table, gains, palette, inv_ww, background_mask, support, seen, line, t_us, xs, ys, lums, cbs, crs, out, steps,
                log, ranges, trace=None):  # fmt: skip
     """Feed events; write records into `out` and each filter step's time (the 32-bit
     datapath's clock wraps, the step keeps the whole event time) into `steps`; with `trace` (an int64 array), write each event's
     action << 16 | slot there (a None trace compiles without it). `support` holds each map
-    cell's latest event time (32-bit), `seen` whether it has one."""
+    cell's latest event time (32-bit), `seen` whether it has one; `line` is the update delay line
+    (D + 1 rows of layout.PENDING_COLUMNS), as in the float model."""
     n_out = 0
+    delay = line.shape[0] - 1
     first_step = G[STEP]
     fb = k[C_FB]
     bits = k[C_SUPPORT_BITS]
@@ -574,6 +622,8 @@ def run_events(S, H, G, k, table, gains, palette, inv_ww, background_mask, suppo
             G[T_FIRST] = t
             G[TAU_PHASE] = 0  # τ boundaries count from the first event, as in the float model
         G[EVENTS] += 1
+        row = line[G[EVENTS] % (delay + 1)]  # it holds event n - D - 1: its turn to commit
+        _commit(S, H, G, row, k, table, log, ranges)
         s = _seek(S, ex << k[C_FP], ey << k[C_FP], k)
         updated_reported = False
         action = TRACE_UPDATE
@@ -585,13 +635,14 @@ def run_events(S, H, G, k, table, gains, palette, inv_ww, background_mask, suppo
             evicted_before = G[EVICTED]
             s = _slot_for_new(S, G, t, k, table)
             if s >= 0:
+                _cancel(line, s)
                 _create(S, H, G, s, t, ex, ey, lum, cb, cr, k)
                 action = TRACE_EVICT if G[EVICTED] > evicted_before else TRACE_CREATE
             else:
                 G[DROPPED] += 1
                 action = TRACE_DROP
         else:
-            _update(S, H, G, s, t, ex, ey, lum, cb, cr, k, table, palette, inv_ww, background_mask, log, ranges)
+            _increments(S, G, s, t, ex, ey, lum, cb, cr, k, palette, inv_ww, background_mask, log, ranges, row)
             updated_reported = S[s, REPORTED] != 0
         if trace is not None:
             trace[i] = (action << 16) | max(s, 0)
@@ -602,14 +653,18 @@ def run_events(S, H, G, k, table, gains, palette, inv_ww, background_mask, suppo
             _decay_background(G, t, k, table)
             G[BG_ACT] = _store(G[BG_ACT] + (np.int64(1) << k[C_FA]), 0, k[C_MAX_ACT], S_ACT, log, ranges)
         if k[C_COLOUR] != 0 and k[C_BG_FIXED] == 0 and not updated_reported:
-            G[BG_Y] = _seen(alpha_step_nb(G[BG_Y], lum, k[C_B_BG], k[C_BB_BG], fb, FLOOR), S_BG, ranges)
-            G[BG_CB] = _seen(alpha_step_nb(G[BG_CB], cb, k[C_B_BG], k[C_BB_BG], fb, FLOOR), S_BG, ranges)
-            G[BG_CR] = _seen(alpha_step_nb(G[BG_CR], cr, k[C_B_BG], k[C_BB_BG], fb, FLOOR), S_BG, ranges)
+            row[PD_BG] = 1
+            row[PD_BG_Y] = alpha_increment_nb(G[BG_Y], lum, k[C_B_BG], k[C_BB_BG], fb, FLOOR)
+            row[PD_BG_CB] = alpha_increment_nb(G[BG_CB], cb, k[C_B_BG], k[C_BB_BG], fb, FLOOR)
+            row[PD_BG_CR] = alpha_increment_nb(G[BG_CR], cr, k[C_B_BG], k[C_BB_BG], fb, FLOOR)
+        if delay == 0:
+            _commit(S, H, G, row, k, table, log, ranges)
         G[SINCE_FILTER] += 1
         if G[SINCE_FILTER] >= k[C_EVERY]:
             G[SINCE_FILTER] = 0
             steps[G[STEP] - first_step] = t_us[i]
             first = n_out
+            _drain(S, H, G, line, k, table, log, ranges)
             n_out = _filter_step(S, H, G, t, k, table, gains, palette, inv_ww, background_mask, out, n_out, log, ranges)
             for r in range(first, n_out):  # the datapath counts 32 bits; a record keeps the event's whole time
                 out[r, 0] = t_us[i]

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from evclust.clusterer.layout import BG_CB, BG_CR, BG_Y, RECORD_COLUMNS, SLOT_COLUMNS, STEP, run_stats, support_shape
+from evclust.clusterer.layout import BG_CB, BG_CR, BG_Y, PENDING_COLUMNS, RECORD_COLUMNS, SLOT_COLUMNS, STEP, run_stats, support_shape
 from evclust.clusterer.params import ClustererParams
 from evclust.fixed import fixed_model
 from evclust.fixed.formats import FormatTable, build_formats, decay_table
@@ -52,6 +52,7 @@ class FixedClusterer:
         self.globals[[BG_Y, BG_CB, BG_CR]] = [int(round(v * 2**fb)) for v in bg]
         self.support = np.zeros(support_shape(width, height, params.support_cell_bits), dtype=np.int64)
         self.seen = np.zeros(self.support.shape, dtype=np.bool_)
+        self.delay_line = np.zeros((params.update_delay + 1, len(PENDING_COLUMNS)), dtype=np.int64)  # the events in flight
         self.inv_ww = np.zeros(len(params.palette), dtype=np.int64)
         fixed_model.refresh_mixing(self.globals, self.palette, self.inv_ww, self.k)
         self.overflow = np.zeros(len(fixed_model.SIGNALS), dtype=np.int64)
@@ -71,7 +72,7 @@ class FixedClusterer:
         first = self.globals[STEP]
         n = fixed_model.run_events(
             self.slots, self.hist, self.globals, self.k, self.decay, self.gains, self.palette, self.inv_ww, self.background_mask,
-            self.support, self.seen, events["t"], events["x"], events["y"], events["Y"], events["Cb"], events["Cr"], out, steps,
+            self.support, self.seen, self.delay_line, events["t"], events["x"], events["y"], events["Y"], events["Cb"], events["Cr"], out, steps,
             self.overflow, self.ranges, trace,
         )  # fmt: skip
         self.steps = steps[: int(self.globals[STEP] - first)]

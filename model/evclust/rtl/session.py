@@ -23,6 +23,7 @@ from evclust.clusterer.layout import OBJECT_RECORD_COLUMNS
 from evclust.errors import EvclustError
 from evclust.fixed.formats import verilog_header
 from evclust.fixed.model import FixedClusterer
+from evclust.rtl.sources import require_rtl_semantics
 from evclust.vectors.pack import event_words, object_rows, record_rows
 
 SIMULATOR = "verilator"  # the fast one; `make cosim SIM=icarus` covers the other
@@ -39,6 +40,7 @@ class RtlClusterer:
 
         if not has_colour:
             raise EvclustError("--model rtl: the RTL clusters colour events; this stream has none (use --model fixed)")
+        require_rtl_semantics(params)
         # The fixed model gives the build: its formats table is the RTL's header.
         self.table = FixedClusterer(params, width, height, t_frame_us).table
         self.params = params.resolved(t_frame_us)

@@ -21,8 +21,16 @@ def require_repository() -> None:
         raise EvclustError(f"{missing[0]}: the RTL is not here; run from a clone of the evclust repository (pip install -e .)")
 
 
+def require_rtl_semantics(params) -> None:
+    """The RTL has the sequential update only: refuse a parameter set with pipeline semantics."""
+    if params.update_delay:
+        raise EvclustError(f"clusterer: update_delay = {params.update_delay}, but the RTL commits every update before the next event "
+                           "reads the table (update_delay = 0); the float and fixed models run the delayed update")  # fmt: skip
+
+
 def params_header(params, width: int, height: int, t_frame_us: float, **formats) -> str:
     """evclust_params.vh for a parameter set on a sensor (`formats`: build_formats's options)."""
     from evclust.fixed.formats import build_formats, verilog_header
 
+    require_rtl_semantics(params)
     return verilog_header(build_formats(params, width, height, t_frame_us, **formats))
