@@ -313,12 +313,12 @@ module evclust_core #(
     wire [CENTRE_W-1:0]             ppx_a = row_a[ROW_PPX +: CENTRE_W], ppx_b = row_b[ROW_PPX +: CENTRE_W];
     wire [CENTRE_W-1:0]             ppy_a = row_a[ROW_PPY +: CENTRE_W], ppy_b = row_b[ROW_PPY +: CENTRE_W];
     wire [ACTIVITY_W-1:0]           act_a = row_a[ROW_ACT +: ACTIVITY_W], act_b = row_b[ROW_ACT +: ACTIVITY_W];
-    wire [DECAY_RESIDUAL_W-1:0]     residual_a = row_a[ROW_RESIDUAL +: DECAY_RESIDUAL_W];
-    wire [T_LAST_W-1:0]             t_last_a = row_a[ROW_T_LAST +: T_LAST_W];
+    wire [DECAY_RESIDUAL_W-1:0]     residual_a = row_a[ROW_RESIDUAL +: DECAY_RESIDUAL_W], residual_b = row_b[ROW_RESIDUAL +: DECAY_RESIDUAL_W];
+    wire [T_LAST_W-1:0]             t_last_a = row_a[ROW_T_LAST +: T_LAST_W], t_last_b = row_b[ROW_T_LAST +: T_LAST_W];
     wire [GAMMA_W-1:0]              gamma_a = row_a[ROW_GAMMA +: GAMMA_W];
     wire [V_MCM_W-1:0]              vmx_a = row_a[ROW_VMX +: V_MCM_W], vmx_b = row_b[ROW_VMX +: V_MCM_W];
     wire [V_MCM_W-1:0]              vmy_a = row_a[ROW_VMY +: V_MCM_W], vmy_b = row_b[ROW_VMY +: V_MCM_W];
-    wire [MCM_NORM_W-1:0]           norm_a = row_a[ROW_NORM +: MCM_NORM_W];
+    wire [MCM_NORM_W-1:0]           norm_a = row_a[ROW_NORM +: MCM_NORM_W], norm_b = row_b[ROW_NORM +: MCM_NORM_W];
     wire [EVENTS_IN_INTERVAL_W-1:0] ev_count_a = row_a[ROW_EV_COUNT +: EVENTS_IN_INTERVAL_W], ev_count_b = row_b[ROW_EV_COUNT +: EVENTS_IN_INTERVAL_W];
     wire [COLOUR_W-1:0]             col_y_a = row_a[ROW_COL_Y +: COLOUR_W], col_y_b = row_b[ROW_COL_Y +: COLOUR_W];
     wire [COLOUR_W-1:0]             col_cb_a = row_a[ROW_COL_CB +: COLOUR_W], col_cb_b = row_b[ROW_COL_CB +: COLOUR_W];
@@ -444,9 +444,9 @@ module evclust_core #(
     wire [ACTIVITY_W-1:0] dec_a;
     wire [DECAY_RESIDUAL_W-1:0] dec_residual;
     evclust_decay #(.ACTIVITY_BITS(ACTIVITY_W), .DT_BITS(DT_W), .RESIDUAL_BITS(DECAY_RESIDUAL_W), .INV_T_HALF_BITS(INV_T_HALF_W)) decay_unit (
-        .activity(act_a),
-        .dt(e_t - t_last_a),
-        .residual(residual_a),
+        .activity(commit_reads ? act_b : act_a),
+        .dt(commit_reads ? c_t - t_last_b : e_t - t_last_a),
+        .residual(commit_reads ? residual_b : residual_a),
         .use_residual(state != ST_SCAN),
         .inv_t_half(K_INV_T_HALF),
         .decayed(dec_a),
@@ -509,7 +509,7 @@ module evclust_core #(
     );
 
     reg signed [63:0] u_ox, u_oy;
-    reg signed [63:0] ex, ey, u_px, u_py, u_px_new, u_py_new, u_gx, u_gy, u_rx, u_ry, u_step_x, u_step_y;
+    reg signed [63:0] ex, ey, u_px, u_py, u_px_new, u_py_new, u_gx, u_gy, u_rx, u_ry, u_rx_step, u_ry_step, u_step_x, u_step_y;
     reg signed [63:0] u_ux, u_uy, u_vmx, u_vmy, u_norm, u_act, u_cy, u_ccb, u_ccr, u_evc, u_gamma;
     // *_full: a value before its format's saturation (the status counters compare it too).
     reg signed [63:0] u_act_full, u_gx_full, u_gy_full, u_step_x_full, u_step_y_full, u_ux_full, u_uy_full, u_evc_full;
@@ -534,8 +534,10 @@ module evclust_core #(
         u_gy_full = (u64({{(64 - OFFSET_W){1'b0}}, u_oy[OFFSET_W-2:0]}) * K_GAIN) >>> (SIZE_GAIN_FRAC + FP - FR);
         u_gx = u_gx_full;  // < 2^SIZE_TARGET_W by construction: |e - P| < 2^coord, g_R < 2^bits(g_R)
         u_gy = u_gy_full;
-        u_rx = saturate(alpha_step(u64({{(63 - HALF_SIZE_W){1'b0}}, rx[e_slot]}), u_gx, K_B_SIZE, BETA_SIZE_FRAC, 0, 1'b0), K_R_MIN, K_R_MAX);
-        u_ry = saturate(alpha_step(u64({{(63 - HALF_SIZE_W){1'b0}}, ry[e_slot]}), u_gy, K_B_SIZE, BETA_SIZE_FRAC, 0, 1'b0), K_R_MIN, K_R_MAX);
+        u_rx_step = alpha_step(u64({{(63 - HALF_SIZE_W){1'b0}}, rx[e_slot]}), u_gx, K_B_SIZE, BETA_SIZE_FRAC, 0, 1'b0);
+        u_ry_step = alpha_step(u64({{(63 - HALF_SIZE_W){1'b0}}, ry[e_slot]}), u_gy, K_B_SIZE, BETA_SIZE_FRAC, 0, 1'b0);
+        u_rx = saturate(u_rx_step, K_R_MIN, K_R_MAX);
+        u_ry = saturate(u_ry_step, K_R_MIN, K_R_MAX);
         // 3d. MCM velocity and its bias-correction weight.
         u_gamma = u64({{(63 - GAMMA_W){1'b0}}, gamma_a});
         u_step_x_full = u_px_new - u_px;
@@ -564,6 +566,77 @@ module evclust_core #(
                 u_hist[c] = u_hist[c] >>> 1;
         u_evc_full = u64({{(63 - EVENTS_IN_INTERVAL_W){1'b0}}, ev_count_a}) + 1;
         u_evc = saturate(u_evc_full, 0, MAX_EVCOUNT);
+    end
+
+    // ---------------------------------------------------------------- the commit (pipeline semantics)
+    // UPDATE_DELAY = 1 (model: _increments, _commit; docs/DESIGN.md, "Pipeline semantics"): EXEC
+    // keeps its event's update as increments from the state it read, and they are added to the
+    // slot as it then is when the next event finishes (or, before a filter step, in PHASE). So
+    // the next event reads the table without them, and the sums leave EXEC's recurrence. The
+    // commit reads its slot's row at port B. UPDATE_DELAY = 0: EXEC writes the update itself.
+    localparam integer DP_W = CENTRE_W + 1;  // each increment: its field's width and a sign
+    localparam integer DR_W = (SIZE_TARGET_W > HALF_SIZE_W ? SIZE_TARGET_W : HALF_SIZE_W) + 1;
+    localparam integer DV_W = V_MCM_W + 1, DN_W = MCM_NORM_W + 1, DC_W = COLOUR_W + 1, DB_W = BACKGROUND_W + 1;
+    localparam signed [63:0] MAX_P = (64'sd1 <<< CENTRE_W) - 1, MAX_C = (64'sd1 <<< COLOUR_W) - 1, MAX_B = (64'sd1 <<< BACKGROUND_W) - 1;
+    localparam signed [63:0] ONE_W = 64'sd1 <<< FW;  // w = 1 - alpha^n never passes 1
+    reg                    c_live, c_bg_live;  // a slot update, a background update in flight
+    reg [SLOT_W-1:0]       c_slot;
+    reg [EV_T_W-1:0]       c_t;
+    reg signed [DP_W-1:0]  c_dpx, c_dpy;
+    reg signed [DR_W-1:0]  c_drx, c_dry;
+    reg signed [DV_W-1:0]  c_dvmx, c_dvmy;
+    reg signed [DN_W-1:0]  c_dnorm;
+    reg signed [DC_W-1:0]  c_dcy, c_dccb, c_dccr;
+    reg [CLASS_W-1:0]      c_class;
+    reg [VOTE_W-1:0]       c_vote;
+    reg signed [DB_W-1:0]  c_dbg_y, c_dbg_cb, c_dbg_cr;
+    reg                    creating;  // a creation's second cycle: the first committed the event before
+    reg [SLOT_W-1:0]       creating_slot;
+    wire commit_moment;  // the event before commits now (the decision logic below)
+    wire commit_reads = UPDATE_DELAY != 0 && (state == ST_EXEC || state == ST_EVICT || state == ST_PHASE);
+    // The increments of this event (EXEC), each the alpha step minus the state it read.
+    wire signed [63:0] i_px = u_px_new - u_px, i_py = u_py_new - u_py;
+    wire signed [63:0] i_rx = u_rx_step - u64({{(63 - HALF_SIZE_W){1'b0}}, rx[e_slot]});
+    wire signed [63:0] i_ry = u_ry_step - u64({{(63 - HALF_SIZE_W){1'b0}}, ry[e_slot]});
+    wire signed [63:0] i_vmx = u_vmx - $signed({{(64 - V_MCM_W){vmx_a[V_MCM_W-1]}}, vmx_a});
+    wire signed [63:0] i_vmy = u_vmy - $signed({{(64 - V_MCM_W){vmy_a[V_MCM_W-1]}}, vmy_a});
+    wire signed [63:0] i_norm = u_norm - u64({{(63 - MCM_NORM_W){1'b0}}, norm_a});
+    wire signed [63:0] i_cy = u_cy - u64({{(63 - COLOUR_W){1'b0}}, col_y_a});
+    wire signed [63:0] i_ccb = u_ccb - u64({{(63 - COLOUR_W){1'b0}}, col_cb_a});
+    wire signed [63:0] i_ccr = u_ccr - u64({{(63 - COLOUR_W){1'b0}}, col_cr_a});
+    // The committed slot: the increments added to its state now, each saturated to its format.
+    reg signed [63:0] cm_px, cm_py, cm_rx, cm_ry, cm_vmx_full, cm_vmy_full, cm_vmx, cm_vmy, cm_norm, cm_cy, cm_ccb, cm_ccr;
+    reg signed [63:0] cm_act_full, cm_act, cm_evc_full, cm_evc, cm_bg_y, cm_bg_cb, cm_bg_cr;
+    reg signed [63:0] cm_hist [0:P-1];
+    reg               cm_halve;
+    integer cc;
+    always @* begin
+        cm_px = saturate(u64({{(63 - CENTRE_W){1'b0}}, px[c_slot]}) + $signed({{(64 - DP_W){c_dpx[DP_W-1]}}, c_dpx}), 0, MAX_P);
+        cm_py = saturate(u64({{(63 - CENTRE_W){1'b0}}, py[c_slot]}) + $signed({{(64 - DP_W){c_dpy[DP_W-1]}}, c_dpy}), 0, MAX_P);
+        cm_rx = saturate(u64({{(63 - HALF_SIZE_W){1'b0}}, rx[c_slot]}) + $signed({{(64 - DR_W){c_drx[DR_W-1]}}, c_drx}), K_R_MIN, K_R_MAX);
+        cm_ry = saturate(u64({{(63 - HALF_SIZE_W){1'b0}}, ry[c_slot]}) + $signed({{(64 - DR_W){c_dry[DR_W-1]}}, c_dry}), K_R_MIN, K_R_MAX);
+        cm_vmx_full = $signed({{(64 - V_MCM_W){vmx_b[V_MCM_W-1]}}, vmx_b}) + $signed({{(64 - DV_W){c_dvmx[DV_W-1]}}, c_dvmx});
+        cm_vmy_full = $signed({{(64 - V_MCM_W){vmy_b[V_MCM_W-1]}}, vmy_b}) + $signed({{(64 - DV_W){c_dvmy[DV_W-1]}}, c_dvmy});
+        cm_vmx = saturate(cm_vmx_full, MIN_V, MAX_V);
+        cm_vmy = saturate(cm_vmy_full, MIN_V, MAX_V);
+        cm_norm = saturate(u64({{(63 - MCM_NORM_W){1'b0}}, norm_b}) + $signed({{(64 - DN_W){c_dnorm[DN_W-1]}}, c_dnorm}), 0, ONE_W);
+        cm_cy = saturate(u64({{(63 - COLOUR_W){1'b0}}, col_y_b}) + $signed({{(64 - DC_W){c_dcy[DC_W-1]}}, c_dcy}), 0, MAX_C);
+        cm_ccb = saturate(u64({{(63 - COLOUR_W){1'b0}}, col_cb_b}) + $signed({{(64 - DC_W){c_dccb[DC_W-1]}}, c_dccb}), 0, MAX_C);
+        cm_ccr = saturate(u64({{(63 - COLOUR_W){1'b0}}, col_cr_b}) + $signed({{(64 - DC_W){c_dccr[DC_W-1]}}, c_dccr}), 0, MAX_C);
+        cm_act_full = a_decayed + ONE_A;  // the decay unit reads port B while committing
+        cm_act = saturate(cm_act_full, 0, MAX_ACT);
+        cm_evc_full = u64({{(63 - EVENTS_IN_INTERVAL_W){1'b0}}, ev_count_b}) + 1;
+        cm_evc = saturate(cm_evc_full, 0, MAX_EVCOUNT);
+        for (cc = 0; cc < P; cc = cc + 1)
+            cm_hist[cc] = u64({{(63 - HIST_W){1'b0}}, hist_b[cc*HIST_W +: HIST_W]});
+        cm_hist[c_class] = min64(cm_hist[c_class] + u64({{(63 - VOTE_W){1'b0}}, c_vote}), H_MAX);
+        cm_halve = cm_hist[c_class] >= H_MAX;
+        for (cc = 0; cc < P; cc = cc + 1)
+            if (cm_halve)
+                cm_hist[cc] = cm_hist[cc] >>> 1;
+        cm_bg_y = saturate(u64({{(63 - BACKGROUND_W){1'b0}}, bg_y}) + $signed({{(64 - DB_W){c_dbg_y[DB_W-1]}}, c_dbg_y}), 0, MAX_B);
+        cm_bg_cb = saturate(u64({{(63 - BACKGROUND_W){1'b0}}, bg_cb}) + $signed({{(64 - DB_W){c_dbg_cb[DB_W-1]}}, c_dbg_cb}), 0, MAX_B);
+        cm_bg_cr = saturate(u64({{(63 - BACKGROUND_W){1'b0}}, bg_cr}) + $signed({{(64 - DB_W){c_dbg_cr[DB_W-1]}}, c_dbg_cr}), 0, MAX_B);
     end
 
     // ---------------------------------------------------------------- the filter sweep
@@ -934,18 +1007,27 @@ module evclust_core #(
     wire init_done = index >= LAST_INIT && (CREATE_SUPPORT == 0 || init_cell == LAST_CELL);
     wire scan_weaker = dec_a < weakest_a || index == {SWEEP_W{1'b0}};
     wire evict = u64({{(63 - ACTIVITY_W){1'b0}}, weakest_a}) < K_A_VALID;
-    reg              do_update, do_create, finish;
+    reg              do_update, do_create, finish, split;
     reg [SLOT_W-1:0] create_slot;
     reg [2:0]        action;
     reg [SLOT_W-1:0] action_slot;
+    // split (UPDATE_DELAY = 1): a creation while the event before is still to commit takes two
+    // cycles, the commit in the first (one write port), the creation, as decided, in the second.
     always @* begin
         do_update = 1'b0;
         do_create = 1'b0;
         finish = 1'b0;
+        split = 1'b0;
         create_slot = e_free_slot;
         action = TRACE_UPDATE;
         action_slot = e_slot;
-        if (state == ST_EXEC) begin
+        if (state == ST_EXEC && creating) begin
+            do_create = 1'b1;
+            finish = 1'b1;
+            create_slot = creating_slot;
+            action = TRACE_CREATE;
+            action_slot = creating_slot;
+        end else if (state == ST_EXEC) begin
             if (e_hit) begin
                 do_update = 1'b1;
                 finish = 1'b1;
@@ -954,23 +1036,34 @@ module evclust_core #(
                 action = TRACE_UNSUPPORTED;
                 action_slot = {SLOT_W{1'b0}};
             end else if (e_free) begin
-                do_create = 1'b1;
-                finish = 1'b1;
+                split = UPDATE_DELAY != 0 && c_live;
+                do_create = !split;
+                finish = !split;
                 action = TRACE_CREATE;
                 action_slot = e_free_slot;
             end
         end else if (state == ST_EVICT) begin
-            finish = 1'b1;
-            do_create = evict;
+            // (an eviction of the slot the event before updates voids that update: no split)
+            split = UPDATE_DELAY != 0 && c_live && !creating && evict && weakest != c_slot;
+            finish = !split;
+            do_create = evict && !split;
             create_slot = weakest;
             action = evict ? TRACE_EVICT : TRACE_DROP;
             action_slot = evict ? weakest : {SLOT_W{1'b0}};
         end
     end
+    assign commit_moment = UPDATE_DELAY != 0 && (finish || split || state == ST_PHASE);
+    wire do_commit = commit_moment && c_live && !(do_create && create_slot == c_slot);
+    // (a split's background update waits for its second cycle: the creation's own background step reads the background without it)
+    wire do_commit_bg = commit_moment && c_bg_live && !split;
+    wire upd_write = do_update && UPDATE_DELAY == 0;  // EXEC writes its update itself
     // The background learns from every event that is not a reported object's.
     wire signed [63:0] bg_y_next = alpha_step(u64({{(63 - BACKGROUND_W){1'b0}}, bg_y}), u64({{(63 - CW){1'b0}}, e_lum}), K_B_BG, BETA_BG_FRAC, FB, 1'b0);
     wire signed [63:0] bg_cb_next = alpha_step(u64({{(63 - BACKGROUND_W){1'b0}}, bg_cb}), u64({{(63 - CW){1'b0}}, e_cb}), K_B_BG, BETA_BG_FRAC, FB, 1'b0);
     wire signed [63:0] bg_cr_next = alpha_step(u64({{(63 - BACKGROUND_W){1'b0}}, bg_cr}), u64({{(63 - CW){1'b0}}, e_cr}), K_B_BG, BETA_BG_FRAC, FB, 1'b0);
+    wire signed [63:0] bg_y_d = bg_y_next - u64({{(63 - BACKGROUND_W){1'b0}}, bg_y});  // its increments (UPDATE_DELAY = 1)
+    wire signed [63:0] bg_cb_d = bg_cb_next - u64({{(63 - BACKGROUND_W){1'b0}}, bg_cb});
+    wire signed [63:0] bg_cr_d = bg_cr_next - u64({{(63 - BACKGROUND_W){1'b0}}, bg_cr});
     wire signed [63:0] gamma_new = gamma_from_activity(ONE_A, gamma_mode, K_GAMMA_GLOBAL, K_GPA);
     wire sweep_due = {{(32 - EVERY_W){1'b0}}, since_filter} + 32'd1 >= {{(32 - EVERY_W){1'b0}}, K_FILTER_EVERY};
     // An update of a reported cluster is the object's colour, not the background's.
@@ -985,10 +1078,10 @@ module evclust_core #(
     // At most one slot's size is written per cycle (an update, a creation or a merge, each in
     // its own state), so one multiplier per product serves them all, and the interval
     // velocity changes only at a filter step's stage 0 (a merge copies the survivor's product).
-    wire                   size_write = do_update || do_create || m_write;
-    wire [SLOT_W-1:0]      size_slot = m_write ? k : (do_update ? e_slot : create_slot);
-    wire [HALF_SIZE_W-1:0] size_rx = m_write ? m_rx[HALF_SIZE_W-1:0] : (do_update ? u_rx[HALF_SIZE_W-1:0] : K_R_INIT);
-    wire [HALF_SIZE_W-1:0] size_ry = m_write ? m_ry[HALF_SIZE_W-1:0] : (do_update ? u_ry[HALF_SIZE_W-1:0] : K_R_INIT);
+    wire                   size_write = upd_write || do_commit || do_create || m_write;
+    wire [SLOT_W-1:0]      size_slot = m_write ? k : (do_commit ? c_slot : (upd_write ? e_slot : create_slot));
+    wire [HALF_SIZE_W-1:0] size_rx = m_write ? m_rx[HALF_SIZE_W-1:0] : (do_commit ? cm_rx[HALF_SIZE_W-1:0] : (upd_write ? u_rx[HALF_SIZE_W-1:0] : K_R_INIT));
+    wire [HALF_SIZE_W-1:0] size_ry = m_write ? m_ry[HALF_SIZE_W-1:0] : (do_commit ? cm_ry[HALF_SIZE_W-1:0] : (upd_write ? u_ry[HALF_SIZE_W-1:0] : K_R_INIT));
     wire [HALF_SIZE_W-1:0] size_r = size_rx > size_ry ? size_rx : size_ry;
     wire signed [63:0]     d_scaled_seek = r64(size_r) * K_SEEK_SCALE;
     wire signed [63:0]     d_reach_x = reach(size_rx, K_SEEK, d_scaled_seek);
@@ -1003,7 +1096,7 @@ module evclust_core #(
     // event's seek tests again.
     wire b_takes = state == ST_IDLE || (finish && !sweep_due);
     wire a_advance = a_valid && b_takes;
-    wire [SLOT_W-1:0] written_slot = do_update ? e_slot : create_slot;
+    wire [SLOT_W-1:0] written_slot = UPDATE_DELAY == 0 ? (do_update ? e_slot : create_slot) : (do_create ? create_slot : c_slot);
     assign ev_ready = !dp_rst && (!a_valid || a_advance);  // no handshake during a reset or clear
 
     // ---------------------------------------------------------------- the FSM's next state
@@ -1015,7 +1108,7 @@ module evclust_core #(
         state_next = state;
         case (state)
             ST_INIT: if (init_done) state_next = ST_IDLE;
-            ST_EXEC: if (!finish) state_next = ST_SCAN;
+            ST_EXEC: if (!finish && !split) state_next = ST_SCAN;
             ST_SCAN: if (scan_last) state_next = ST_EVICT;
             ST_SWEEP: if (sweep_merge) state_next = ST_MERGE;
                       else if (sweep_advance && index == LAST_SWEEP) state_next = ST_IDLE;
@@ -1056,24 +1149,27 @@ module evclust_core #(
         inc[COUNT_EVENTS * COUNTER_INC_W +: 2] = {1'b0, ev_valid && ev_ready};
         inc[COUNT_UPDATES * COUNTER_INC_W +: 2] = {1'b0, do_update};
         inc[COUNT_CREATES * COUNTER_INC_W +: 2] = {1'b0, do_create};
-        inc[COUNT_EVICTIONS * COUNTER_INC_W +: 2] = {1'b0, state == ST_EVICT && evict};
-        inc[COUNT_DROPS * COUNTER_INC_W +: 2] = {1'b0, state == ST_EVICT && !evict};
+        inc[COUNT_EVICTIONS * COUNTER_INC_W +: 2] = {1'b0, state == ST_EVICT && finish && evict};
+        inc[COUNT_DROPS * COUNTER_INC_W +: 2] = {1'b0, state == ST_EVICT && finish && !evict};
         inc[COUNT_UNSUPPORTED * COUNTER_INC_W +: 2] = {1'b0, finish && action == TRACE_UNSUPPORTED};
         inc[COUNT_EXPIRIES * COUNTER_INC_W +: 2] = {1'b0, sweep_slot && f_expire};
         inc[COUNT_EXITS * COUNTER_INC_W +: 2] = {1'b0, tail_out && f_exit};
         inc[COUNT_MERGES * COUNTER_INC_W +: 2] = {1'b0, m_write};
         inc[COUNT_RECORDS * COUNTER_INC_W +: 2] = {1'b0, tail_out && !f_exit && f_report};
-        inc[COUNT_SAT_ACTIVITY * COUNTER_INC_W +: 2] = (do_update ? outside(u_act_full, 0, MAX_ACT) : 2'd0)
+        inc[COUNT_SAT_ACTIVITY * COUNTER_INC_W +: 2] = (upd_write ? outside(u_act_full, 0, MAX_ACT) : 2'd0)
+            + (do_commit ? outside(cm_act_full, 0, MAX_ACT) : 2'd0)
             + (bg_counts ? outside(bg_counted_full, 0, MAX_ACT) : 2'd0)
             + (m_write ? outside(m_weight, 0, MAX_ACT) : 2'd0);
         inc[COUNT_SAT_CENTRE_STEP * COUNTER_INC_W +: 2] = do_update ? outside(u_step_x_full, MIN_STEP, MAX_STEP) + outside(u_step_y_full, MIN_STEP, MAX_STEP) : 2'd0;
         inc[COUNT_SAT_MCM_STEP * COUNTER_INC_W +: 2] = do_update ? outside(u_ux_full, MIN_V, MAX_V) + outside(u_uy_full, MIN_V, MAX_V) : 2'd0;
-        inc[COUNT_SAT_EVENTS_IN_INTERVAL * COUNTER_INC_W +: 2] = (do_update ? outside(u_evc_full, 0, MAX_EVCOUNT) : 2'd0)
+        inc[COUNT_SAT_EVENTS_IN_INTERVAL * COUNTER_INC_W +: 2] = (upd_write ? outside(u_evc_full, 0, MAX_EVCOUNT) : 2'd0)
+            + (do_commit ? outside(cm_evc_full, 0, MAX_EVCOUNT) : 2'd0)
             + (m_write ? outside(m_evc_full, 0, MAX_EVCOUNT) : 2'd0);
         inc[COUNT_SAT_GAMMA * COUNTER_INC_W +: 2] = (stage0 && f_gamma_by_activity ? outside(f_gamma_activity, 0, MAX_GAMMA) : 2'd0)
             + (stage0 && f_gamma_by_count ? outside(f_gamma_count, 0, MAX_GAMMA) : 2'd0);
         inc[COUNT_SAT_V_INT * COUNTER_INC_W +: 2] = stage0 && boundaries != 33'd0 ? outside(f_mx_full, MIN_VI, MAX_VI) + outside(f_my_full, MIN_VI, MAX_VI) : 2'd0;
-        inc[COUNT_SAT_V_MCM * COUNTER_INC_W +: 2] = tail_out && t_correct ? {1'b0, t_over_x} + {1'b0, t_over_y} : 2'd0;
+        inc[COUNT_SAT_V_MCM * COUNTER_INC_W +: 2] = (tail_out && t_correct ? {1'b0, t_over_x} + {1'b0, t_over_y} : 2'd0)
+            + (do_commit ? outside(cm_vmx_full, MIN_V, MAX_V) + outside(cm_vmy_full, MIN_V, MAX_V) : 2'd0);
     end
     assign idle = state == ST_IDLE && !a_valid && !rec_valid && !step_pending;
 
@@ -1081,14 +1177,14 @@ module evclust_core #(
     // One writer per cycle; the fields it leaves keep their value, read at port A (the written
     // slot's, for an update, a merge or the sweep; a creation writes every field).
     assign row_a_slot = state == ST_EXEC ? e_slot : k;
-    assign row_b_slot = state == ST_MERGE ? m_j : t;
+    assign row_b_slot = state == ST_MERGE ? m_j : (commit_reads ? c_slot : t);
     integer wi;
     always @* begin
-        wi = 0;  // the loop below runs only on an update: no latch for its variable
+        wi = 0;  // the loops below run only on an update or a commit: no latch for their variable
         row_we = 1'b0;
         row_w_slot = k;
         row_w = row_a;
-        if (do_update) begin
+        if (upd_write) begin
             row_we = 1'b1;
             row_w_slot = e_slot;
             row_w[ROW_ACT +: ACTIVITY_W] = u_act[ACTIVITY_W-1:0];
@@ -1103,6 +1199,23 @@ module evclust_core #(
             for (wi = 0; wi < P; wi = wi + 1)
                 row_w[ROW_HIST + wi * HIST_W +: HIST_W] = u_hist[wi][HIST_W-1:0];
             row_w[ROW_EV_COUNT +: EVENTS_IN_INTERVAL_W] = u_evc[EVENTS_IN_INTERVAL_W-1:0];
+        end
+        if (do_commit) begin  // the event before's increments added to its slot's row (port B)
+            row_we = 1'b1;
+            row_w_slot = c_slot;
+            row_w = row_b;
+            row_w[ROW_ACT +: ACTIVITY_W] = cm_act[ACTIVITY_W-1:0];
+            row_w[ROW_RESIDUAL +: DECAY_RESIDUAL_W] = dec_residual;
+            row_w[ROW_T_LAST +: T_LAST_W] = c_t;
+            row_w[ROW_VMX +: V_MCM_W] = cm_vmx[V_MCM_W-1:0];
+            row_w[ROW_VMY +: V_MCM_W] = cm_vmy[V_MCM_W-1:0];
+            row_w[ROW_NORM +: MCM_NORM_W] = cm_norm[MCM_NORM_W-1:0];
+            row_w[ROW_COL_Y +: COLOUR_W] = cm_cy[COLOUR_W-1:0];
+            row_w[ROW_COL_CB +: COLOUR_W] = cm_ccb[COLOUR_W-1:0];
+            row_w[ROW_COL_CR +: COLOUR_W] = cm_ccr[COLOUR_W-1:0];
+            for (wi = 0; wi < P; wi = wi + 1)
+                row_w[ROW_HIST + wi * HIST_W +: HIST_W] = cm_hist[wi][HIST_W-1:0];
+            row_w[ROW_EV_COUNT +: EVENTS_IN_INTERVAL_W] = cm_evc[EVENTS_IN_INTERVAL_W-1:0];
         end
         if (do_create) begin
             row_we = 1'b1;
@@ -1187,6 +1300,9 @@ module evclust_core #(
             started <= 1'b0;
             a_valid <= 1'b0;
             seek_w <= {SLOT_W{1'b0}};
+            c_live <= 1'b0;
+            c_bg_live <= 1'b0;
+            creating <= 1'b0;
             p_live <= 1'b0;
             boundaries <= 33'd0;
             per_frame <= {FRAME_PER_TAU_W{1'b0}};
@@ -1284,7 +1400,7 @@ module evclust_core #(
                     bg_residual <= bg_dec_residual;
                     bg_t <= e_t;
                 end
-                if (bg_learns) begin
+                if (bg_learns && UPDATE_DELAY == 0) begin
                     bg_y <= bg_y_next[BACKGROUND_W-1:0];
                     bg_cb <= bg_cb_next[BACKGROUND_W-1:0];
                     bg_cr <= bg_cr_next[BACKGROUND_W-1:0];
@@ -1332,7 +1448,53 @@ module evclust_core #(
             else if (a_advance)
                 a_valid <= 1'b0;
 
-            if (do_update) begin
+            // The commit (UPDATE_DELAY = 1): the event before's increments land; this event's
+            // are kept. A creation's split first cycle commits; its second finishes.
+            if (do_commit_bg) begin
+                bg_y <= cm_bg_y[BACKGROUND_W-1:0];
+                bg_cb <= cm_bg_cb[BACKGROUND_W-1:0];
+                bg_cr <= cm_bg_cr[BACKGROUND_W-1:0];
+            end
+            if (do_commit) begin
+                px[c_slot] <= cm_px[CENTRE_W-1:0];
+                py[c_slot] <= cm_py[CENTRE_W-1:0];
+                rx[c_slot] <= cm_rx[HALF_SIZE_W-1:0];
+                ry[c_slot] <= cm_ry[HALF_SIZE_W-1:0];
+            end
+            if (UPDATE_DELAY != 0) begin
+                if (commit_moment) begin
+                    c_live <= 1'b0;
+                    if (!split)
+                        c_bg_live <= 1'b0;
+                end
+                if (split) begin
+                    creating <= 1'b1;
+                    creating_slot <= e_free_slot;
+                end else if (finish) begin
+                    creating <= 1'b0;
+                    c_live <= do_update;
+                    c_bg_live <= bg_learns;
+                    c_slot <= e_slot;
+                    c_t <= e_t;
+                    c_dpx <= i_px[DP_W-1:0];
+                    c_dpy <= i_py[DP_W-1:0];
+                    c_drx <= i_rx[DR_W-1:0];
+                    c_dry <= i_ry[DR_W-1:0];
+                    c_dvmx <= i_vmx[DV_W-1:0];
+                    c_dvmy <= i_vmy[DV_W-1:0];
+                    c_dnorm <= i_norm[DN_W-1:0];
+                    c_dcy <= i_cy[DC_W-1:0];
+                    c_dccb <= i_ccb[DC_W-1:0];
+                    c_dccr <= i_ccr[DC_W-1:0];
+                    c_class <= vote_class;
+                    c_vote <= vote;
+                    c_dbg_y <= bg_y_d[DB_W-1:0];
+                    c_dbg_cb <= bg_cb_d[DB_W-1:0];
+                    c_dbg_cr <= bg_cr_d[DB_W-1:0];
+                end
+            end
+
+            if (upd_write) begin
                 px[e_slot] <= u_px_new[CENTRE_W-1:0];
                 py[e_slot] <= u_py_new[CENTRE_W-1:0];
                 rx[e_slot] <= u_rx[HALF_SIZE_W-1:0];

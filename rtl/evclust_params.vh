@@ -482,6 +482,7 @@ localparam integer SUPPORT_CELL_BITS = 0;
 localparam integer VI_CAP = 2;
 localparam integer OBJECTS = 1;
 localparam integer N_OBJECTS = 16;
+localparam integer UPDATE_DELAY = 0;
 localparam integer BG_INIT_Y = 6321603;
 localparam integer BG_INIT_CB = 8519680;
 localparam integer BG_INIT_CR = 8366981;

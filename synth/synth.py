@@ -27,10 +27,11 @@ DEFAULTS_START, DEFAULTS_END = "<!-- bench:synth-defaults:start -->", "<!-- benc
 ARTIX7_DSP = {"XC7A35T": 90, "XC7A50T": 120, "XC7A75T": 180, "XC7A100T": 240, "XC7A200T": 740}
 
 
-def params_header(n: int, preset: str = "traffic") -> str:
-    """evclust_params.vh of a preset for n clusters, from the formats table (as `evclust formats --verilog`)."""
+def params_header(n: int, preset: str = "traffic", **update) -> str:
+    """evclust_params.vh of a preset for n clusters (and `update`'s parameters), from the formats
+    table (as `evclust formats --verilog`)."""
     params, _ = load_params(preset)
-    text = rtl_header(params.model_copy(update={"n_clusters": n}), 480, 270, params.t_frame_us or 50000.0)
+    text = rtl_header(params.model_copy(update={"n_clusters": n, **update}), 480, 270, params.t_frame_us or 50000.0)
     reference = (RTL_DIR / "evclust_params.vh").read_text()
     if preset == "traffic" and f"N_CLUSTERS = {n};" in reference and text != reference:  # the RTL's own N: must match
         print(f"synth: warning: the generated header for N={n} differs from rtl/evclust_params.vh "
@@ -38,11 +39,12 @@ def params_header(n: int, preset: str = "traffic") -> str:
     return text
 
 
-def defaults_header(n: int) -> str:
-    """evclust_params.vh of the defaults (creation support off) for n clusters on 480x270 at 20 fps."""
+def defaults_header(n: int, **update) -> str:
+    """evclust_params.vh of the defaults (creation support off; and `update`'s parameters) for n
+    clusters on 480x270 at 20 fps."""
     from evclust.clusterer import ClustererParams
 
-    return rtl_header(ClustererParams(n_clusters=n, create_support=False), 480, 270, 50000.0)
+    return rtl_header(ClustererParams(n_clusters=n, create_support=False, **update), 480, 270, 50000.0)
 
 
 def defaults_section(rows) -> str:

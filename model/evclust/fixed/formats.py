@@ -369,7 +369,7 @@ def _options(p: ClustererParams, background: Format) -> tuple[tuple[str, int], .
         ("VOTE_CONTRAST", int(p.palette_vote == "contrast")), ("MIXING", int(p.palette_assign == "mixing")),
         ("BG_FIXED", int(p.background is not None)), ("BACKGROUND_MASK", mask),
         ("MERGE", int(p.merge)), ("CREATE_SUPPORT", int(p.create_support)), ("SUPPORT_CELL_BITS", p.support_cell_bits),
-        ("VI_CAP", p.interval_warmup()), ("OBJECTS", int(p.objects)), ("N_OBJECTS", p.n_objects),
+        ("VI_CAP", p.interval_warmup()), ("OBJECTS", int(p.objects)), ("N_OBJECTS", p.n_objects), ("UPDATE_DELAY", p.update_delay),
         *((f"BG_INIT_{c}", int(round(v * 2**background.frac_bits))) for c, v in zip(("Y", "CB", "CR"), bg)),
     )  # fmt: skip
 

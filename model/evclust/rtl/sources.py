@@ -21,11 +21,14 @@ def require_repository() -> None:
         raise EvclustError(f"{missing[0]}: the RTL is not here; run from a clone of the evclust repository (pip install -e .)")
 
 
+RTL_UPDATE_DELAYS = (0, 1)  # the pipeline semantics evclust_core implements (its UPDATE_DELAY)
+
+
 def require_rtl_semantics(params) -> None:
-    """The RTL has the sequential update only: refuse a parameter set with pipeline semantics."""
-    if params.update_delay:
-        raise EvclustError(f"clusterer: update_delay = {params.update_delay}, but the RTL commits every update before the next event "
-                           "reads the table (update_delay = 0); the float and fixed models run the delayed update")  # fmt: skip
+    """Refuse a parameter set whose pipeline semantics the RTL does not implement."""
+    if params.update_delay not in RTL_UPDATE_DELAYS:
+        raise EvclustError(f"clusterer: update_delay = {params.update_delay}, but the RTL implements update_delay "
+                           f"{' or '.join(map(str, RTL_UPDATE_DELAYS))}; the float and fixed models run any delay")  # fmt: skip
 
 
 def params_header(params, width: int, height: int, t_frame_us: float, **formats) -> str:
