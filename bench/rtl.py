@@ -94,7 +94,9 @@ def main() -> int:
         "on with its events: `object unit cycles/step` is its busy time per step, and `core held` the filter-step cycles "
         "the core waited for it (a record it could not pass on, or the last step's end not taken yet). `latency` counts "
         "clock edges from the one that takes an event to the one that writes its slot (the harness stamps both); the "
-        "largest is an event taken as a filter step begins, which waits in stage A for the whole step.",
+        "largest is an event taken as a filter step begins, which waits in stage A for the whole step. In the "
+        "`pipelined_*` cases (update_delay = 1) the edge stamped is the one that decides the event; its update is "
+        "written as the next event finishes (docs/RTL.md, \"Pipeline semantics\").",
         "",
         "| case | N | events | cycles | cycles/event | cycles/event outside sweeps | sweeps | cycles/sweep | evictions + drops "
         "| object unit cycles/step | core held (cycles) | latency, edges: min / mean / max |",

@@ -1,0 +1,40 @@
+"""`evclust generalize --pipeline` (docs/PIPELINE.md): the paired comparison and its page."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from evclust.cli import main
+from evclust.suite.pipeline import PERTURBATIONS, TARGET_POINTS, configurations, section
+
+
+def test_every_delay_is_paired_with_the_sequential_update_on_every_perturbation():
+    runs = configurations(delays=(2, 5))
+    names = {(c.name.split("|")[0], int(c.name.split("|")[1])) for c in runs}
+    assert names == {(p, d) for p in PERTURBATIONS for d in (0, 2, 5)}
+    for c in runs:
+        perturbation, delay = c.name.split("|")
+        assert c.params.update_delay == int(delay) and c.model == "float"
+        for key, value in PERTURBATIONS[perturbation].items():
+            assert getattr(c.params, key) == value
+
+
+def test_the_page_gives_the_mean_change_and_its_standard_error_and_judges_the_target():
+    base = ({"HOTA": 0.5}, {"HOTA": 0.49})
+    changes = {
+        (4, "objects"): {"HOTA": np.array([-0.2, -0.4, 0.0]), "recall": np.zeros(3), "precision": np.zeros(3), "base": base},
+        (8, "objects"): {"HOTA": np.array([-0.9, -0.5, -0.7]), "recall": np.zeros(3), "precision": np.zeros(3), "base": base},
+    }
+    lines = section("test", changes, held_out=True)
+    text = "\n".join(lines)
+    # mean -0.20, s.e. std([-0.2, -0.4, 0.0], ddof=1) / sqrt(3) = 0.2 / sqrt(3) = 0.115...
+    assert "| 4 | objects | 50.0 → 49.0 % | -0.20 ± 0.12 |" in text
+    assert f"at most {TARGET_POINTS:g} HOTA points" in text
+    assert "| 4 | -0.20 points | yes |" in text and "| 8 | -0.70 points | no |" in text
+    assert "Target:" not in "\n".join(section("tuning", changes, held_out=False))  # no verdict off the held-out split
+
+
+def test_pipeline_runs_whole_splits_and_refuses_seeds(tmp_path, capsys):
+    assert main(["generalize", "--pipeline", "--seeds", "1000", "-o", str(tmp_path / "P.md")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "--pipeline" in err and "\n" not in err
