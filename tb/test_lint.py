@@ -21,11 +21,12 @@ def test_the_reference_rtl_is_lint_clean(top):
     assert lint(top=top) == ""
 
 
-@pytest.mark.parametrize("case", ["table_full", "palette_tie", "pedestrian_clip", "suite_clip", "creation_support", "merge_edges"])
+@pytest.mark.parametrize("case", ["table_full", "palette_tie", "pedestrian_clip", "suite_clip", "creation_support", "merge_edges",
+                                  "pipelined_traffic"])  # fmt: skip
 def test_the_rtl_is_lint_clean_for_other_parameter_sets(case):
     # N = 4; nearest palette with a fixed background; another sensor and other formats; the
     # default configuration (merging, scaled seek, noise gate, warm-up); the support map; merging
-    # with a warm-up table.
+    # with a warm-up table; the commit one event later (update_delay = 1).
     assert lint(load_case(VECTORS / case).header) == ""
 
 

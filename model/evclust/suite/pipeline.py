@@ -16,7 +16,7 @@ import numpy as np
 
 from evclust.clusterer import ClustererParams
 from evclust.suite.aggregate import figures
-from evclust.suite.report import Configuration, SuiteRun
+from evclust.suite.report import Configuration, SuiteRun, commands_section, save_page
 
 DELAYS = (1, 4, 8, 16)  # events in flight: the RTL's (1), and the depths a deeper pipeline may take
 # The defaults, and each nudged by far less than any tuning step: a fair sample of "the same"
@@ -105,16 +105,6 @@ def write_page(by_split: dict, out: Path, command: str, machine: str, scenes: di
         what = ("held out: no parameter, threshold or design rule was chosen on it" if held_out else
                 "the split the defaults were tuned on, with the sequential update: not a held-out measure")  # fmt: skip
         lines += [f"## {split} split ({scenes[split]} scenes; {what})", "", *section(split, changes, held_out), ""]
-    lines += [
-        "## Commands",
-        "",
-        "```sh",
-        "make generalize          # this page, with docs/GENERALIZATION.md",
-        "evclust generalize --pipeline -o docs/PIPELINE.md",
-        "```",
-        "",
-    ]
-    text = "\n".join(lines)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(text)
-    return text
+    lines += commands_section(("make generalize          # this page, with docs/GENERALIZATION.md",
+                               "evclust generalize --pipeline -o docs/PIPELINE.md"))  # fmt: skip
+    return save_page(out, lines)

@@ -297,17 +297,23 @@ def write_report(runs: list[SuiteRun], folder: Path, out: Path, split: str, seed
         "|---|---|---|---|---|",
         *(f"| {r.configuration.name} | {r.configuration.model} | {len(r.results)} | {r.wall_s:.1f} s | {sum(x.events for x in r.results):,} |" for r in runs),
         "",
-        "## Commands",
-        "",
-        "```sh",
-        "make generalize                                   # this page: the test split, default and paper, float and fixed",
-        "evclust scenes --generate 1000 -o scenes/         # one scene of the suite (TOML, truth, video for codec scenes)",
-        "evclust scenes --split test -o scenes/            # every scene of a split",
-        "evclust tune --suite tuning --trials 400 --storage sqlite:///build/tune.db   # the tuning of the defaults",
-        "evclust generalize --split test --scheduler tcp://host:8786 -o GENERALIZATION.md   # on a Dask cluster",
-        "```",
-        "",
+        *commands_section((
+            "make generalize                                   # this page: the test split, default and paper, float and fixed",
+            "evclust scenes --generate 1000 -o scenes/         # one scene of the suite (TOML, truth, video for codec scenes)",
+            "evclust scenes --split test -o scenes/            # every scene of a split",
+            "evclust tune --suite tuning --trials 400 --storage sqlite:///build/tune.db   # the tuning of the defaults",
+            "evclust generalize --split test --scheduler tcp://host:8786 -o GENERALIZATION.md   # on a Dask cluster",
+        )),
     ]
+    return save_page(out, lines)
+
+
+def commands_section(commands) -> list[str]:
+    """A page's closing "Commands" section: the shell lines that remake it and its neighbours."""
+    return ["## Commands", "", "```sh", *commands, "```", ""]
+
+
+def save_page(out: Path, lines: list[str]) -> str:
     text = "\n".join(lines)
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(text)
