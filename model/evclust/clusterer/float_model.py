@@ -187,7 +187,7 @@ def _create(S, H, G, s, t, x, y, lum, cb, cr, k, precision):
     G[CREATED] += 1
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")  # the per-event loop's: no call
 def _increments(S, G, s, t, x, y, lum, cb, cr, k, palette, background_mask, precision, row):
     """Step 3, read half: the mean-shift update of the chosen cluster as increments computed from
     the state the event reads (the table D events ago in a pipelined core), into `row`."""
@@ -221,7 +221,7 @@ def _increments(S, G, s, t, x, y, lum, cb, cr, k, palette, background_mask, prec
             row[PD_VOTE] = int(abs(lum - G[BG_Y]) + abs(cb - G[BG_CB]) + abs(cr - G[BG_CR]) + 0.5)
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")  # the per-event loop's: no call
 def _commit(S, H, G, row, k, precision):
     """Step 3, write half: an event's increments added to the slot as it is now (in a pipelined
     core, other events' commits may have landed since the event read it); with no delay, the
@@ -487,7 +487,8 @@ def run_events(S, H, G, k, palette, background_mask, support, line, t_us, xs, ys
             G[T_FIRST] = t
         G[EVENTS] += 1
         row = line[int(G[EVENTS]) % (delay + 1)]  # it holds event n - D - 1: its turn to commit
-        _commit(S, H, G, row, k, precision)
+        if delay > 0:
+            _commit(S, H, G, row, k, precision)
         s = _seek(S, x, y, k)
         updated_reported = False
         cx, cy = (int(xs[i]) >> bits) + 1, (int(ys[i]) >> bits) + 1

@@ -277,7 +277,7 @@ def _create(S, H, G, s, t, ex, ey, lum, cb, cr, k):
     G[CREATED] += 1
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")  # the per-event loop's: no call
 def _increments(S, G, s, t, ex, ey, lum, cb, cr, k, palette, inv_ww, background_mask, log, ranges, row):
     """Step 3, read half: the slot's update as increments from the state the event reads (in a
     pipelined core, the table D events ago), into the delay-line row."""
@@ -321,7 +321,7 @@ def _increments(S, G, s, t, ex, ey, lum, cb, cr, k, palette, inv_ww, background_
         row[PD_VOTE] = palette_vote(lum, cb, cr, G, k)
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")  # the per-event loop's: no call
 def _commit(S, H, G, row, k, table, log, ranges):
     """Step 3, write half: the increments added to the slot as it is now, each saturated to its
     format (with no delay the state read is the state now, and no saturation can act: the paper's
@@ -623,7 +623,8 @@ def run_events(S, H, G, k, table, gains, palette, inv_ww, background_mask, suppo
             G[TAU_PHASE] = 0  # τ boundaries count from the first event, as in the float model
         G[EVENTS] += 1
         row = line[G[EVENTS] % (delay + 1)]  # it holds event n - D - 1: its turn to commit
-        _commit(S, H, G, row, k, table, log, ranges)
+        if delay > 0:
+            _commit(S, H, G, row, k, table, log, ranges)
         s = _seek(S, ex << k[C_FP], ey << k[C_FP], k)
         updated_reported = False
         action = TRACE_UPDATE
