@@ -72,3 +72,22 @@ function automatic signed [63:0] mul_by_addition;
         mul_by_addition = mul_by_addition - ((a <<< (b_bits - 1)) & {64{b[b_bits - 1]}});
     end
 endfunction
+
+// An unsigned field of up to 63 bits as a 64-bit word (give it zero-extended).
+function automatic signed [63:0] u64;
+    input [62:0] v;
+    begin
+        u64 = {1'b0, v};
+    end
+endfunction
+
+// 1 if v lies outside [lo, hi]: a saturation, for the status counters (two bits, so that two
+// axes' counts add).
+function automatic [1:0] outside;
+    input signed [63:0] v;
+    input signed [63:0] lo;
+    input signed [63:0] hi;
+    begin
+        outside = (v < lo || v > hi) ? 2'd1 : 2'd0;
+    end
+endfunction

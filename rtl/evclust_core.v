@@ -52,6 +52,7 @@ module evclust_core #(
 );
 `include "evclust_params.vh"
 `include "evclust_arith.vh"
+`include "evclust_increments.vh"
 
     // The port parameters must be the header's: they are given for the instantiating design's sake.
     generate
@@ -93,15 +94,11 @@ module evclust_core #(
     localparam signed [63:0] MAX_EVCOUNT = (64'sd1 <<< EVENTS_IN_INTERVAL_W) - 1;
     localparam signed [63:0] MAX_V = (64'sd1 <<< (V_MCM_W - 1)) - 1, MIN_V = -(64'sd1 <<< (V_MCM_W - 1));
     localparam signed [63:0] MAX_VI = (64'sd1 <<< (V_INT_W - 1)) - 1, MIN_VI = -(64'sd1 <<< (V_INT_W - 1));
-    localparam signed [63:0] MAX_STEP = (64'sd1 <<< (CENTRE_STEP_W - 1)) - 1, MIN_STEP = -(64'sd1 <<< (CENTRE_STEP_W - 1));
-    localparam signed [63:0] H_MAX = (64'sd1 <<< HIST_W) - 1;
-    wire signed [63:0] K_B_POS = $signed({{(64 - CFG_BETA_POS_W){1'b0}}, cfg_beta_pos}), K_B_SIZE = $signed({{(64 - CFG_BETA_SIZE_W){1'b0}}, cfg_beta_size});
-    wire signed [63:0] K_B_VM = $signed({{(64 - CFG_BETA_VEL_MCM_W){1'b0}}, cfg_beta_vel_mcm}), K_B_VI = $signed({{(64 - CFG_BETA_VEL_INT_W){1'b0}}, cfg_beta_vel_int});
-    wire signed [63:0] K_B_LUM = $signed({{(64 - CFG_BETA_LUM_W){1'b0}}, cfg_beta_lum}), K_B_CHRO = $signed({{(64 - CFG_BETA_CHRO_W){1'b0}}, cfg_beta_chro});
-    wire signed [63:0] K_B_BG = $signed({{(64 - CFG_BETA_BG_W){1'b0}}, cfg_beta_bg}), K_GAIN = $signed({{(64 - CFG_SIZE_GAIN_W){1'b0}}, cfg_size_gain});
+    // (The update's constants go to evclust_update and evclust_commit as their fields.)
+    wire signed [63:0] K_B_VI = $signed({{(64 - CFG_BETA_VEL_INT_W){1'b0}}, cfg_beta_vel_int});
+    wire signed [63:0] K_B_BG = $signed({{(64 - CFG_BETA_BG_W){1'b0}}, cfg_beta_bg});
     wire signed [63:0] K_GAMMA_GLOBAL = $signed({{(64 - CFG_GAMMA_GLOBAL_W){1'b0}}, cfg_gamma_global}), K_GPA = $signed({{(64 - CFG_GAMMA_PER_ACTIVITY_W){1'b0}}, cfg_gamma_per_activity});
     wire signed [63:0] K_INV_P = $signed({{(64 - CFG_INV_P_W){1'b0}}, cfg_inv_p});
-    wire signed [63:0] K_R_MIN = $signed({{(64 - CFG_R_MIN_W){1'b0}}, cfg_r_min});
     wire signed [63:0] K_R_MAX = $signed({{(64 - CFG_R_MAX_W){1'b0}}, cfg_r_max}), K_SEEK = $signed({{(64 - CFG_SEEK_MARGIN_W){1'b0}}, cfg_seek_margin});
     wire signed [63:0] K_EXIT_M = $signed({{(64 - CFG_EXIT_MARGIN_W){1'b0}}, cfg_exit_margin}), K_A_MIN = $signed({{(64 - CFG_A_MIN_W){1'b0}}, cfg_a_min});
     wire signed [63:0] K_A_VALID = $signed({{(64 - CFG_A_VALID_W){1'b0}}, cfg_a_valid}), K_V_MIN_SQ = $signed({{(64 - CFG_V_MIN_SQ_W){1'b0}}, cfg_v_min_sq});
@@ -155,13 +152,7 @@ module evclust_core #(
     localparam [2:0] TRACE_UPDATE = 3'd0, TRACE_CREATE = 3'd1, TRACE_EVICT = 3'd2, TRACE_DROP = 3'd3, TRACE_UNSUPPORTED = 3'd4;
     localparam [3:0] FLAG_NEW = 4'd1, FLAG_BORDER = 4'd2, FLAG_MOVING_MCM = 4'd4, FLAG_MOVING_INT = 4'd8;
 
-    // Words of the 64-bit datapath from unsigned and signed fields.
-    function automatic signed [63:0] u64;
-        input [62:0] v;
-        begin
-            u64 = {1'b0, v};
-        end
-    endfunction
+    // Words of the 64-bit datapath from unsigned and signed fields (u64: evclust_arith.vh).
 
     // A slot's seek window along one axis in P's format: R + S + seek_scale * max(Rx, Ry)
     // (model: _margin), from the larger half-size's product, taken once as the slot is written.
@@ -318,12 +309,12 @@ module evclust_core #(
     wire [GAMMA_W-1:0]              gamma_a = row_a[ROW_GAMMA +: GAMMA_W];
     wire [V_MCM_W-1:0]              vmx_a = row_a[ROW_VMX +: V_MCM_W], vmx_b = row_b[ROW_VMX +: V_MCM_W];
     wire [V_MCM_W-1:0]              vmy_a = row_a[ROW_VMY +: V_MCM_W], vmy_b = row_b[ROW_VMY +: V_MCM_W];
-    wire [MCM_NORM_W-1:0]           norm_a = row_a[ROW_NORM +: MCM_NORM_W], norm_b = row_b[ROW_NORM +: MCM_NORM_W];
+    wire [MCM_NORM_W-1:0]           norm_a = row_a[ROW_NORM +: MCM_NORM_W];
     wire [EVENTS_IN_INTERVAL_W-1:0] ev_count_a = row_a[ROW_EV_COUNT +: EVENTS_IN_INTERVAL_W], ev_count_b = row_b[ROW_EV_COUNT +: EVENTS_IN_INTERVAL_W];
     wire [COLOUR_W-1:0]             col_y_a = row_a[ROW_COL_Y +: COLOUR_W], col_y_b = row_b[ROW_COL_Y +: COLOUR_W];
     wire [COLOUR_W-1:0]             col_cb_a = row_a[ROW_COL_CB +: COLOUR_W], col_cb_b = row_b[ROW_COL_CB +: COLOUR_W];
     wire [COLOUR_W-1:0]             col_cr_a = row_a[ROW_COL_CR +: COLOUR_W], col_cr_b = row_b[ROW_COL_CR +: COLOUR_W];
-    wire [P*HIST_W-1:0]             hist_a = row_a[ROW_HIST +: P * HIST_W], hist_b = row_b[ROW_HIST +: P * HIST_W];
+    wire [P*HIST_W-1:0]             hist_b = row_b[ROW_HIST +: P * HIST_W];
 
     // ---------------------------------------------------------------- globals
     reg [BACKGROUND_W-1:0]     bg_y, bg_cb, bg_cr;
@@ -508,77 +499,40 @@ module evclust_core #(
         .vote(vote)
     );
 
-    reg signed [63:0] u_ox, u_oy;
-    reg signed [63:0] ex, ey, u_px, u_py, u_px_new, u_py_new, u_gx, u_gy, u_rx, u_ry, u_rx_step, u_ry_step, u_step_x, u_step_y;
-    reg signed [63:0] u_ux, u_uy, u_vmx, u_vmy, u_norm, u_act, u_cy, u_ccb, u_ccr, u_evc, u_gamma;
-    // *_full: a value before its format's saturation (the status counters compare it too).
-    reg signed [63:0] u_act_full, u_gx_full, u_gy_full, u_step_x_full, u_step_y_full, u_ux_full, u_uy_full, u_evc_full;
-    reg signed [63:0] u_hist [0:P-1];
-    reg               u_halve;
-    integer c;  // the update's loop; the sweep has its own (one variable per always block)
-    always @* begin
-        ex = u64({{(63 - EV_XY_W){1'b0}}, e_x});
-        ey = u64({{(63 - EV_XY_W){1'b0}}, e_y});
-        // 3a. Activity: decay to t, then count the event.
-        u_act_full = a_decayed + ONE_A;
-        u_act = saturate(u_act_full, 0, MAX_ACT);
-        // 3b. Centre.
-        u_px = u64({{(63 - CENTRE_W){1'b0}}, px[e_slot]});
-        u_py = u64({{(63 - CENTRE_W){1'b0}}, py[e_slot]});
-        u_px_new = alpha_step(u_px, ex, K_B_POS, BETA_POS_FRAC, FP, 1'b0);
-        u_py_new = alpha_step(u_py, ey, K_B_POS, BETA_POS_FRAC, FP, 1'b0);
-        // 3c. Size.
-        u_ox = abs64((ex <<< FP) - u_px);  // |e - P|: the offset format's magnitude
-        u_oy = abs64((ey <<< FP) - u_py);
-        u_gx_full = (u64({{(64 - OFFSET_W){1'b0}}, u_ox[OFFSET_W-2:0]}) * K_GAIN) >>> (SIZE_GAIN_FRAC + FP - FR);
-        u_gy_full = (u64({{(64 - OFFSET_W){1'b0}}, u_oy[OFFSET_W-2:0]}) * K_GAIN) >>> (SIZE_GAIN_FRAC + FP - FR);
-        u_gx = u_gx_full;  // < 2^SIZE_TARGET_W by construction: |e - P| < 2^coord, g_R < 2^bits(g_R)
-        u_gy = u_gy_full;
-        u_rx_step = alpha_step(u64({{(63 - HALF_SIZE_W){1'b0}}, rx[e_slot]}), u_gx, K_B_SIZE, BETA_SIZE_FRAC, 0, 1'b0);
-        u_ry_step = alpha_step(u64({{(63 - HALF_SIZE_W){1'b0}}, ry[e_slot]}), u_gy, K_B_SIZE, BETA_SIZE_FRAC, 0, 1'b0);
-        u_rx = saturate(u_rx_step, K_R_MIN, K_R_MAX);
-        u_ry = saturate(u_ry_step, K_R_MIN, K_R_MAX);
-        // 3d. MCM velocity and its bias-correction weight.
-        u_gamma = u64({{(63 - GAMMA_W){1'b0}}, gamma_a});
-        u_step_x_full = u_px_new - u_px;
-        u_step_y_full = u_py_new - u_py;
-        u_step_x = saturate(u_step_x_full, MIN_STEP, MAX_STEP);
-        u_step_y = saturate(u_step_y_full, MIN_STEP, MAX_STEP);
-        // gamma * (P_new - P): the step saturated to centre_step's format, so 22 x 22 bits.
-        u_ux_full = align(u_gamma * $signed({{(64 - CENTRE_STEP_W){u_step_x[CENTRE_STEP_W-1]}}, u_step_x[CENTRE_STEP_W-1:0]}), FG + FP, FV);
-        u_uy_full = align(u_gamma * $signed({{(64 - CENTRE_STEP_W){u_step_y[CENTRE_STEP_W-1]}}, u_step_y[CENTRE_STEP_W-1:0]}), FG + FP, FV);
-        u_ux = saturate(u_ux_full, MIN_V, MAX_V);
-        u_uy = saturate(u_uy_full, MIN_V, MAX_V);
-        u_vmx = alpha_step($signed({{(64 - V_MCM_W){vmx_a[V_MCM_W-1]}}, vmx_a}), u_ux, K_B_VM, BETA_VEL_MCM_FRAC, 0, 1'b1);
-        u_vmy = alpha_step($signed({{(64 - V_MCM_W){vmy_a[V_MCM_W-1]}}, vmy_a}), u_uy, K_B_VM, BETA_VEL_MCM_FRAC, 0, 1'b1);
-        u_norm = alpha_step(u64({{(63 - MCM_NORM_W){1'b0}}, norm_a}), 64'sd1, K_B_VM, BETA_VEL_MCM_FRAC, FW, 1'b1);
-        // 3e. Colour.
-        u_cy = alpha_step(u64({{(63 - COLOUR_W){1'b0}}, col_y_a}), u64({{(63 - CW){1'b0}}, e_lum}), K_B_LUM, BETA_LUM_FRAC, FC, 1'b0);
-        u_ccb = alpha_step(u64({{(63 - COLOUR_W){1'b0}}, col_cb_a}), u64({{(63 - CW){1'b0}}, e_cb}), K_B_CHRO, BETA_CHRO_FRAC, FC, 1'b0);
-        u_ccr = alpha_step(u64({{(63 - COLOUR_W){1'b0}}, col_cr_a}), u64({{(63 - CW){1'b0}}, e_cr}), K_B_CHRO, BETA_CHRO_FRAC, FC, 1'b0);
-        // 3f. Palette histogram: a saturating counter; reaching the top halves the row.
-        for (c = 0; c < P; c = c + 1)
-            u_hist[c] = u64({{(63 - HIST_W){1'b0}}, hist_a[c*HIST_W +: HIST_W]});
-        u_hist[vote_class] = min64(u_hist[vote_class] + u64({{(63 - VOTE_W){1'b0}}, vote}), H_MAX);
-        u_halve = u_hist[vote_class] >= H_MAX;
-        for (c = 0; c < P; c = c + 1)
-            if (u_halve)
-                u_hist[c] = u_hist[c] >>> 1;
-        u_evc_full = u64({{(63 - EVENTS_IN_INTERVAL_W){1'b0}}, ev_count_a}) + 1;
-        u_evc = saturate(u_evc_full, 0, MAX_EVCOUNT);
-    end
+    // The update as the model's _increments computes it (the palette's class and vote above):
+    // each alpha filter's new value and its increment from the slot read at port A.
+    wire [CENTRE_W-1:0]       up_px, up_py;
+    wire [HALF_SIZE_W-1:0]    up_rx, up_ry;
+    wire [V_MCM_W-1:0]        up_vmx, up_vmy;
+    wire [MCM_NORM_W-1:0]     up_norm;
+    wire [COLOUR_W-1:0]       up_cy, up_ccb, up_ccr;
+    wire signed [DP_W-1:0]    i_px, i_py;
+    wire signed [DR_W-1:0]    i_rx, i_ry;
+    wire signed [DV_W-1:0]    i_vmx, i_vmy;
+    wire signed [DN_W-1:0]    i_norm;
+    wire signed [DC_W-1:0]    i_cy, i_ccb, i_ccr;
+    wire [1:0]                up_step_saturations, up_mcm_saturations;
+    evclust_update update (
+        .ev_x(e_x), .ev_y(e_y), .lum(e_lum), .cb(e_cb), .cr(e_cr),
+        .px(px[e_slot]), .py(py[e_slot]), .rx(rx[e_slot]), .ry(ry[e_slot]), .gamma(gamma_a), .vmx(vmx_a), .vmy(vmy_a), .norm(norm_a),
+        .col_y(col_y_a), .col_cb(col_cb_a), .col_cr(col_cr_a),
+        .beta_pos(cfg_beta_pos), .size_gain(cfg_size_gain), .beta_size(cfg_beta_size), .r_min(cfg_r_min), .r_max(cfg_r_max),
+        .beta_vel_mcm(cfg_beta_vel_mcm), .beta_lum(cfg_beta_lum), .beta_chro(cfg_beta_chro),
+        .px_new(up_px), .py_new(up_py), .rx_new(up_rx), .ry_new(up_ry), .vmx_new(up_vmx), .vmy_new(up_vmy), .norm_new(up_norm),
+        .col_y_new(up_cy), .col_cb_new(up_ccb), .col_cr_new(up_ccr),
+        .d_px(i_px), .d_py(i_py), .d_rx(i_rx), .d_ry(i_ry), .d_vmx(i_vmx), .d_vmy(i_vmy), .d_norm(i_norm),
+        .d_col_y(i_cy), .d_col_cb(i_ccb), .d_col_cr(i_ccr),
+        .step_saturations(up_step_saturations), .mcm_saturations(up_mcm_saturations)
+    );
 
     // ---------------------------------------------------------------- the commit (pipeline semantics)
     // UPDATE_DELAY = 1 (model: _increments, _commit; docs/DESIGN.md, "Pipeline semantics"): EXEC
     // keeps its event's update as increments from the state it read, and they are added to the
     // slot as it then is when the next event finishes (or, before a filter step, in PHASE). So
     // the next event reads the table without them, and the sums leave EXEC's recurrence. The
-    // commit reads its slot's row at port B. UPDATE_DELAY = 0: EXEC writes the update itself.
-    localparam integer DP_W = CENTRE_W + 1;  // each increment: its field's width and a sign
-    localparam integer DR_W = (SIZE_TARGET_W > HALF_SIZE_W ? SIZE_TARGET_W : HALF_SIZE_W) + 1;
-    localparam integer DV_W = V_MCM_W + 1, DN_W = MCM_NORM_W + 1, DC_W = COLOUR_W + 1, DB_W = BACKGROUND_W + 1;
-    localparam signed [63:0] MAX_P = (64'sd1 <<< CENTRE_W) - 1, MAX_C = (64'sd1 <<< COLOUR_W) - 1, MAX_B = (64'sd1 <<< BACKGROUND_W) - 1;
-    localparam signed [63:0] ONE_W = 64'sd1 <<< FW;  // w = 1 - alpha^n never passes 1
+    // commit reads its slot's row at port B. UPDATE_DELAY = 0: EXEC writes the update itself,
+    // the alpha filters' new values and the commit's counts on the row it read at port A.
+    localparam signed [63:0] MAX_B = (64'sd1 <<< BACKGROUND_W) - 1;
     reg                    c_live, c_bg_live;  // a slot update, a background update in flight
     reg [SLOT_W-1:0]       c_slot;
     reg [EV_T_W-1:0]       c_t;
@@ -594,46 +548,44 @@ module evclust_core #(
     reg [SLOT_W-1:0]       creating_slot;
     wire commit_moment;  // the event before commits now (the decision logic below)
     wire commit_reads = UPDATE_DELAY != 0 && (state == ST_EXEC || state == ST_EVICT || state == ST_PHASE);
-    // The increments of this event (EXEC), each the alpha step minus the state it read.
-    wire signed [63:0] i_px = u_px_new - u_px, i_py = u_py_new - u_py;
-    wire signed [63:0] i_rx = u_rx_step - u64({{(63 - HALF_SIZE_W){1'b0}}, rx[e_slot]});
-    wire signed [63:0] i_ry = u_ry_step - u64({{(63 - HALF_SIZE_W){1'b0}}, ry[e_slot]});
-    wire signed [63:0] i_vmx = u_vmx - $signed({{(64 - V_MCM_W){vmx_a[V_MCM_W-1]}}, vmx_a});
-    wire signed [63:0] i_vmy = u_vmy - $signed({{(64 - V_MCM_W){vmy_a[V_MCM_W-1]}}, vmy_a});
-    wire signed [63:0] i_norm = u_norm - u64({{(63 - MCM_NORM_W){1'b0}}, norm_a});
-    wire signed [63:0] i_cy = u_cy - u64({{(63 - COLOUR_W){1'b0}}, col_y_a});
-    wire signed [63:0] i_ccb = u_ccb - u64({{(63 - COLOUR_W){1'b0}}, col_cb_a});
-    wire signed [63:0] i_ccr = u_ccr - u64({{(63 - COLOUR_W){1'b0}}, col_cr_a});
-    // The committed slot: the increments added to its state now, each saturated to its format.
-    reg signed [63:0] cm_px, cm_py, cm_rx, cm_ry, cm_vmx_full, cm_vmy_full, cm_vmx, cm_vmy, cm_norm, cm_cy, cm_ccb, cm_ccr;
-    reg signed [63:0] cm_act_full, cm_act, cm_evc_full, cm_evc, cm_bg_y, cm_bg_cb, cm_bg_cr;
-    reg signed [63:0] cm_hist [0:P-1];
-    reg               cm_halve;
-    integer cc;
+    // The slot an update lands in, as it is now: the event's own at port A, or the event
+    // before's at port B (the decay unit reads the same port).
+    localparam DELAYED = UPDATE_DELAY != 0;
+    wire [SLOT_W-1:0] sw_slot = DELAYED ? c_slot : e_slot;
+    wire [ROW_W-1:0]  sw_row = DELAYED ? row_b : row_a;
+    wire [ACTIVITY_W-1:0] cm_act;
+    wire [CENTRE_W-1:0]   cm_px, cm_py;
+    wire [HALF_SIZE_W-1:0] cm_rx, cm_ry;
+    wire [V_MCM_W-1:0]    cm_vmx, cm_vmy;
+    wire [MCM_NORM_W-1:0] cm_norm;
+    wire [COLOUR_W-1:0]   cm_cy, cm_ccb, cm_ccr;
+    wire [P*HIST_W-1:0]   cm_hist;
+    wire [EVENTS_IN_INTERVAL_W-1:0] cm_evc;
+    wire [1:0]            cm_act_saturations, cm_vm_saturations, cm_evc_saturations;
+    evclust_commit commit (
+        .act_decayed(dec_a), .px(px[sw_slot]), .py(py[sw_slot]), .rx(rx[sw_slot]), .ry(ry[sw_slot]),
+        .vmx(sw_row[ROW_VMX +: V_MCM_W]), .vmy(sw_row[ROW_VMY +: V_MCM_W]), .norm(sw_row[ROW_NORM +: MCM_NORM_W]),
+        .col_y(sw_row[ROW_COL_Y +: COLOUR_W]), .col_cb(sw_row[ROW_COL_CB +: COLOUR_W]), .col_cr(sw_row[ROW_COL_CR +: COLOUR_W]),
+        .hist(sw_row[ROW_HIST +: P * HIST_W]), .ev_count(sw_row[ROW_EV_COUNT +: EVENTS_IN_INTERVAL_W]),
+        .d_px(c_dpx), .d_py(c_dpy), .d_rx(c_drx), .d_ry(c_dry), .d_vmx(c_dvmx), .d_vmy(c_dvmy), .d_norm(c_dnorm),
+        .d_col_y(c_dcy), .d_col_cb(c_dccb), .d_col_cr(c_dccr),
+        .class_index(DELAYED ? c_class : vote_class), .vote(DELAYED ? c_vote : vote),
+        .r_min(cfg_r_min), .r_max(cfg_r_max),
+        .act_out(cm_act), .px_out(cm_px), .py_out(cm_py), .rx_out(cm_rx), .ry_out(cm_ry), .vmx_out(cm_vmx), .vmy_out(cm_vmy),
+        .norm_out(cm_norm), .col_y_out(cm_cy), .col_cb_out(cm_ccb), .col_cr_out(cm_ccr), .hist_out(cm_hist), .ev_count_out(cm_evc),
+        .act_saturations(cm_act_saturations), .vm_saturations(cm_vm_saturations), .ev_count_saturations(cm_evc_saturations)
+    );
+    // What the slot write stores: without delay, the alpha filters' new values (their sums with
+    // the state read cannot saturate) and the commit's counts; with it, the commit's all.
+    wire [CENTRE_W-1:0]    sw_px = DELAYED ? cm_px : up_px, sw_py = DELAYED ? cm_py : up_py;
+    wire [HALF_SIZE_W-1:0] sw_rx = DELAYED ? cm_rx : up_rx, sw_ry = DELAYED ? cm_ry : up_ry;
+    wire [V_MCM_W-1:0]     sw_vmx = DELAYED ? cm_vmx : up_vmx, sw_vmy = DELAYED ? cm_vmy : up_vmy;
+    wire [MCM_NORM_W-1:0]  sw_norm = DELAYED ? cm_norm : up_norm;
+    wire [COLOUR_W-1:0]    sw_cy = DELAYED ? cm_cy : up_cy, sw_ccb = DELAYED ? cm_ccb : up_ccb, sw_ccr = DELAYED ? cm_ccr : up_ccr;
+    wire [EV_T_W-1:0]      sw_t = DELAYED ? c_t : e_t;
+    // The background colour's commit.
+    reg signed [63:0] cm_bg_y, cm_bg_cb, cm_bg_cr;
     always @* begin
-        cm_px = saturate(u64({{(63 - CENTRE_W){1'b0}}, px[c_slot]}) + $signed({{(64 - DP_W){c_dpx[DP_W-1]}}, c_dpx}), 0, MAX_P);
-        cm_py = saturate(u64({{(63 - CENTRE_W){1'b0}}, py[c_slot]}) + $signed({{(64 - DP_W){c_dpy[DP_W-1]}}, c_dpy}), 0, MAX_P);
-        cm_rx = saturate(u64({{(63 - HALF_SIZE_W){1'b0}}, rx[c_slot]}) + $signed({{(64 - DR_W){c_drx[DR_W-1]}}, c_drx}), K_R_MIN, K_R_MAX);
-        cm_ry = saturate(u64({{(63 - HALF_SIZE_W){1'b0}}, ry[c_slot]}) + $signed({{(64 - DR_W){c_dry[DR_W-1]}}, c_dry}), K_R_MIN, K_R_MAX);
-        cm_vmx_full = $signed({{(64 - V_MCM_W){vmx_b[V_MCM_W-1]}}, vmx_b}) + $signed({{(64 - DV_W){c_dvmx[DV_W-1]}}, c_dvmx});
-        cm_vmy_full = $signed({{(64 - V_MCM_W){vmy_b[V_MCM_W-1]}}, vmy_b}) + $signed({{(64 - DV_W){c_dvmy[DV_W-1]}}, c_dvmy});
-        cm_vmx = saturate(cm_vmx_full, MIN_V, MAX_V);
-        cm_vmy = saturate(cm_vmy_full, MIN_V, MAX_V);
-        cm_norm = saturate(u64({{(63 - MCM_NORM_W){1'b0}}, norm_b}) + $signed({{(64 - DN_W){c_dnorm[DN_W-1]}}, c_dnorm}), 0, ONE_W);
-        cm_cy = saturate(u64({{(63 - COLOUR_W){1'b0}}, col_y_b}) + $signed({{(64 - DC_W){c_dcy[DC_W-1]}}, c_dcy}), 0, MAX_C);
-        cm_ccb = saturate(u64({{(63 - COLOUR_W){1'b0}}, col_cb_b}) + $signed({{(64 - DC_W){c_dccb[DC_W-1]}}, c_dccb}), 0, MAX_C);
-        cm_ccr = saturate(u64({{(63 - COLOUR_W){1'b0}}, col_cr_b}) + $signed({{(64 - DC_W){c_dccr[DC_W-1]}}, c_dccr}), 0, MAX_C);
-        cm_act_full = a_decayed + ONE_A;  // the decay unit reads port B while committing
-        cm_act = saturate(cm_act_full, 0, MAX_ACT);
-        cm_evc_full = u64({{(63 - EVENTS_IN_INTERVAL_W){1'b0}}, ev_count_b}) + 1;
-        cm_evc = saturate(cm_evc_full, 0, MAX_EVCOUNT);
-        for (cc = 0; cc < P; cc = cc + 1)
-            cm_hist[cc] = u64({{(63 - HIST_W){1'b0}}, hist_b[cc*HIST_W +: HIST_W]});
-        cm_hist[c_class] = min64(cm_hist[c_class] + u64({{(63 - VOTE_W){1'b0}}, c_vote}), H_MAX);
-        cm_halve = cm_hist[c_class] >= H_MAX;
-        for (cc = 0; cc < P; cc = cc + 1)
-            if (cm_halve)
-                cm_hist[cc] = cm_hist[cc] >>> 1;
         cm_bg_y = saturate(u64({{(63 - BACKGROUND_W){1'b0}}, bg_y}) + $signed({{(64 - DB_W){c_dbg_y[DB_W-1]}}, c_dbg_y}), 0, MAX_B);
         cm_bg_cb = saturate(u64({{(63 - BACKGROUND_W){1'b0}}, bg_cb}) + $signed({{(64 - DB_W){c_dbg_cb[DB_W-1]}}, c_dbg_cb}), 0, MAX_B);
         cm_bg_cr = saturate(u64({{(63 - BACKGROUND_W){1'b0}}, bg_cr}) + $signed({{(64 - DB_W){c_dbg_cr[DB_W-1]}}, c_dbg_cr}), 0, MAX_B);
@@ -1057,6 +1009,7 @@ module evclust_core #(
     // (a split's background update waits for its second cycle: the creation's own background step reads the background without it)
     wire do_commit_bg = commit_moment && c_bg_live && !split;
     wire upd_write = do_update && UPDATE_DELAY == 0;  // EXEC writes its update itself
+    wire slot_write = upd_write || do_commit;         // an update lands in slot sw_slot
     // The background learns from every event that is not a reported object's.
     wire signed [63:0] bg_y_next = alpha_step(u64({{(63 - BACKGROUND_W){1'b0}}, bg_y}), u64({{(63 - CW){1'b0}}, e_lum}), K_B_BG, BETA_BG_FRAC, FB, 1'b0);
     wire signed [63:0] bg_cb_next = alpha_step(u64({{(63 - BACKGROUND_W){1'b0}}, bg_cb}), u64({{(63 - CW){1'b0}}, e_cb}), K_B_BG, BETA_BG_FRAC, FB, 1'b0);
@@ -1078,10 +1031,10 @@ module evclust_core #(
     // At most one slot's size is written per cycle (an update, a creation or a merge, each in
     // its own state), so one multiplier per product serves them all, and the interval
     // velocity changes only at a filter step's stage 0 (a merge copies the survivor's product).
-    wire                   size_write = upd_write || do_commit || do_create || m_write;
-    wire [SLOT_W-1:0]      size_slot = m_write ? k : (do_commit ? c_slot : (upd_write ? e_slot : create_slot));
-    wire [HALF_SIZE_W-1:0] size_rx = m_write ? m_rx[HALF_SIZE_W-1:0] : (do_commit ? cm_rx[HALF_SIZE_W-1:0] : (upd_write ? u_rx[HALF_SIZE_W-1:0] : K_R_INIT));
-    wire [HALF_SIZE_W-1:0] size_ry = m_write ? m_ry[HALF_SIZE_W-1:0] : (do_commit ? cm_ry[HALF_SIZE_W-1:0] : (upd_write ? u_ry[HALF_SIZE_W-1:0] : K_R_INIT));
+    wire                   size_write = slot_write || do_create || m_write;
+    wire [SLOT_W-1:0]      size_slot = m_write ? k : (slot_write ? sw_slot : create_slot);
+    wire [HALF_SIZE_W-1:0] size_rx = m_write ? m_rx[HALF_SIZE_W-1:0] : (slot_write ? sw_rx : K_R_INIT);
+    wire [HALF_SIZE_W-1:0] size_ry = m_write ? m_ry[HALF_SIZE_W-1:0] : (slot_write ? sw_ry : K_R_INIT);
     wire [HALF_SIZE_W-1:0] size_r = size_rx > size_ry ? size_rx : size_ry;
     wire signed [63:0]     d_scaled_seek = r64(size_r) * K_SEEK_SCALE;
     wire signed [63:0]     d_reach_x = reach(size_rx, K_SEEK, d_scaled_seek);
@@ -1132,14 +1085,6 @@ module evclust_core #(
     // ---------------------------------------------------------------- status counters
     // What this cycle adds to each counter of evclust_regs, registered into count_inc. The
     // saturations are the model's `_store` sites (fixed_model.py), each counted where it applies.
-    function automatic [1:0] outside;  // 1 if v lies outside [lo, hi]
-        input signed [63:0] v;
-        input signed [63:0] lo;
-        input signed [63:0] hi;
-        begin
-            outside = (v < lo || v > hi) ? 2'd1 : 2'd0;
-        end
-    endfunction
     wire               stage0 = sweep_slot && !f_expire;
     wire               tail_out = tail_en && t_live;
     wire               bg_counts = finish && !(do_update && reported[e_slot]) && K_NOISE_GATE != 0;
@@ -1156,20 +1101,18 @@ module evclust_core #(
         inc[COUNT_EXITS * COUNTER_INC_W +: 2] = {1'b0, tail_out && f_exit};
         inc[COUNT_MERGES * COUNTER_INC_W +: 2] = {1'b0, m_write};
         inc[COUNT_RECORDS * COUNTER_INC_W +: 2] = {1'b0, tail_out && !f_exit && f_report};
-        inc[COUNT_SAT_ACTIVITY * COUNTER_INC_W +: 2] = (upd_write ? outside(u_act_full, 0, MAX_ACT) : 2'd0)
-            + (do_commit ? outside(cm_act_full, 0, MAX_ACT) : 2'd0)
+        inc[COUNT_SAT_ACTIVITY * COUNTER_INC_W +: 2] = (slot_write ? cm_act_saturations : 2'd0)
             + (bg_counts ? outside(bg_counted_full, 0, MAX_ACT) : 2'd0)
             + (m_write ? outside(m_weight, 0, MAX_ACT) : 2'd0);
-        inc[COUNT_SAT_CENTRE_STEP * COUNTER_INC_W +: 2] = do_update ? outside(u_step_x_full, MIN_STEP, MAX_STEP) + outside(u_step_y_full, MIN_STEP, MAX_STEP) : 2'd0;
-        inc[COUNT_SAT_MCM_STEP * COUNTER_INC_W +: 2] = do_update ? outside(u_ux_full, MIN_V, MAX_V) + outside(u_uy_full, MIN_V, MAX_V) : 2'd0;
-        inc[COUNT_SAT_EVENTS_IN_INTERVAL * COUNTER_INC_W +: 2] = (upd_write ? outside(u_evc_full, 0, MAX_EVCOUNT) : 2'd0)
-            + (do_commit ? outside(cm_evc_full, 0, MAX_EVCOUNT) : 2'd0)
+        inc[COUNT_SAT_CENTRE_STEP * COUNTER_INC_W +: 2] = do_update ? up_step_saturations : 2'd0;
+        inc[COUNT_SAT_MCM_STEP * COUNTER_INC_W +: 2] = do_update ? up_mcm_saturations : 2'd0;
+        inc[COUNT_SAT_EVENTS_IN_INTERVAL * COUNTER_INC_W +: 2] = (slot_write ? cm_evc_saturations : 2'd0)
             + (m_write ? outside(m_evc_full, 0, MAX_EVCOUNT) : 2'd0);
         inc[COUNT_SAT_GAMMA * COUNTER_INC_W +: 2] = (stage0 && f_gamma_by_activity ? outside(f_gamma_activity, 0, MAX_GAMMA) : 2'd0)
             + (stage0 && f_gamma_by_count ? outside(f_gamma_count, 0, MAX_GAMMA) : 2'd0);
         inc[COUNT_SAT_V_INT * COUNTER_INC_W +: 2] = stage0 && boundaries != 33'd0 ? outside(f_mx_full, MIN_VI, MAX_VI) + outside(f_my_full, MIN_VI, MAX_VI) : 2'd0;
         inc[COUNT_SAT_V_MCM * COUNTER_INC_W +: 2] = (tail_out && t_correct ? {1'b0, t_over_x} + {1'b0, t_over_y} : 2'd0)
-            + (do_commit ? outside(cm_vmx_full, MIN_V, MAX_V) + outside(cm_vmy_full, MIN_V, MAX_V) : 2'd0);
+            + (do_commit ? cm_vm_saturations : 2'd0);  // (without delay, V's alpha step cannot leave its format)
     end
     assign idle = state == ST_IDLE && !a_valid && !rec_valid && !step_pending;
 
@@ -1178,44 +1121,25 @@ module evclust_core #(
     // slot's, for an update, a merge or the sweep; a creation writes every field).
     assign row_a_slot = state == ST_EXEC ? e_slot : k;
     assign row_b_slot = state == ST_MERGE ? m_j : (commit_reads ? c_slot : t);
-    integer wi;
     always @* begin
-        wi = 0;  // the loops below run only on an update or a commit: no latch for their variable
         row_we = 1'b0;
         row_w_slot = k;
         row_w = row_a;
-        if (upd_write) begin
+        if (slot_write) begin  // an update lands: EXEC's own (port A) or the event before's (port B)
             row_we = 1'b1;
-            row_w_slot = e_slot;
-            row_w[ROW_ACT +: ACTIVITY_W] = u_act[ACTIVITY_W-1:0];
+            row_w_slot = sw_slot;
+            row_w = sw_row;
+            row_w[ROW_ACT +: ACTIVITY_W] = cm_act;
             row_w[ROW_RESIDUAL +: DECAY_RESIDUAL_W] = dec_residual;
-            row_w[ROW_T_LAST +: T_LAST_W] = e_t;
-            row_w[ROW_VMX +: V_MCM_W] = u_vmx[V_MCM_W-1:0];
-            row_w[ROW_VMY +: V_MCM_W] = u_vmy[V_MCM_W-1:0];
-            row_w[ROW_NORM +: MCM_NORM_W] = u_norm[MCM_NORM_W-1:0];
-            row_w[ROW_COL_Y +: COLOUR_W] = u_cy[COLOUR_W-1:0];
-            row_w[ROW_COL_CB +: COLOUR_W] = u_ccb[COLOUR_W-1:0];
-            row_w[ROW_COL_CR +: COLOUR_W] = u_ccr[COLOUR_W-1:0];
-            for (wi = 0; wi < P; wi = wi + 1)
-                row_w[ROW_HIST + wi * HIST_W +: HIST_W] = u_hist[wi][HIST_W-1:0];
-            row_w[ROW_EV_COUNT +: EVENTS_IN_INTERVAL_W] = u_evc[EVENTS_IN_INTERVAL_W-1:0];
-        end
-        if (do_commit) begin  // the event before's increments added to its slot's row (port B)
-            row_we = 1'b1;
-            row_w_slot = c_slot;
-            row_w = row_b;
-            row_w[ROW_ACT +: ACTIVITY_W] = cm_act[ACTIVITY_W-1:0];
-            row_w[ROW_RESIDUAL +: DECAY_RESIDUAL_W] = dec_residual;
-            row_w[ROW_T_LAST +: T_LAST_W] = c_t;
-            row_w[ROW_VMX +: V_MCM_W] = cm_vmx[V_MCM_W-1:0];
-            row_w[ROW_VMY +: V_MCM_W] = cm_vmy[V_MCM_W-1:0];
-            row_w[ROW_NORM +: MCM_NORM_W] = cm_norm[MCM_NORM_W-1:0];
-            row_w[ROW_COL_Y +: COLOUR_W] = cm_cy[COLOUR_W-1:0];
-            row_w[ROW_COL_CB +: COLOUR_W] = cm_ccb[COLOUR_W-1:0];
-            row_w[ROW_COL_CR +: COLOUR_W] = cm_ccr[COLOUR_W-1:0];
-            for (wi = 0; wi < P; wi = wi + 1)
-                row_w[ROW_HIST + wi * HIST_W +: HIST_W] = cm_hist[wi][HIST_W-1:0];
-            row_w[ROW_EV_COUNT +: EVENTS_IN_INTERVAL_W] = cm_evc[EVENTS_IN_INTERVAL_W-1:0];
+            row_w[ROW_T_LAST +: T_LAST_W] = sw_t;
+            row_w[ROW_VMX +: V_MCM_W] = sw_vmx;
+            row_w[ROW_VMY +: V_MCM_W] = sw_vmy;
+            row_w[ROW_NORM +: MCM_NORM_W] = sw_norm;
+            row_w[ROW_COL_Y +: COLOUR_W] = sw_cy;
+            row_w[ROW_COL_CB +: COLOUR_W] = sw_ccb;
+            row_w[ROW_COL_CR +: COLOUR_W] = sw_ccr;
+            row_w[ROW_HIST +: P * HIST_W] = cm_hist;
+            row_w[ROW_EV_COUNT +: EVENTS_IN_INTERVAL_W] = cm_evc;
         end
         if (do_create) begin
             row_we = 1'b1;
@@ -1455,11 +1379,11 @@ module evclust_core #(
                 bg_cb <= cm_bg_cb[BACKGROUND_W-1:0];
                 bg_cr <= cm_bg_cr[BACKGROUND_W-1:0];
             end
-            if (do_commit) begin
-                px[c_slot] <= cm_px[CENTRE_W-1:0];
-                py[c_slot] <= cm_py[CENTRE_W-1:0];
-                rx[c_slot] <= cm_rx[HALF_SIZE_W-1:0];
-                ry[c_slot] <= cm_ry[HALF_SIZE_W-1:0];
+            if (slot_write) begin
+                px[sw_slot] <= sw_px;
+                py[sw_slot] <= sw_py;
+                rx[sw_slot] <= sw_rx;
+                ry[sw_slot] <= sw_ry;
             end
             if (UPDATE_DELAY != 0) begin
                 if (commit_moment) begin
@@ -1492,13 +1416,6 @@ module evclust_core #(
                     c_dbg_cb <= bg_cb_d[DB_W-1:0];
                     c_dbg_cr <= bg_cr_d[DB_W-1:0];
                 end
-            end
-
-            if (upd_write) begin
-                px[e_slot] <= u_px_new[CENTRE_W-1:0];
-                py[e_slot] <= u_py_new[CENTRE_W-1:0];
-                rx[e_slot] <= u_rx[HALF_SIZE_W-1:0];
-                ry[e_slot] <= u_ry[HALF_SIZE_W-1:0];
             end
 
             if (do_create) begin
