@@ -31,6 +31,8 @@ BENCHES = {
     "evclust_seek": ((), TB_DIR.parent / "evclust_seek", "test_evclust_seek"),
     "evclust_slot_ram": ((), TB_DIR.parent / "evclust_slot_ram", "test_evclust_slot_ram"),
     "evclust_top2": ((), TB_DIR.parent / "evclust_top2", "test_evclust_top2"),
+    "evclust_update": ((), TB_DIR.parent / "evclust_update", "test_evclust_update"),
+    "evclust_commit": ((), TB_DIR.parent / "evclust_commit", "test_evclust_commit"),
 }
 
 
