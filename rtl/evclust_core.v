@@ -500,7 +500,11 @@ module evclust_core #(
     );
 
     // The update as the model's _increments computes it (the palette's class and vote above):
-    // each alpha filter's new value and its increment from the slot read at port A.
+    // each alpha filter's new value and its increment from the slot read at port A. With
+    // UPDATE_DELAY = 2 its second half runs a stage later (stage H, below), from a register
+    // loaded as the event finishes (h_load).
+    localparam integer UPDATE_STAGES = UPDATE_DELAY > 1 ? 2 : 1;
+    wire h_load;
     wire [CENTRE_W-1:0]       up_px, up_py;
     wire [HALF_SIZE_W-1:0]    up_rx, up_ry;
     wire [V_MCM_W-1:0]        up_vmx, up_vmy;
@@ -512,7 +516,8 @@ module evclust_core #(
     wire signed [DN_W-1:0]    i_norm;
     wire signed [DC_W-1:0]    i_cy, i_ccb, i_ccr;
     wire [1:0]                up_step_saturations, up_mcm_saturations;
-    evclust_update update (
+    evclust_update #(.STAGES(UPDATE_STAGES)) update (
+        .clk(clk), .advance(h_load),
         .ev_x(e_x), .ev_y(e_y), .lum(e_lum), .cb(e_cb), .cr(e_cr),
         .px(px[e_slot]), .py(py[e_slot]), .rx(rx[e_slot]), .ry(ry[e_slot]), .gamma(gamma_a), .vmx(vmx_a), .vmy(vmy_a), .norm(norm_a),
         .col_y(col_y_a), .col_cb(col_cb_a), .col_cr(col_cr_a),
@@ -544,6 +549,15 @@ module evclust_core #(
     reg [CLASS_W-1:0]      c_class;
     reg [VOTE_W-1:0]       c_vote;
     reg signed [DB_W-1:0]  c_dbg_y, c_dbg_cb, c_dbg_cr;
+    // Stage H (UPDATE_DELAY = 2): the event before's update, its second half being computed
+    // (evclust_update's register holds its operands); it moves to C as the next event finishes,
+    // or in PHASE. The increments C takes are evclust_update's outputs.
+    reg                    h_live, h_bg_live, h_fresh;  // h_fresh: loaded last cycle (its MCM saturations count now)
+    reg [SLOT_W-1:0]       h_slot;
+    reg [EV_T_W-1:0]       h_t;
+    reg [CLASS_W-1:0]      h_class;
+    reg [VOTE_W-1:0]       h_vote;
+    reg signed [DB_W-1:0]  h_dbg_y, h_dbg_cb, h_dbg_cr;
     reg                    creating;  // a creation's second cycle: the first committed the event before
     reg [SLOT_W-1:0]       creating_slot;
     wire commit_moment;  // the event before commits now (the decision logic below)
@@ -890,7 +904,7 @@ module evclust_core #(
     // PHASE until then, so a step's records never follow the next step's mark.
     reg  step_pending;
     assign step_valid = step_pending && !rec_valid;
-    wire phase_hold = step_pending;
+    wire phase_hold = step_pending || (UPDATE_DELAY > 1 && (h_live || h_bg_live));  // (or stage H still to drain through C)
 
     // tau boundaries since the last filter step, from the phase counter (33 bits: a 32-bit time
     // difference plus the phase); T_frame/(n tau), nothing once n reaches 2^FRAME_PER_TAU_W.
@@ -1009,6 +1023,17 @@ module evclust_core #(
     // (a split's background update waits for its second cycle: the creation's own background step reads the background without it)
     wire do_commit_bg = commit_moment && c_bg_live && !split;
     wire upd_write = do_update && UPDATE_DELAY == 0;  // EXEC writes its update itself
+    // What C takes as an event finishes or in PHASE: the update of the event (UPDATE_DELAY = 1),
+    // or stage H's (2), void if this event's creation takes its slot.
+    localparam H_STAGE = UPDATE_DELAY > 1;
+    assign h_load = H_STAGE && finish && !split;
+    wire c_load = UPDATE_DELAY != 0 && ((finish && !split) || (H_STAGE && state == ST_PHASE));
+    wire to_c_live = H_STAGE ? h_live && !(do_create && create_slot == h_slot) : do_update;
+    wire to_c_bg_live = H_STAGE ? h_bg_live : bg_learns;
+    wire [SLOT_W-1:0] to_c_slot = H_STAGE ? h_slot : e_slot;
+    wire [EV_T_W-1:0] to_c_t = H_STAGE ? h_t : e_t;
+    wire [CLASS_W-1:0] to_c_class = H_STAGE ? h_class : vote_class;
+    wire [VOTE_W-1:0] to_c_vote = H_STAGE ? h_vote : vote;
     wire slot_write = upd_write || do_commit;         // an update lands in slot sw_slot
     // The background learns from every event that is not a reported object's.
     wire signed [63:0] bg_y_next = alpha_step(u64({{(63 - BACKGROUND_W){1'b0}}, bg_y}), u64({{(63 - CW){1'b0}}, e_lum}), K_B_BG, BETA_BG_FRAC, FB, 1'b0);
@@ -1105,7 +1130,7 @@ module evclust_core #(
             + (bg_counts ? outside(bg_counted_full, 0, MAX_ACT) : 2'd0)
             + (m_write ? outside(m_weight, 0, MAX_ACT) : 2'd0);
         inc[COUNT_SAT_CENTRE_STEP * COUNTER_INC_W +: 2] = do_update ? up_step_saturations : 2'd0;
-        inc[COUNT_SAT_MCM_STEP * COUNTER_INC_W +: 2] = do_update ? up_mcm_saturations : 2'd0;
+        inc[COUNT_SAT_MCM_STEP * COUNTER_INC_W +: 2] = (H_STAGE ? h_fresh : do_update) ? up_mcm_saturations : 2'd0;
         inc[COUNT_SAT_EVENTS_IN_INTERVAL * COUNTER_INC_W +: 2] = (slot_write ? cm_evc_saturations : 2'd0)
             + (m_write ? outside(m_evc_full, 0, MAX_EVCOUNT) : 2'd0);
         inc[COUNT_SAT_GAMMA * COUNTER_INC_W +: 2] = (stage0 && f_gamma_by_activity ? outside(f_gamma_activity, 0, MAX_GAMMA) : 2'd0)
@@ -1226,6 +1251,19 @@ module evclust_core #(
             seek_w <= {SLOT_W{1'b0}};
             c_live <= 1'b0;
             c_bg_live <= 1'b0;
+            h_live <= 1'b0;
+            h_bg_live <= 1'b0;
+            h_fresh <= 1'b0;
+            // Stage H's fields pass to C whether live or not, and C's slot is the next seek's to
+            // retest when nothing is written: both defined from reset.
+            c_slot <= {SLOT_W{1'b0}};
+            h_slot <= {SLOT_W{1'b0}};
+            h_t <= {EV_T_W{1'b0}};
+            h_class <= {CLASS_W{1'b0}};
+            h_vote <= {VOTE_W{1'b0}};
+            h_dbg_y <= {DB_W{1'b0}};
+            h_dbg_cb <= {DB_W{1'b0}};
+            h_dbg_cr <= {DB_W{1'b0}};
             creating <= 1'b0;
             p_live <= 1'b0;
             boundaries <= 33'd0;
@@ -1372,8 +1410,9 @@ module evclust_core #(
             else if (a_advance)
                 a_valid <= 1'b0;
 
-            // The commit (UPDATE_DELAY = 1): the event before's increments land; this event's
-            // are kept. A creation's split first cycle commits; its second finishes.
+            // The commit (UPDATE_DELAY >= 1): the oldest update in flight (C) lands; C takes the
+            // next (this event's, or stage H's while H takes this event's). A creation's split
+            // first cycle commits; its second finishes.
             if (do_commit_bg) begin
                 bg_y <= cm_bg_y[BACKGROUND_W-1:0];
                 bg_cb <= cm_bg_cb[BACKGROUND_W-1:0];
@@ -1396,25 +1435,43 @@ module evclust_core #(
                     creating_slot <= e_free_slot;
                 end else if (finish) begin
                     creating <= 1'b0;
-                    c_live <= do_update;
-                    c_bg_live <= bg_learns;
-                    c_slot <= e_slot;
-                    c_t <= e_t;
-                    c_dpx <= i_px[DP_W-1:0];
-                    c_dpy <= i_py[DP_W-1:0];
-                    c_drx <= i_rx[DR_W-1:0];
-                    c_dry <= i_ry[DR_W-1:0];
-                    c_dvmx <= i_vmx[DV_W-1:0];
-                    c_dvmy <= i_vmy[DV_W-1:0];
-                    c_dnorm <= i_norm[DN_W-1:0];
-                    c_dcy <= i_cy[DC_W-1:0];
-                    c_dccb <= i_ccb[DC_W-1:0];
-                    c_dccr <= i_ccr[DC_W-1:0];
-                    c_class <= vote_class;
-                    c_vote <= vote;
-                    c_dbg_y <= bg_y_d[DB_W-1:0];
-                    c_dbg_cb <= bg_cb_d[DB_W-1:0];
-                    c_dbg_cr <= bg_cr_d[DB_W-1:0];
+                end
+                if (c_load) begin
+                    c_live <= to_c_live;
+                    c_bg_live <= to_c_bg_live;
+                    c_slot <= to_c_slot;
+                    c_t <= to_c_t;
+                    c_dpx <= i_px;
+                    c_dpy <= i_py;
+                    c_drx <= i_rx;
+                    c_dry <= i_ry;
+                    c_dvmx <= i_vmx;
+                    c_dvmy <= i_vmy;
+                    c_dnorm <= i_norm;
+                    c_dcy <= i_cy;
+                    c_dccb <= i_ccb;
+                    c_dccr <= i_ccr;
+                    c_class <= to_c_class;
+                    c_vote <= to_c_vote;
+                    c_dbg_y <= H_STAGE ? h_dbg_y : bg_y_d[DB_W-1:0];
+                    c_dbg_cb <= H_STAGE ? h_dbg_cb : bg_cb_d[DB_W-1:0];
+                    c_dbg_cr <= H_STAGE ? h_dbg_cr : bg_cr_d[DB_W-1:0];
+                end
+                h_fresh <= h_load && do_update;
+                if (H_STAGE && state == ST_PHASE) begin  // the filter step drains H through C
+                    h_live <= 1'b0;
+                    h_bg_live <= 1'b0;
+                end
+                if (h_load) begin
+                    h_live <= do_update;
+                    h_bg_live <= bg_learns;
+                    h_slot <= e_slot;
+                    h_t <= e_t;
+                    h_class <= vote_class;
+                    h_vote <= vote;
+                    h_dbg_y <= bg_y_d[DB_W-1:0];
+                    h_dbg_cb <= bg_cb_d[DB_W-1:0];
+                    h_dbg_cr <= bg_cr_d[DB_W-1:0];
                 end
             end
 

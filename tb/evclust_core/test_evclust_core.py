@@ -433,16 +433,17 @@ def test_random_streams_match_the_model_in_the_loop(sim, preset, n_clusters):
     assert result["records"] > 0, "a stream that reports nothing checks little"
 
 
-@pytest.mark.parametrize("preset", ["small", "defaults"])
+@pytest.mark.parametrize("preset, delay", [("small", 2), ("defaults", 1), ("defaults", 2)])
 @pytest.mark.parametrize("sim", SIMS)
-def test_the_pipelined_core_matches_the_model_in_the_loop_through_gaps_and_stalls(sim, preset):
-    # update_delay = 1: each update commits as the next event finishes. The pipeline is
-    # event-clocked, so the stream's random gaps and output stalls must not change what it computes.
+def test_the_pipelined_core_matches_the_model_in_the_loop_through_gaps_and_stalls(sim, preset, delay):
+    # update_delay = 1: each update commits as the next event finishes; 2: as the one after
+    # finishes, its second half computed a stage later. The pipeline is event-clocked, so the
+    # stream's random gaps and output stalls must not change what it computes.
     from cosim import configuration_params
 
-    seed = int(os.environ.get("EVCLUST_SEED", 1000)) + 7
+    seed = int(os.environ.get("EVCLUST_SEED", 1000)) + 7 + delay
     count = _stream_length(sim, preset, 10_000)
-    params = configuration_params(preset, 16).model_copy(update={"update_delay": 1})
+    params = configuration_params(preset, 16).model_copy(update={"update_delay": delay})
     header, config = _random_config(preset, 16, seed=seed, count=count, params=params)
     result = run(sim, header, "model_in_the_loop", config)
     assert result["events"] == count

@@ -8,6 +8,11 @@ V's format), colours over theirs. Half the cases use the build's constants, half
 each register's width (the module's constants are run-time registers). Each case checks every
 increment, every new value (the state read plus its increment, the size clamped) and the two
 saturation counts the status counters add.
+
+With STAGES = 2 (the core with update_delay = 2) the same cases go through the pipeline register:
+each case's step saturations are read in its own cycle (stage 1); after an edge with `advance`,
+the inputs move to another case's and the increments and MCM saturations read must still be the
+captured case's (stage 2 reads only its register); an edge without `advance` must keep them.
 """
 
 from __future__ import annotations
@@ -132,22 +137,56 @@ if cocotb is not None:
         model = make_model(config["build"])
         header = Path(config["header"]).read_text()
         signed = {"vmx", "vmy", "vmx_new", "vmy_new"} | {increment for increment, *_ in OUTPUTS}
-        checked = 0
-        for k, S, s, event in cases(model, header, config["seed"]):
-            for port, slot, _ in CONSTANTS:
-                getattr(dut, port).value = int(k[getattr(fixed_model, slot)])
+        rng = random.Random(config["seed"])
+        all_cases = list(cases(model, header, config["seed"]))
+        pipelined = config["stages"] == 2
+        stage2 = {"mcm_saturations"} | {increment for increment, *_ in OUTPUTS}
+
+        def apply(k, S, s, event, constants=True):
+            if constants:
+                for port, slot, _ in CONSTANTS:
+                    getattr(dut, port).value = int(k[getattr(fixed_model, slot)])
             for port, column in FIELDS:
-                value, bits = int(S[s, getattr(layout, column)]), len(getattr(dut, port))
-                getattr(dut, port).value = value & ((1 << bits) - 1)
+                getattr(dut, port).value = int(S[s, getattr(layout, column)]) & ((1 << len(getattr(dut, port))) - 1)
             for port, value in zip(("ev_x", "ev_y", "lum", "cb", "cr"), event):
                 getattr(dut, port).value = value
+
+        def read(names):
+            return {name: getattr(dut, name).value.to_signed() if name in signed else int(getattr(dut, name).value) for name in names}
+
+        async def edge(advance: int):
+            dut.advance.value = advance
+            dut.clk.value = 1
             await Timer(1, unit="ns")
+            dut.clk.value = 0
+            dut.advance.value = 0
+            await Timer(1, unit="ns")
+
+        def mismatch(S, s, event, got, want):
+            diff = {name: (got[name], want[name]) for name in want if got[name] != want[name]}
+            return f"slot {S[s].tolist()}, event {event}: (RTL, model) {diff}" if diff else None
+
+        dut.clk.value, dut.advance.value = 0, 0
+        checked = 0
+        for k, S, s, event in all_cases:
             want = model_update(model, k, S, s, event)
-            got = {name: getattr(dut, name).value.to_signed() if name in signed else int(getattr(dut, name).value) for name in want}
+            apply(k, S, s, event)
+            await Timer(1, unit="ns")
+            if not pipelined:
+                error = mismatch(S, s, event, read(want), want)
+            else:
+                error = mismatch(S, s, event, read({"step_saturations"}), {"step_saturations": want["step_saturations"]})
+                if error is None:
+                    await edge(1)
+                    apply(*rng.choice(all_cases), constants=False)  # stage 1 moves on; stage 2 must not
+                    await Timer(1, unit="ns")
+                    error = mismatch(S, s, event, read(stage2), {name: want[name] for name in stage2})
+                if error is None and rng.random() < 0.2:
+                    await edge(0)  # no advance: the register keeps its case
+                    error = mismatch(S, s, event, read(stage2), {name: want[name] for name in stage2})
             checked += 1
-            if got != want:
-                diff = {name: (got[name], want[name]) for name in want if got[name] != want[name]}
-                return f"slot {S[s].tolist()}, event {event}: (RTL, model) {diff}", checked
+            if error:
+                return error, checked
         return None, checked
 
 
@@ -157,13 +196,14 @@ if cocotb is not None:
 from cosim import run, selected_simulators  # noqa: E402
 
 
-@pytest.mark.parametrize("build", sorted(BUILDS))
+@pytest.mark.parametrize("build, stages", [("traffic", 1), ("defaults", 1), ("defaults", 2)])
 @pytest.mark.parametrize("sim", selected_simulators())
-def test_the_update_gives_the_models_increments_and_new_values(sim, build):
+def test_the_update_gives_the_models_increments_and_new_values(sim, build, stages):
     from evclust.fixed.formats import verilog_header
 
     header = verilog_header(make_model(build).table)
-    result = run(sim, header, "update_vectors", {"build": build, "seed": 11}, toplevel="evclust_update")
+    result = run(sim, header, "update_vectors", {"build": build, "seed": 11, "stages": stages}, toplevel="evclust_update",
+                 parameters={"STAGES": stages})  # fmt: skip
     assert result["checked"] == CASES
 
 

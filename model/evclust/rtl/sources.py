@@ -21,7 +21,7 @@ def require_repository() -> None:
         raise EvclustError(f"{missing[0]}: the RTL is not here; run from a clone of the evclust repository (pip install -e .)")
 
 
-RTL_UPDATE_DELAYS = (0, 1)  # the pipeline semantics evclust_core implements (its UPDATE_DELAY)
+RTL_UPDATE_DELAYS = (0, 1, 2)  # the pipeline semantics evclust_core implements (its UPDATE_DELAY)
 
 
 def require_rtl_semantics(params) -> None:

@@ -418,34 +418,34 @@ def suite_clip() -> Case:
                 sim.meta.t_frame_us, ClustererParams(), f"evclust scenes --generate {seed}", seed)  # fmt: skip
 
 
-def _pipelined(case: Case, what: str) -> Case:
-    """A case with the pipeline semantics of a core that commits each update one event later
-    (update_delay = 1, docs/DESIGN.md "Pipeline semantics")."""
-    return dataclasses.replace(case, description=f"{case.description}; update_delay = 1: {what}",
-                               params=case.params.model_copy(update={"update_delay": 1}))  # fmt: skip
+def _pipelined(case: Case, what: str, delay: int) -> Case:
+    """A case with the pipeline semantics of a core that commits each update `delay` events later
+    (update_delay, docs/DESIGN.md "Pipeline semantics")."""
+    return dataclasses.replace(case, description=f"{case.description}; update_delay = {delay}: {what}",
+                               params=case.params.model_copy(update={"update_delay": delay}))  # fmt: skip
 
 
 def pipelined_traffic() -> Case:
-    return _pipelined(traffic_clip(), "every update committed as the next event finishes, creations split around a commit, "
-                                      "the commit before each filter step")  # fmt: skip
+    return _pipelined(traffic_clip(), "every update committed two events later (its second half a stage behind), creations "
+                                      "split around a commit, two commits draining before each filter step", delay=2)  # fmt: skip
 
 
 def pipelined_table_full() -> Case:
-    return _pipelined(table_full(), "evictions and drops with an update in flight")
+    return _pipelined(table_full(), "evictions and drops with an update in flight", delay=1)
 
 
 def pipelined_eviction_voids() -> Case:
-    # One slot. A spot's last update is still in flight when, after 8 ms of silence, a far event
-    # evicts the spot's weak cluster: the update is void, and the new cluster starts clean.
+    # One slot. A spot's last two updates are still in flight when, after 8 ms of silence, a far
+    # event evicts the spot's weak cluster: both updates are void, and the new cluster starts clean.
     rows, t = [], 1000
     for x, y, count, gap in ((10, 10, 40, 8000), (50, 38, 40, 8000), (20, 30, 40, 0)):
         for i in range(count):
             rows.append((t, x + i % 2, y + i // 2 % 2, 200, 90, 160))
             t += 10
         t += gap
-    return Case("a one-slot table whose cluster is evicted while its last update is in flight, twice; update_delay = 1",
+    return Case("a one-slot table whose cluster is evicted while its last two updates are in flight, twice; update_delay = 2",
                 _events(rows), **SMALL, params=_small_params(n_clusters=1, t_half_us=2000.0, a_valid=6.0, filter_every=64,
-                                                             update_delay=1), source="directed")  # fmt: skip
+                                                             update_delay=2), source="directed")  # fmt: skip
 
 
 def file_case(path: str | Path, max_events: int, params: ClustererParams, t_frame_us: float | None = None) -> Case:
