@@ -7,7 +7,7 @@ What users build: the core with its run-time registers (RUNTIME_CONFIG = 1) for 
 on 480x270, each run `configuration:N`: `defaults` (the default parameters, every one-cluster-per-
 object addition on but the creation-support map, which a device keeps in block RAM), `traffic`
 or `paper` (the presets), and `defaults_pipelined` or `paper_pipelined` (the same with
-update_delay = 1: each update committed one event later). Results are cached by content in build/timing/ (the flow is
+update_delay = 1: each update committed one event later) and `*_pipelined2` (update_delay = 2). Results are cached by content in build/timing/ (the flow is
 `evclust.rtl.timing`'s), so a rerun with the RTL and header unchanged takes no time.
 """
 
@@ -27,10 +27,13 @@ from synth import defaults_header, params_header  # noqa: E402
 ROOT = Path(__file__).resolve().parents[1]
 START, END = "<!-- bench:timing:start -->", "<!-- bench:timing:end -->"
 RUNS = ["defaults:16", "defaults:64", "paper:16"]
-# `*_pipelined`: the same with update_delay = 1, each update committed one event later (docs/RTL.md).
+# `*_pipelined`: the same with update_delay = 1, each update committed one event later;
+# `*_pipelined2`: update_delay = 2, the update's second half a stage later (docs/RTL.md).
 HEADERS = {"defaults": defaults_header, "traffic": params_header, "paper": lambda n: params_header(n, "paper"),
            "defaults_pipelined": lambda n: defaults_header(n, update_delay=1),
-           "paper_pipelined": lambda n: params_header(n, "paper", update_delay=1)}  # fmt: skip
+           "paper_pipelined": lambda n: params_header(n, "paper", update_delay=1),
+           "defaults_pipelined2": lambda n: defaults_header(n, update_delay=2),
+           "paper_pipelined2": lambda n: params_header(n, "paper", update_delay=2)}  # fmt: skip
 
 
 def command() -> str:

@@ -18,7 +18,7 @@ from evclust.clusterer import ClustererParams
 from evclust.suite.aggregate import figures
 from evclust.suite.report import Configuration, SuiteRun, commands_section, save_page
 
-DELAYS = (1, 4, 8, 16)  # events in flight: the RTL's (1), and the depths a deeper pipeline may take
+DELAYS = (1, 2, 4, 8, 16)  # events in flight: the RTL's (1, 2), and the depths a deeper pipeline may take
 # The defaults, and each nudged by far less than any tuning step: a fair sample of "the same"
 # configuration, over which a delay's effect is averaged.
 PERTURBATIONS = {
