@@ -292,13 +292,13 @@ module evclust_core #(
     localparam integer ROW_HIST = ROW_COL_CR + COLOUR_W;  // entry c at ROW_HIST + c * HIST_W
     localparam integer ROW_W = ROW_HIST + P * HIST_W;
     wire [SLOT_W-1:0] row_a_slot, row_b_slot;
-    wire [ROW_W-1:0]  row_a, row_b;
+    wire [ROW_W-1:0]  row_a, row_b, row_e;
     reg               row_we;
     reg  [SLOT_W-1:0] row_w_slot;
     reg  [ROW_W-1:0]  row_w;
     evclust_slot_ram #(.DEPTH(N), .WIDTH(ROW_W), .ADDR_W(SLOT_W)) slot_rows (
         .clk(clk), .we(row_we), .waddr(row_w_slot), .wdata(row_w),
-        .raddr_a(row_a_slot), .rdata_a(row_a), .raddr_b(row_b_slot), .rdata_b(row_b)
+        .raddr_a(row_a_slot), .rdata_a(row_a), .raddr_b(row_b_slot), .rdata_b(row_b), .raddr_e(e_slot), .rdata_e(row_e)
     );
     wire [ID_W-1:0]                 id_b = row_b[ROW_ID +: ID_W];  // (port A's id: a merge copies the whole row)
     wire [CENTRE_W-1:0]             ppx_a = row_a[ROW_PPX +: CENTRE_W], ppx_b = row_b[ROW_PPX +: CENTRE_W];
@@ -311,9 +311,9 @@ module evclust_core #(
     wire [V_MCM_W-1:0]              vmy_a = row_a[ROW_VMY +: V_MCM_W], vmy_b = row_b[ROW_VMY +: V_MCM_W];
     wire [MCM_NORM_W-1:0]           norm_a = row_a[ROW_NORM +: MCM_NORM_W];
     wire [EVENTS_IN_INTERVAL_W-1:0] ev_count_a = row_a[ROW_EV_COUNT +: EVENTS_IN_INTERVAL_W], ev_count_b = row_b[ROW_EV_COUNT +: EVENTS_IN_INTERVAL_W];
-    wire [COLOUR_W-1:0]             col_y_a = row_a[ROW_COL_Y +: COLOUR_W], col_y_b = row_b[ROW_COL_Y +: COLOUR_W];
-    wire [COLOUR_W-1:0]             col_cb_a = row_a[ROW_COL_CB +: COLOUR_W], col_cb_b = row_b[ROW_COL_CB +: COLOUR_W];
-    wire [COLOUR_W-1:0]             col_cr_a = row_a[ROW_COL_CR +: COLOUR_W], col_cr_b = row_b[ROW_COL_CR +: COLOUR_W];
+    wire [COLOUR_W-1:0]             col_y_b = row_b[ROW_COL_Y +: COLOUR_W];
+    wire [COLOUR_W-1:0]             col_cb_b = row_b[ROW_COL_CB +: COLOUR_W];
+    wire [COLOUR_W-1:0]             col_cr_b = row_b[ROW_COL_CR +: COLOUR_W];
     wire [P*HIST_W-1:0]             hist_b = row_b[ROW_HIST +: P * HIST_W];
 
     // ---------------------------------------------------------------- globals
@@ -504,6 +504,7 @@ module evclust_core #(
     // UPDATE_DELAY = 2 its second half runs a stage later (stage H, below), from a register
     // loaded as the event finishes (h_load).
     localparam integer UPDATE_STAGES = UPDATE_DELAY > 1 ? 2 : 1;
+    wire [ROW_W-1:0] row_u = UPDATE_DELAY == 0 ? row_a : row_e;  // the event's slot's row (port E when delayed)
     wire h_load;
     wire [CENTRE_W-1:0]       up_px, up_py;
     wire [HALF_SIZE_W-1:0]    up_rx, up_ry;
@@ -519,8 +520,9 @@ module evclust_core #(
     evclust_update #(.STAGES(UPDATE_STAGES)) update (
         .clk(clk), .advance(h_load),
         .ev_x(e_x), .ev_y(e_y), .lum(e_lum), .cb(e_cb), .cr(e_cr),
-        .px(px[e_slot]), .py(py[e_slot]), .rx(rx[e_slot]), .ry(ry[e_slot]), .gamma(gamma_a), .vmx(vmx_a), .vmy(vmy_a), .norm(norm_a),
-        .col_y(col_y_a), .col_cb(col_cb_a), .col_cr(col_cr_a),
+        .px(px[e_slot]), .py(py[e_slot]), .rx(rx[e_slot]), .ry(ry[e_slot]), .gamma(row_u[ROW_GAMMA +: GAMMA_W]),
+        .vmx(row_u[ROW_VMX +: V_MCM_W]), .vmy(row_u[ROW_VMY +: V_MCM_W]), .norm(row_u[ROW_NORM +: MCM_NORM_W]),
+        .col_y(row_u[ROW_COL_Y +: COLOUR_W]), .col_cb(row_u[ROW_COL_CB +: COLOUR_W]), .col_cr(row_u[ROW_COL_CR +: COLOUR_W]),
         .beta_pos(cfg_beta_pos), .size_gain(cfg_size_gain), .beta_size(cfg_beta_size), .r_min(cfg_r_min), .r_max(cfg_r_max),
         .beta_vel_mcm(cfg_beta_vel_mcm), .beta_lum(cfg_beta_lum), .beta_chro(cfg_beta_chro),
         .px_new(up_px), .py_new(up_py), .rx_new(up_rx), .ry_new(up_ry), .vmx_new(up_vmx), .vmy_new(up_vmy), .norm_new(up_norm),
@@ -1144,7 +1146,9 @@ module evclust_core #(
     // ---------------------------------------------------------------- the slot row's write port
     // One writer per cycle; the fields it leaves keep their value, read at port A (the written
     // slot's, for an update, a merge or the sweep; a creation writes every field).
-    assign row_a_slot = state == ST_EXEC ? e_slot : k;
+    // A delayed update reads its slot at port E, so port A's address (the scan, the sweep, a
+    // merge) does not hang on the event's search; without delay EXEC decays at port A.
+    assign row_a_slot = state == ST_EXEC && UPDATE_DELAY == 0 ? e_slot : k;
     assign row_b_slot = state == ST_MERGE ? m_j : (commit_reads ? c_slot : t);
     always @* begin
         row_we = 1'b0;
