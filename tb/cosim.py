@@ -70,6 +70,29 @@ def random_config(name: str, n_clusters: int, seed: int, count: int, formats: di
     return header, config
 
 
+# The builds the step-3 leaf benches (tb/evclust_update, tb/evclust_commit) run: the traffic
+# preset and the defaults on a suite-sized sensor, N = 4 (the modules are per slot).
+LEAF_BUILDS = {"traffic": (480, 270, 50000.0), "defaults": (160, 120, 16666.0)}
+
+
+def leaf_model(build: str):
+    """The fixed model of a LEAF_BUILDS build: its formats, constants and globals are what the
+    leaf benches drive the module with and compare against."""
+    from evclust.clusterer import ClustererParams, load_params
+    from evclust.fixed.model import FixedClusterer
+
+    width, height, t_frame = LEAF_BUILDS[build]
+    params = ClustererParams(n_clusters=4) if build == "defaults" else load_params(build)[0].model_copy(update={"n_clusters": 4})
+    return FixedClusterer(params, width, height, t_frame)
+
+
+def header_width(header: str, name: str) -> int:
+    """A `localparam integer` of an evclust_params.vh: what a module's ports are sized by."""
+    import re
+
+    return int(re.search(rf"localparam integer {name} = (\d+);", header).group(1))
+
+
 async def checked_vectors(dut, body) -> None:
     """A unit testbench's cocotb side: `await body(dut, config)` gives (error or None, cases
     checked); both go where the pytest side reads them (config["out"]), and an error fails the test."""

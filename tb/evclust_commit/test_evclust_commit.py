@@ -14,7 +14,6 @@ commit writes and the three saturation counts the status counters add.
 from __future__ import annotations
 
 import random
-import re
 import sys
 from pathlib import Path
 
@@ -26,13 +25,12 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 try:
     import cocotb
 
-    from cosim import checked_vectors
+    from cosim import checked_vectors, header_width, leaf_model
     from cocotb.triggers import Timer
 except ImportError:  # collected by pytest without cocotb: the pytest half still reports why
     cocotb = None
 
 CASES = 3000
-BUILDS = {"traffic": (480, 270, 50000.0), "defaults": (160, 120, 16666.0)}
 # The fields the commit adds to: (state port, increment port, output port, layout column,
 # delay-line column, increment width name in the header).
 SUMS = (("px", "d_px", "px_out", "PX", "PD_PX", "CENTRE_W"), ("py", "d_py", "py_out", "PY", "PD_PY", "CENTRE_W"),
@@ -44,9 +42,6 @@ SUMS = (("px", "d_px", "px_out", "PX", "PD_PX", "CENTRE_W"), ("py", "d_py", "py_
 SIGNED = {"vmx", "vmy", "vmx_out", "vmy_out"} | {increment for _, increment, *_ in SUMS}
 
 
-def header_width(header: str, name: str) -> int:
-    return int(re.search(rf"localparam integer {name} = (\d+);", header).group(1))
-
 
 def increment_bits(header: str, width: str | None) -> int:
     """An increment's width as evclust_increments.vh declares it: its field's and a sign (the
@@ -55,14 +50,6 @@ def increment_bits(header: str, width: str | None) -> int:
         return max(header_width(header, "SIZE_TARGET_W"), header_width(header, "HALF_SIZE_W")) + 1
     return header_width(header, width) + 1
 
-
-def make_model(build: str):
-    from evclust.clusterer import ClustererParams, load_params
-    from evclust.fixed.model import FixedClusterer
-
-    width, height, t_frame = BUILDS[build]
-    params = ClustererParams(n_clusters=4) if build == "defaults" else load_params(build)[0].model_copy(update={"n_clusters": 4})
-    return FixedClusterer(params, width, height, t_frame)
 
 
 def cases(model, header: str, seed: int):
@@ -133,7 +120,7 @@ if cocotb is not None:
         from evclust.clusterer import layout
         from evclust.fixed import fixed_model
 
-        model = make_model(config["build"])
+        model = leaf_model(config["build"])
         header = Path(config["header"]).read_text()
         hist_bits = model.table["hist"].word_bits
         dut.r_min.value = int(model.k[fixed_model.C_R_MIN])
@@ -162,15 +149,15 @@ if cocotb is not None:
 # ------------------------------------------------------------------------------------------
 # pytest: build, launch, check.
 
-from cosim import run, selected_simulators  # noqa: E402
+from cosim import LEAF_BUILDS, header_width, leaf_model, run, selected_simulators  # noqa: E402
 
 
-@pytest.mark.parametrize("build", sorted(BUILDS))
+@pytest.mark.parametrize("build", sorted(LEAF_BUILDS))
 @pytest.mark.parametrize("sim", selected_simulators())
 def test_the_commit_lands_an_update_as_the_model_does(sim, build):
     from evclust.fixed.formats import verilog_header
 
-    header = verilog_header(make_model(build).table)
+    header = verilog_header(leaf_model(build).table)
     result = run(sim, header, "commit_vectors", {"build": build, "seed": 13}, toplevel="evclust_commit")
     assert result["checked"] == CASES
 
@@ -181,7 +168,7 @@ def test_the_cases_reach_every_saturation_and_the_halving():
     from evclust.clusterer import layout
     from evclust.fixed.formats import verilog_header
 
-    model = make_model("traffic")
+    model = leaf_model("traffic")
     header = verilog_header(model.table)
     outs, low, high, halved = [], set(), set(), 0
     hist_top = (1 << model.table["hist"].word_bits) - 1

@@ -18,7 +18,6 @@ captured case's (stage 2 reads only its register); an edge without `advance` mus
 from __future__ import annotations
 
 import random
-import re
 import sys
 from pathlib import Path
 
@@ -30,14 +29,12 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 try:
     import cocotb
 
-    from cosim import checked_vectors
+    from cosim import checked_vectors, header_width, leaf_model
     from cocotb.triggers import Timer
 except ImportError:  # collected by pytest without cocotb: the pytest half still reports why
     cocotb = None
 
 CASES = 3000
-# The builds: (width, height, T_frame) and whether the parameters are the preset's or the defaults.
-BUILDS = {"traffic": (480, 270, 50000.0), "defaults": (160, 120, 16666.0)}
 # The module's constant ports: (port, the model's constant slot name, register width in the header).
 CONSTANTS = (("beta_pos", "C_B_POS", "CFG_BETA_POS_W"), ("size_gain", "C_GAIN", "CFG_SIZE_GAIN_W"),
              ("beta_size", "C_B_SIZE", "CFG_BETA_SIZE_W"), ("r_min", "C_R_MIN", "CFG_R_MIN_W"),
@@ -53,18 +50,6 @@ OUTPUTS = (("d_px", "px_new", "PD_PX", "PX"), ("d_py", "py_new", "PD_PY", "PY"),
            ("d_col_cb", "col_cb_new", "PD_CCB", "CCB"), ("d_col_cr", "col_cr_new", "PD_CCR", "CCR"))  # fmt: skip
 
 
-def header_width(header: str, name: str) -> int:
-    """A localparam integer of the header: what the module's ports are sized by."""
-    return int(re.search(rf"localparam integer {name} = (\d+);", header).group(1))
-
-
-def make_model(build: str):
-    from evclust.clusterer import ClustererParams, load_params
-    from evclust.fixed.model import FixedClusterer
-
-    width, height, t_frame = BUILDS[build]
-    params = ClustererParams(n_clusters=4) if build == "defaults" else load_params(build)[0].model_copy(update={"n_clusters": 4})
-    return FixedClusterer(params, width, height, t_frame)
 
 
 def cases(model, header: str, seed: int):
@@ -134,7 +119,7 @@ if cocotb is not None:
         from evclust.clusterer import layout
         from evclust.fixed import fixed_model
 
-        model = make_model(config["build"])
+        model = leaf_model(config["build"])
         header = Path(config["header"]).read_text()
         signed = {"vmx", "vmy", "vmx_new", "vmy_new"} | {increment for increment, *_ in OUTPUTS}
         rng = random.Random(config["seed"])
@@ -193,7 +178,7 @@ if cocotb is not None:
 # ------------------------------------------------------------------------------------------
 # pytest: build, launch, check.
 
-from cosim import run, selected_simulators  # noqa: E402
+from cosim import LEAF_BUILDS, header_width, leaf_model, run, selected_simulators  # noqa: E402
 
 
 @pytest.mark.parametrize("build, stages", [("traffic", 1), ("defaults", 1), ("defaults", 2)])
@@ -201,7 +186,7 @@ from cosim import run, selected_simulators  # noqa: E402
 def test_the_update_gives_the_models_increments_and_new_values(sim, build, stages):
     from evclust.fixed.formats import verilog_header
 
-    header = verilog_header(make_model(build).table)
+    header = verilog_header(leaf_model(build).table)
     result = run(sim, header, "update_vectors", {"build": build, "seed": 11, "stages": stages}, toplevel="evclust_update",
                  parameters={"STAGES": stages})  # fmt: skip
     assert result["checked"] == CASES
@@ -212,7 +197,7 @@ def test_the_cases_saturate_and_clamp():
     format, the size clamped at R_min and at R_max, and increments of both signs."""
     from evclust.fixed.formats import verilog_header
 
-    model = make_model("traffic")
+    model = leaf_model("traffic")
     header = verilog_header(model.table)
     outs = []
     for k, S, s, event in cases(model, header, 11):
