@@ -1027,7 +1027,7 @@ module evclust_core #(
     wire upd_write = do_update && UPDATE_DELAY == 0;  // EXEC writes its update itself
     // What C takes as an event finishes or in PHASE: the update of the event (UPDATE_DELAY = 1),
     // or stage H's (2), void if this event's creation takes its slot.
-    localparam H_STAGE = UPDATE_DELAY > 1;
+    localparam H_STAGE = UPDATE_STAGES == 2;  // stage H exists: the update's second half a stage later
     assign h_load = H_STAGE && finish && !split;
     wire c_load = UPDATE_DELAY != 0 && ((finish && !split) || (H_STAGE && state == ST_PHASE));
     wire to_c_live = H_STAGE ? h_live && !(do_create && create_slot == h_slot) : do_update;
