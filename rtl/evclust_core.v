@@ -539,6 +539,7 @@ module evclust_core #(
     // the next event reads the table without them, and the sums leave EXEC's recurrence. The
     // commit reads its slot's row at port B. UPDATE_DELAY = 0: EXEC writes the update itself,
     // the alpha filters' new values and the commit's counts on the row it read at port A.
+    // UPDATE_DELAY = 2: the same, the update passing through stage H first (below).
     localparam signed [63:0] MAX_B = (64'sd1 <<< BACKGROUND_W) - 1;
     reg                    c_live, c_bg_live;  // a slot update, a background update in flight
     reg [SLOT_W-1:0]       c_slot;
@@ -979,7 +980,7 @@ module evclust_core #(
     reg [SLOT_W-1:0] create_slot;
     reg [2:0]        action;
     reg [SLOT_W-1:0] action_slot;
-    // split (UPDATE_DELAY = 1): a creation while the event before is still to commit takes two
+    // split (UPDATE_DELAY >= 1): a creation while an update is due to commit (C) takes two
     // cycles, the commit in the first (one write port), the creation, as decided, in the second.
     always @* begin
         do_update = 1'b0;
@@ -1041,7 +1042,7 @@ module evclust_core #(
     wire signed [63:0] bg_y_next = alpha_step(u64({{(63 - BACKGROUND_W){1'b0}}, bg_y}), u64({{(63 - CW){1'b0}}, e_lum}), K_B_BG, BETA_BG_FRAC, FB, 1'b0);
     wire signed [63:0] bg_cb_next = alpha_step(u64({{(63 - BACKGROUND_W){1'b0}}, bg_cb}), u64({{(63 - CW){1'b0}}, e_cb}), K_B_BG, BETA_BG_FRAC, FB, 1'b0);
     wire signed [63:0] bg_cr_next = alpha_step(u64({{(63 - BACKGROUND_W){1'b0}}, bg_cr}), u64({{(63 - CW){1'b0}}, e_cr}), K_B_BG, BETA_BG_FRAC, FB, 1'b0);
-    wire signed [63:0] bg_y_d = bg_y_next - u64({{(63 - BACKGROUND_W){1'b0}}, bg_y});  // its increments (UPDATE_DELAY = 1)
+    wire signed [63:0] bg_y_d = bg_y_next - u64({{(63 - BACKGROUND_W){1'b0}}, bg_y});  // its increments (UPDATE_DELAY >= 1)
     wire signed [63:0] bg_cb_d = bg_cb_next - u64({{(63 - BACKGROUND_W){1'b0}}, bg_cb});
     wire signed [63:0] bg_cr_d = bg_cr_next - u64({{(63 - BACKGROUND_W){1'b0}}, bg_cr});
     wire signed [63:0] gamma_new = gamma_from_activity(ONE_A, gamma_mode, K_GAMMA_GLOBAL, K_GPA);
