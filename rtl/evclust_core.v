@@ -483,12 +483,17 @@ module evclust_core #(
     end
 
     // ---------------------------------------------------------------- step 3: the update
+    // With UPDATE_DELAY = 2 the palette's and the update's second halves run in stage H, from
+    // registers loaded as the event finishes (h_load).
+    localparam integer UPDATE_STAGES = UPDATE_DELAY > 1 ? 2 : 1;
+    wire h_load;
     wire [CLASS_W-1:0] vote_class;
     wire [VOTE_W-1:0]  vote;
     evclust_palette #(
         .P(P), .CLASS_W(CLASS_W), .BG_BITS(BACKGROUND_W), .INV_BITS(INV_WW_W), .VOTE_BITS(VOTE_W),
-        .LUMA_BITS(LUMA_WEIGHT_W), .TOL_BITS(MIXING_TOLERANCE_W)
+        .LUMA_BITS(LUMA_WEIGHT_W), .TOL_BITS(MIXING_TOLERANCE_W), .STAGES(UPDATE_STAGES)
     ) palette (
+        .clk(clk), .rst(dp_rst), .advance(h_load),  // with stage H, its second half is H's
         .lum(e_lum), .cb(e_cb), .cr(e_cr),
         .bg_y(bg_y), .bg_cb(bg_cb), .bg_cr(bg_cr),
         .inv_ww(inv_ww),
@@ -503,9 +508,7 @@ module evclust_core #(
     // each alpha filter's new value and its increment from the slot read at port A. With
     // UPDATE_DELAY = 2 its second half runs a stage later (stage H, below), from a register
     // loaded as the event finishes (h_load).
-    localparam integer UPDATE_STAGES = UPDATE_DELAY > 1 ? 2 : 1;
     wire [ROW_W-1:0] row_u = UPDATE_DELAY == 0 ? row_a : row_e;  // the event's slot's row (port E when delayed)
-    wire h_load;
     wire [CENTRE_W-1:0]       up_px, up_py;
     wire [HALF_SIZE_W-1:0]    up_rx, up_ry;
     wire [V_MCM_W-1:0]        up_vmx, up_vmy;
@@ -558,8 +561,6 @@ module evclust_core #(
     reg                    h_live, h_bg_live, h_fresh;  // h_fresh: loaded last cycle (its MCM saturations count now)
     reg [SLOT_W-1:0]       h_slot;
     reg [EV_T_W-1:0]       h_t;
-    reg [CLASS_W-1:0]      h_class;
-    reg [VOTE_W-1:0]       h_vote;
     reg signed [DB_W-1:0]  h_dbg_y, h_dbg_cb, h_dbg_cr;
     reg                    creating;  // a creation's second cycle: the first committed the event before
     reg [SLOT_W-1:0]       creating_slot;
@@ -1035,8 +1036,8 @@ module evclust_core #(
     wire to_c_bg_live = H_STAGE ? h_bg_live : bg_learns;
     wire [SLOT_W-1:0] to_c_slot = H_STAGE ? h_slot : e_slot;
     wire [EV_T_W-1:0] to_c_t = H_STAGE ? h_t : e_t;
-    wire [CLASS_W-1:0] to_c_class = H_STAGE ? h_class : vote_class;
-    wire [VOTE_W-1:0] to_c_vote = H_STAGE ? h_vote : vote;
+    wire [CLASS_W-1:0] to_c_class = vote_class;  // stage H's with H (the palette's second half), else the event's
+    wire [VOTE_W-1:0] to_c_vote = vote;
     wire slot_write = upd_write || do_commit;         // an update lands in slot sw_slot
     // The background learns from every event that is not a reported object's.
     wire signed [63:0] bg_y_next = alpha_step(u64({{(63 - BACKGROUND_W){1'b0}}, bg_y}), u64({{(63 - CW){1'b0}}, e_lum}), K_B_BG, BETA_BG_FRAC, FB, 1'b0);
@@ -1264,8 +1265,6 @@ module evclust_core #(
             c_slot <= {SLOT_W{1'b0}};
             h_slot <= {SLOT_W{1'b0}};
             h_t <= {EV_T_W{1'b0}};
-            h_class <= {CLASS_W{1'b0}};
-            h_vote <= {VOTE_W{1'b0}};
             h_dbg_y <= {DB_W{1'b0}};
             h_dbg_cb <= {DB_W{1'b0}};
             h_dbg_cr <= {DB_W{1'b0}};
@@ -1472,8 +1471,6 @@ module evclust_core #(
                     h_bg_live <= bg_learns;
                     h_slot <= e_slot;
                     h_t <= e_t;
-                    h_class <= vote_class;
-                    h_vote <= vote;
                     h_dbg_y <= bg_y_d[DB_W-1:0];
                     h_dbg_cb <= bg_cb_d[DB_W-1:0];
                     h_dbg_cr <= bg_cr_d[DB_W-1:0];

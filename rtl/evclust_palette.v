@@ -1,10 +1,20 @@
 // Palette vote of one event (model: fixed_model._nearest_palette, _mixing_palette and the vote
-// in _update). Combinational; all PALETTE_SIZE entries in parallel.
+// in _update). All PALETTE_SIZE entries in parallel.
 //  - nearest: the entry nearest in L1, luminance weighted by w_Y; ties go to the lower index;
 //  - mixing: among the entries whose background-to-entry segment passes within the tolerance
 //    of the event's colour, the nearest; q = clamp(u.w / |w|^2, 0, 1) from 1/|w|^2 (inv_ww,
 //    refreshed at filter steps), so there is no divider here;
 //  - the vote: 1, or the event's L1 contrast to the background, rounded half up.
+//
+// Two halves. Stage 1, from the event and the background: each entry's end distance and q (the
+// products u.w and u.w / |w|^2), the order of the entries by end distance (every pair compared
+// at once, so choosing needs no chain of comparisons), the nearest entry and the vote. Stage 2:
+// each entry's distance to its segment, (u << F_q) - q w weighted, against the tolerance, and
+// the nearest entry within it.
+// STAGES = 1: combinational. STAGES = 2: a register (enabled by `advance`) between the halves,
+// so the class and vote belong to the event of the last advance (the core with
+// update_delay = 2 loads it as the event enters stage H). The run-time registers are read by
+// both halves: they are quasi-static (written while the core is idle).
 `default_nettype none
 `include "evclust_require.vh"
 module evclust_palette #(
@@ -14,8 +24,12 @@ module evclust_palette #(
     parameter integer INV_BITS = 33,    // INV_WW_W
     parameter integer VOTE_BITS = 10,   // VOTE_W
     parameter integer LUMA_BITS = 8,    // LUMA_WEIGHT_W
-    parameter integer TOL_BITS = 11     // MIXING_TOLERANCE_W
+    parameter integer TOL_BITS = 11,    // MIXING_TOLERANCE_W
+    parameter integer STAGES = 1        // 1: combinational; 2: one pipeline register
 ) (
+    input  wire                  clk,      // STAGES = 2 only
+    input  wire                  rst,      // STAGES = 2: clears the register (synchronous)
+    input  wire                  advance,  // STAGES = 2: stage 1's results move to stage 2
     input  wire [7:0]            lum,
     input  wire [7:0]            cb,
     input  wire [7:0]            cr,
@@ -41,8 +55,9 @@ module evclust_palette #(
 
     generate
         if (P != PALETTE_SIZE || CLASS_W != (P > 1 ? $clog2(P) : 1) || BG_BITS != BACKGROUND_W || INV_BITS != INV_WW_W
-            || VOTE_BITS != VOTE_W || LUMA_BITS != LUMA_WEIGHT_W || TOL_BITS != MIXING_TOLERANCE_W || EV_COLOUR_W != 8) begin : widths_differ_from_evclust_params_vh
-            `EVCLUST_FAIL("evclust_palette: a width differs from evclust_params.vh")
+            || VOTE_BITS != VOTE_W || LUMA_BITS != LUMA_WEIGHT_W || TOL_BITS != MIXING_TOLERANCE_W || EV_COLOUR_W != 8
+            || BACKGROUND_W - BACKGROUND_FRAC != 8 || (STAGES != 1 && STAGES != 2)) begin : widths_differ_from_evclust_params_vh
+            `EVCLUST_FAIL("evclust_palette: a width differs from evclust_params.vh, the background is not UQ8.f, or STAGES is not 1 or 2")
         end
     endgenerate
 
@@ -58,35 +73,19 @@ module evclust_palette #(
     wire signed [63:0] b_cb = $signed({{(64 - BACKGROUND_W){1'b0}}, bg_cb});
     wire signed [63:0] b_cr = $signed({{(64 - BACKGROUND_W){1'b0}}, bg_cr});
     // The background's integer colour, and the event seen from it.
-    wire signed [63:0] bi_y = b_y >>> FB;
-    wire signed [63:0] bi_cb = b_cb >>> FB;
-    wire signed [63:0] bi_cr = b_cr >>> FB;
-    wire signed [9:0] u_y10 = e_y[9:0] - bi_y[9:0];  // both in 0..255
-    wire signed [9:0] u_cb10 = e_cb[9:0] - bi_cb[9:0];
-    wire signed [9:0] u_cr10 = e_cr[9:0] - bi_cr[9:0];
+    wire signed [9:0] bi_y = {{(10 - BACKGROUND_W + FB){1'b0}}, bg_y[BACKGROUND_W-1:FB]};
+    wire signed [9:0] bi_cb = {{(10 - BACKGROUND_W + FB){1'b0}}, bg_cb[BACKGROUND_W-1:FB]};
+    wire signed [9:0] bi_cr = {{(10 - BACKGROUND_W + FB){1'b0}}, bg_cr[BACKGROUND_W-1:FB]};
+    wire signed [9:0] u_y10 = e_y[9:0] - bi_y;  // both in 0..255
+    wire signed [9:0] u_cb10 = e_cb[9:0] - bi_cb;
+    wire signed [9:0] u_cr10 = e_cr[9:0] - bi_cr;
 
     // Operands are sized to their ranges so that synthesis builds small multipliers: colour
     // differences fit 9 bits, u.w fits 19, q fits 17 bits (0..2^16), the residual 27.
-    integer j;
-    reg signed [63:0] p_y, p_cb, p_cr, t_y, t_cb, t_cr, d_end;
-    /* verilator lint_off UNUSEDSIGNAL */  // compared at CMP_W bits, above which it is zero
-    reg signed [63:0] d_line;
-    /* verilator lint_on UNUSEDSIGNAL */
-    reg [7:0]         ad_y, ad_cb, ad_cr;
-    reg signed [9:0]  w_y, w_cb, w_cr;
-    reg signed [19:0] dot;
-    /* verilator lint_off UNUSEDSIGNAL */  // products by addition: only the product's bits are used
-    reg signed [63:0] wy_ad, wy_t, qw_y, qw_cb, qw_cr;
-    /* verilator lint_on UNUSEDSIGNAL */
     localparam integer QF = MIXING_Q_FRAC;
     localparam integer PROD_W = 18 + INV_WW_W;  // u.w (positive, 18 bits) x 2^32 / |w|^2
     localparam integer RES_W = 10 + QF + 2;     // (u << QF) - q w
     localparam [MIXING_Q_W-1:0] ONE_Q = 1 << QF;
-    reg [PROD_W-1:0]  q_wide;
-    reg [MIXING_Q_W-1:0] q;
-    reg signed [RES_W-1:0] r_y, r_cb, r_cr;
-    reg [CLASS_W-1:0] nearest, mixed;
-    reg mixed_found;
 
     // The distances compared at a width that holds them all (64-bit comparisons would cost a
     // 64-bit carry chain each, per entry): w_Y|dY| + (|dCb| + |dCr|) << F_w, the line distance
@@ -95,12 +94,10 @@ module evclust_palette #(
     localparam integer D_LINE_W = (LUMA_WEIGHT_W + RES_W > RES_W + 1 + FW ? LUMA_WEIGHT_W + RES_W : RES_W + 1 + FW) + 1;
     localparam integer D_W = D_END_W > D_LINE_W ? D_END_W : D_LINE_W;
     localparam integer CMP_W = (D_W > MIXING_TOLERANCE_W + FW ? D_W : MIXING_TOLERANCE_W + FW) + 1;
-    localparam [CMP_W-1:0] FAR_C = {CMP_W{1'b1}};
     /* verilator lint_off UNUSEDSIGNAL */  // the bits above CMP_W are zero
     wire [63:0] tolerance_bits = TOLERANCE;
     /* verilator lint_on UNUSEDSIGNAL */
     wire [CMP_W-1:0] TOLERANCE_C = tolerance_bits[CMP_W-1:0];
-    reg  [CMP_W-1:0] d_end_c, d_line_c, nearest_d, mixed_d;
 
     function automatic [7:0] byte_gap;  // |a - b| of two bytes: a subtraction, negated if it borrowed
         input [7:0] a;
@@ -118,62 +115,132 @@ module evclust_palette #(
         end
     endfunction
 
+    // ------------------------------------------------ stage 1: end distances, q, order, vote
+    integer j, i;
+    reg [P*CMP_W-1:0]      s1_d_end;  // entry j's end distance in bits [CMP_W j +: CMP_W]
+    reg [P*MIXING_Q_W-1:0] s1_q;      // entry j's q
+    reg [P*P-1:0]          s1_before; // bit P j + i: entry j comes before entry i (nearer, or as near and lower)
+    reg [CLASS_W-1:0]      s1_nearest;
+    /* verilator lint_off UNUSEDSIGNAL */  // compared at CMP_W bits, above which it is zero
+    reg signed [63:0] d_end;
+    /* verilator lint_on UNUSEDSIGNAL */
+    reg [7:0]         ad_y, ad_cb, ad_cr;
+    reg signed [9:0]  w_y, w_cb, w_cr;
+    reg signed [19:0] dot;
+    /* verilator lint_off UNUSEDSIGNAL */  // products by addition: only the product's bits are used
+    reg signed [63:0] wy_ad;
+    /* verilator lint_on UNUSEDSIGNAL */
+    reg [PROD_W-1:0]  q_wide;
+    reg [CMP_W-1:0]   d_j, d_i;
+    reg               first;
     always @* begin
-        nearest = {CLASS_W{1'b0}};
-        nearest_d = FAR_C;
-        mixed = {CLASS_W{1'b0}};
-        mixed_d = FAR_C;
-        mixed_found = 1'b0;
         for (j = 0; j < P; j = j + 1) begin
-            p_y = $signed({56'd0, palette_y[j*8 +: 8]});
-            p_cb = $signed({56'd0, palette_cb[j*8 +: 8]});
-            p_cr = $signed({56'd0, palette_cr[j*8 +: 8]});
             ad_y = byte_gap(lum, palette_y[j*8 +: 8]);
             ad_cb = byte_gap(cb, palette_cb[j*8 +: 8]);
             ad_cr = byte_gap(cr, palette_cr[j*8 +: 8]);
             wy_ad = mul_by_addition($signed({56'd0, ad_y}), W_Y, LUMA_WEIGHT_W + 1);
             d_end = $signed({{(64 - LUMA_WEIGHT_W - 8){1'b0}}, wy_ad[LUMA_WEIGHT_W+7:0]}) + (($signed({56'd0, ad_cb}) + $signed({56'd0, ad_cr})) <<< FW);
-            d_end_c = d_end[CMP_W-1:0];
-            if (d_end_c < nearest_d) begin
-                nearest = j[CLASS_W-1:0];
-                nearest_d = d_end_c;
-            end
-            t_y = p_y - bi_y;
-            t_cb = p_cb - bi_cb;
-            t_cr = p_cr - bi_cr;
-            w_y = t_y[9:0];
-            w_cb = t_cb[9:0];
-            w_cr = t_cr[9:0];
+            s1_d_end[j*CMP_W +: CMP_W] = d_end[CMP_W-1:0];
+            w_y = $signed({2'b00, palette_y[j*8 +: 8]}) - bi_y;  // entry - background, both in 0..255
+            w_cb = $signed({2'b00, palette_cb[j*8 +: 8]}) - bi_cb;
+            w_cr = $signed({2'b00, palette_cr[j*8 +: 8]}) - bi_cr;
             dot = u_y10 * w_y + u_cb10 * w_cb + u_cr10 * w_cr;  // three DSP blocks: by addition they cost more cells than the part spares
             q_wide = {{(PROD_W - 18){1'b0}}, dot[17:0]} * {{(PROD_W - INV_WW_W){1'b0}}, inv_ww[j*INV_WW_W +: INV_WW_W]};
             // mixing_q, clamped to 1
-            q = dot <= 20'sd0 ? {MIXING_Q_W{1'b0}} : (q_wide[PROD_W-1:QF] > {{(PROD_W - QF - MIXING_Q_W){1'b0}}, ONE_Q} ? ONE_Q : q_wide[QF +: MIXING_Q_W]);
-            qw_y = mul_by_addition($signed({{(64 - MIXING_Q_W){1'b0}}, q}), {{54{w_y[9]}}, w_y}, 10);
-            qw_cb = mul_by_addition($signed({{(64 - MIXING_Q_W){1'b0}}, q}), {{54{w_cb[9]}}, w_cb}, 10);
-            qw_cr = mul_by_addition($signed({{(64 - MIXING_Q_W){1'b0}}, q}), {{54{w_cr[9]}}, w_cr}, 10);
-            r_y = ($signed({{(RES_W - 10){u_y10[9]}}, u_y10}) <<< QF) - qw_y[RES_W-1:0];
-            r_cb = ($signed({{(RES_W - 10){u_cb10[9]}}, u_cb10}) <<< QF) - qw_cb[RES_W-1:0];
-            r_cr = ($signed({{(RES_W - 10){u_cr10[9]}}, u_cr10}) <<< QF) - qw_cr[RES_W-1:0];
-            // |r| of a RES_W-bit r fits RES_W bits: the product with w_Y stays a small multiplier.
-            t_y = $signed({{(64 - RES_W){1'b0}}, residual_size(r_y)});
-            t_cb = $signed({{(64 - RES_W){1'b0}}, residual_size(r_cb)});
-            t_cr = $signed({{(64 - RES_W){1'b0}}, residual_size(r_cr)});
-            wy_t = mul_by_addition(t_y, W_Y, LUMA_WEIGHT_W + 1);
-            d_line = background_mask[j] ? d_end
-                   : ($signed({{(64 - LUMA_WEIGHT_W - RES_W){1'b0}}, wy_t[LUMA_WEIGHT_W+RES_W-1:0]}) + ((t_cb + t_cr) <<< FW)) >>> QF;
-            d_line_c = d_line[CMP_W-1:0];
-            if (d_line_c <= TOLERANCE_C && d_end_c < mixed_d) begin
-                mixed = j[CLASS_W-1:0];
-                mixed_d = d_end_c;
-                mixed_found = 1'b1;
-            end
+            s1_q[j*MIXING_Q_W +: MIXING_Q_W] = dot <= 20'sd0 ? {MIXING_Q_W{1'b0}}
+                : (q_wide[PROD_W-1:QF] > {{(PROD_W - QF - MIXING_Q_W){1'b0}}, ONE_Q} ? ONE_Q : q_wide[QF +: MIXING_Q_W]);
         end
-        class_index = (mixing && mixed_found) ? mixed : nearest;
+        // The order: what the model's scan in index order with a strict "<" keeps.
+        s1_nearest = {CLASS_W{1'b0}};
+        for (j = 0; j < P; j = j + 1) begin
+            first = 1'b1;
+            for (i = 0; i < P; i = i + 1) begin
+                d_j = s1_d_end[j*CMP_W +: CMP_W];
+                d_i = s1_d_end[i*CMP_W +: CMP_W];
+                s1_before[j*P + i] = i == j ? 1'b0 : (d_j < d_i || (d_j == d_i && j < i));
+                if (i != j && !s1_before[j*P + i])
+                    first = 1'b0;
+            end
+            if (first)
+                s1_nearest = j[CLASS_W-1:0];
+        end
     end
 
     // |e - BG|_1 from the exact background, rounded half up.
     wire signed [63:0] contrast = (abs64((e_y <<< FB) - b_y) + abs64((e_cb <<< FB) - b_cb) + abs64((e_cr <<< FB) - b_cr)
                                    + (64'sd1 <<< (FB - 1))) >>> FB;
-    assign vote = vote_contrast ? contrast[VOTE_W-1:0] : {{(VOTE_W - 1){1'b0}}, 1'b1};
+    wire [VOTE_W-1:0] s1_vote = vote_contrast ? contrast[VOTE_W-1:0] : {{(VOTE_W - 1){1'b0}}, 1'b1};
+
+    // ------------------------------------------------ the pipeline register (STAGES = 2)
+    localparam integer S2_W = 6 * 10 + P * CMP_W + P * MIXING_Q_W + P * P + CLASS_W + VOTE_W;
+    wire [S2_W-1:0] s2_in = {u_y10, u_cb10, u_cr10, bi_y, bi_cb, bi_cr, s1_d_end, s1_q, s1_before, s1_nearest, s1_vote};
+    wire [S2_W-1:0] s2;
+    generate
+        if (STAGES == 2) begin : registered
+            reg [S2_W-1:0] operands;
+            always @(posedge clk)
+                if (rst)
+                    operands <= {S2_W{1'b0}};
+                else if (advance)
+                    operands <= s2_in;
+            assign s2 = operands;
+        end else begin : direct
+            assign s2 = s2_in;
+            wire unused_clock = &{1'b0, clk, rst, advance};
+        end
+    endgenerate
+    wire signed [9:0]      s2_u_y, s2_u_cb, s2_u_cr;
+    wire [9:0]             s2_bi_y, s2_bi_cb, s2_bi_cr;  // the background's integer colour (0..255)
+    wire [P*CMP_W-1:0]     s2_d_end;
+    wire [P*MIXING_Q_W-1:0] s2_q;
+    wire [P*P-1:0]         s2_before;
+    wire [CLASS_W-1:0]     s2_nearest;
+    assign {s2_u_y, s2_u_cb, s2_u_cr, s2_bi_y, s2_bi_cb, s2_bi_cr, s2_d_end, s2_q, s2_before, s2_nearest, vote} = s2;
+
+    // ------------------------------------------------ stage 2: the segments, the choice
+    reg [MIXING_Q_W-1:0]   q;
+    reg signed [9:0]       v_y, v_cb, v_cr;
+    reg signed [RES_W-1:0] r_y, r_cb, r_cr;
+    reg signed [63:0]      a_y, a_cb, a_cr;
+    /* verilator lint_off UNUSEDSIGNAL */  // products by addition: only the product's bits are used; d_line compared at CMP_W bits
+    reg signed [63:0]      qw_y, qw_cb, qw_cr, wy_t, d_line;
+    /* verilator lint_on UNUSEDSIGNAL */
+    reg [CMP_W-1:0]        d_line_c;
+    reg [P-1:0]            in_tolerance;  // entry j's segment passes within the tolerance
+    reg [CLASS_W-1:0]      mixed;
+    reg                    chosen;
+    always @* begin
+        for (j = 0; j < P; j = j + 1) begin
+            v_y = $signed({2'b00, palette_y[j*8 +: 8]}) - $signed(s2_bi_y);
+            v_cb = $signed({2'b00, palette_cb[j*8 +: 8]}) - $signed(s2_bi_cb);
+            v_cr = $signed({2'b00, palette_cr[j*8 +: 8]}) - $signed(s2_bi_cr);
+            q = s2_q[j*MIXING_Q_W +: MIXING_Q_W];
+            qw_y = mul_by_addition($signed({{(64 - MIXING_Q_W){1'b0}}, q}), {{54{v_y[9]}}, v_y}, 10);
+            qw_cb = mul_by_addition($signed({{(64 - MIXING_Q_W){1'b0}}, q}), {{54{v_cb[9]}}, v_cb}, 10);
+            qw_cr = mul_by_addition($signed({{(64 - MIXING_Q_W){1'b0}}, q}), {{54{v_cr[9]}}, v_cr}, 10);
+            r_y = ($signed({{(RES_W - 10){s2_u_y[9]}}, s2_u_y}) <<< QF) - qw_y[RES_W-1:0];
+            r_cb = ($signed({{(RES_W - 10){s2_u_cb[9]}}, s2_u_cb}) <<< QF) - qw_cb[RES_W-1:0];
+            r_cr = ($signed({{(RES_W - 10){s2_u_cr[9]}}, s2_u_cr}) <<< QF) - qw_cr[RES_W-1:0];
+            // |r| of a RES_W-bit r fits RES_W bits: the product with w_Y stays a small multiplier.
+            a_y = $signed({{(64 - RES_W){1'b0}}, residual_size(r_y)});
+            a_cb = $signed({{(64 - RES_W){1'b0}}, residual_size(r_cb)});
+            a_cr = $signed({{(64 - RES_W){1'b0}}, residual_size(r_cr)});
+            wy_t = mul_by_addition(a_y, W_Y, LUMA_WEIGHT_W + 1);
+            d_line = ($signed({{(64 - LUMA_WEIGHT_W - RES_W){1'b0}}, wy_t[LUMA_WEIGHT_W+RES_W-1:0]}) + ((a_cb + a_cr) <<< FW)) >>> QF;
+            d_line_c = background_mask[j] ? s2_d_end[j*CMP_W +: CMP_W] : d_line[CMP_W-1:0];
+            in_tolerance[j] = d_line_c <= TOLERANCE_C;
+        end
+        // The entry within the tolerance that comes before every other within it.
+        mixed = {CLASS_W{1'b0}};
+        for (j = 0; j < P; j = j + 1) begin
+            chosen = in_tolerance[j];
+            for (i = 0; i < P; i = i + 1)
+                if (i != j && in_tolerance[i] && !s2_before[j*P + i])
+                    chosen = 1'b0;
+            if (chosen)
+                mixed = j[CLASS_W-1:0];
+        end
+        class_index = (mixing && in_tolerance != {P{1'b0}}) ? mixed : s2_nearest;
+    end
 endmodule
 `default_nettype wire

@@ -8,6 +8,11 @@ space is small: every value 0..255 of each colour channel of the event (the othe
 under each of the four switch settings; random elsewhere: whole random events and registers,
 and events placed on or near a background-to-entry segment, where the mixing rule decides.
 
+With STAGES = 2 (the core with update_delay = 2) each case goes through the pipeline register:
+after an edge with `advance`, the event and the background move to another's, and the class and
+vote read must still be the captured case's (stage 2 reads only its register and the run-time
+registers); an edge without `advance` must keep them.
+
 The cocotb test runs inside the simulator (configured by EVCLUST_TB); the pytest function builds
 and launches it through `cocotb_tools.runner`, as tb/evclust_core/test_evclust_core.py.
 """
@@ -112,6 +117,18 @@ if cocotb is not None:
         rng = random.Random(config["seed"])
         error, checked, classes = None, 0, set()
         inv_bits = config["widths"]["INV_BITS"]
+        pipelined = config["stages"] == 2
+        bg_max = (1 << config["widths"]["BG_BITS"]) - 1
+
+        async def edge(advance: int):
+            dut.advance.value = advance
+            dut.clk.value = 1
+            await Timer(1, unit="ns")
+            dut.clk.value = 0
+            dut.advance.value = 0
+            await Timer(1, unit="ns")
+
+        dut.clk.value, dut.rst.value, dut.advance.value = 0, 0, 0
         for _ in range(SETTINGS):
             pal = Palette(config, rng)
             for port, channel in (("palette_y", 0), ("palette_cb", 1), ("palette_cr", 2)):
@@ -128,7 +145,17 @@ if cocotb is not None:
                 for mixing, vote_contrast in SWITCHES:
                     dut.mixing.value, dut.vote_contrast.value = mixing, vote_contrast
                     await Timer(1, unit="ns")
+                    if pipelined:
+                        await edge(1)  # stage 1 moves on to another event and background; stage 2 must not
+                        dut.lum.value, dut.cb.value, dut.cr.value = (rng.randrange(256) for _ in range(3))
+                        dut.bg_y.value, dut.bg_cb.value, dut.bg_cr.value = (rng.randrange(bg_max + 1) for _ in range(3))
+                        await Timer(1, unit="ns")
+                        if rng.random() < 0.1:
+                            await edge(0)  # no advance: the register keeps its case
                     got = (int(dut.class_index.value), int(dut.vote.value))
+                    if pipelined:
+                        dut.lum.value, dut.cb.value, dut.cr.value = lum, cb, cr
+                        dut.bg_y.value, dut.bg_cb.value, dut.bg_cr.value = pal.bg
                     want = pal.expect(lum, cb, cr, mixing, vote_contrast)
                     checked += 1
                     classes.add((mixing, got[0]))
@@ -175,11 +202,12 @@ def palette_build(name: str) -> tuple[str, dict, dict]:
     return verilog_header(table), widths, {"widths": widths, "k": [int(v) for v in model.k]}
 
 
-@pytest.mark.parametrize("build", sorted(BUILDS))
+@pytest.mark.parametrize("build, stages", [("traffic", 1), ("defaults", 1), ("defaults", 2)])
 @pytest.mark.parametrize("sim", selected_simulators())
-def test_the_palette_class_and_vote_match_the_models_functions(sim, build):
+def test_the_palette_class_and_vote_match_the_models_functions(sim, build, stages):
     header, parameters, config = palette_build(build)
-    result = run(sim, header, "palette_vectors", config | {"seed": 11}, toplevel="evclust_palette", parameters=parameters)
+    result = run(sim, header, "palette_vectors", config | {"seed": 11, "stages": stages}, toplevel="evclust_palette",
+                 parameters=parameters | {"STAGES": stages})  # fmt: skip
     assert result["checked"] == SETTINGS * (3 * 256 + 2 * RANDOM_EVENTS) * len(SWITCHES)
     size = parameters["P"]
     # Both rules chose every entry somewhere, so no class index went untested.
