@@ -45,10 +45,12 @@ cosim: $(STAMP)
 # Every configuration the model supports against the fixed model, under both simulators: the
 # pairwise cover of the switches (tb/switch_cover.py), every row, and the paper's configuration
 # at N = 4 and 16. `make test` runs two rows of the cover, chosen from the commit hash, and
-# Icarus on the first 3,000 events of two random streams: here they run whole.
+# Icarus on the first 3,000 events of two random streams: here they run whole. Icarus also
+# replays every vector case, random stream, reset point and built-in-constants case here, of
+# which `make test` runs a subset drawn from the commit hash (tb/cosim.py: icarus_share).
 cosim-full: $(STAMP)
 	EVCLUST_COVER=all $(PY) -m pytest -q -n auto tb/evclust_core/test_every_configuration.py
-	EVCLUST_COVER=all SIM=icarus $(PY) -m pytest -q -n auto tb/evclust_core/test_evclust_core.py -k "random_streams or axi_lite"
+	EVCLUST_COVER=all SIM=icarus $(PY) -m pytest -q -n auto tb/evclust_core/test_evclust_core.py -k "random_streams or axi_lite or vector_case or reset or built_in"
 
 # Functional coverage of the RTL over every co-simulation (tb/, the whole switch cover, both
 # simulators): each run saves its bins in build/coverage/; the merged table, holes named, goes

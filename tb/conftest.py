@@ -1,5 +1,6 @@
-"""The switch cover's selection, printed at the end of a run that co-simulated any of it, so that a
-failure can be run again with the same rows (tb/switch_cover.py)."""
+"""The switch cover's selection and the Icarus subsets' key, printed at the end of a run that
+co-simulated any of them, so that a failure can be run again with the same rows and cases
+(tb/switch_cover.py, tb/cosim.py)."""
 
 from __future__ import annotations
 
@@ -16,3 +17,13 @@ def pytest_terminal_summary(terminalreporter):
 
         rows, how = selected_rows()
         terminalreporter.write_line(f"switch cover: {len(rows)} of {len(cover())} rows ({how})")
+    if any("[icarus" in getattr(r, "nodeid", "") for outcome in ("passed", "failed", "error") for r in terminalreporter.stats.get(outcome, ())):
+        import sys
+        from pathlib import Path
+
+        sys.path.insert(0, str(Path(__file__).parent))
+        from cosim import full, rotation_key
+
+        if not full():
+            terminalreporter.write_line(f"icarus: the subsets of vector cases and streams drawn from {rotation_key()[:12]} "
+                                        "(make cosim-full runs them all)")  # fmt: skip

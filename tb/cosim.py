@@ -4,7 +4,13 @@ parameter sets the tests run."""
 
 from __future__ import annotations
 
+import datetime
+import hashlib
 import os
+import subprocess
+from pathlib import Path
+
+import numpy as np
 
 from evclust.rtl.cosim import SIMULATORS, build, run, use_simulator  # noqa: F401  (the testbench's API)
 from evclust.rtl.sources import RTL_DIR as RTL  # noqa: F401
@@ -19,6 +25,37 @@ def selected_simulators() -> tuple[str, ...]:
     if sim not in SIMULATORS:
         raise SystemExit(f"SIM={sim}: expected one of {', '.join(SIMULATORS)}")
     return (sim,)
+
+
+def full() -> bool:
+    """EVCLUST_COVER=all (`make cosim-full`): every switch-cover row, every vector case and reset
+    under Icarus too, and the longer runs."""
+    return os.environ.get("EVCLUST_COVER", "").lower() == "all"
+
+
+def rotation_key() -> str:
+    """What the rotating subsets follow: the checked-out commit, or today's date outside a git checkout."""
+    try:
+        return subprocess.run(["git", "rev-parse", "HEAD"], cwd=Path(__file__).parent, capture_output=True, text=True,
+                              check=True, timeout=10).stdout.strip()  # fmt: skip
+    except (OSError, subprocess.SubprocessError):
+        return datetime.date.today().isoformat()
+
+
+def rotating_subset(count: int, size: int, salt: str) -> list[int]:
+    """`size` of the indices 0..count-1, sorted, drawn from the commit hash (and `salt`, so that two
+    subsets of one commit are drawn apart): the same in every pytest-xdist worker, another set at
+    the next commit, so that successive commits cover the whole list."""
+    key = rotation_key() + (f":{salt}" if salt else "")
+    seed = int.from_bytes(hashlib.sha256(key.encode()).digest()[:8], "little")
+    return sorted(np.random.default_rng(seed).choice(count, min(size, count), replace=False).tolist())
+
+
+def icarus_share(items, size: int, salt: str) -> list:
+    """What Icarus runs of `items` in `make test`: a rotating subset of `size`; all of them under
+    `make cosim-full`. (Verilator, some 30 times faster per cycle, runs them all.)"""
+    items = list(items)
+    return items if full() else [items[i] for i in rotating_subset(len(items), size, salt)]
 
 
 # Model-in-the-loop configurations: two parameter sets whose formats differ (the presets' filters

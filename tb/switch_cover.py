@@ -7,22 +7,21 @@ on a stream that exercises it: `live_stream` picks, deterministically, the first
 the row reports records and on which flipping any one of its switches, alone, changes the fixed
 model's records. A switch whose setting the stream cannot see would be co-simulated for nothing.
 
-`make test` co-simulates two rows chosen from the commit hash (`selected_rows`); `make cosim-full`
-(EVCLUST_COVER=all) all of them; EVCLUST_COVER_ROWS=3,7 chooses. Rows are numbered in allpairspy's
+`make test` co-simulates two rows chosen from the commit hash (`selected_rows`, tb/cosim.py's
+rotating subset); `make cosim-full` (EVCLUST_COVER=all) all of them; EVCLUST_COVER_ROWS=3,7 chooses. Rows are numbered in allpairspy's
 order, which is deterministic.
 """
 
 from __future__ import annotations
 
-import datetime
 import functools
 import hashlib
 import os
-import subprocess
-from pathlib import Path
 from typing import NamedTuple
 
 import numpy as np
+
+from cosim import full, rotating_subset, rotation_key  # noqa: F401  (full: the tests' switch)
 
 # The small sensor of tb/cosim.py's "small" configuration.
 WIDTH, HEIGHT, T_FRAME_US = 64, 48, 10000.0
@@ -185,21 +184,7 @@ def live_stream(row: Row, count: int = COUNT, tries: int = TRIES) -> tuple[int, 
     raise AssertionError(f"{row.name}: none of {tries} streams exercises every switch:\n" + "\n".join(tried))
 
 
-def _rotation_key() -> str:
-    """What the subset follows: the checked-out commit, or today's date outside a git checkout."""
-    try:
-        return subprocess.run(["git", "rev-parse", "HEAD"], cwd=Path(__file__).parent, capture_output=True, text=True,
-                              check=True, timeout=10).stdout.strip()  # fmt: skip
-    except (OSError, subprocess.SubprocessError):
-        return datetime.date.today().isoformat()
-
-
 ROTATING = 2  # rows per `make test`
-
-
-def full() -> bool:
-    """EVCLUST_COVER=all (`make cosim-full`): every row, and the longer runs."""
-    return os.environ.get("EVCLUST_COVER", "").lower() == "all"
 
 
 def selected_rows() -> tuple[tuple[Row, ...], str]:
@@ -215,7 +200,5 @@ def selected_rows() -> tuple[tuple[Row, ...], str]:
         except (ValueError, IndexError):
             raise SystemExit(f"EVCLUST_COVER_ROWS={chosen}: expected row numbers from 0 to {len(rows) - 1}, comma-separated") from None
         return picked, f"EVCLUST_COVER_ROWS={chosen}"
-    key = _rotation_key()
-    rng = np.random.default_rng(int.from_bytes(hashlib.sha256(key.encode()).digest()[:8], "little"))
-    picked = sorted(rng.choice(len(rows), ROTATING, replace=False).tolist())
-    return tuple(rows[i] for i in picked), f"rotating subset of {key[:12]}: EVCLUST_COVER_ROWS={','.join(map(str, picked))}"
+    picked = rotating_subset(len(rows), ROTATING, "")
+    return tuple(rows[i] for i in picked), f"rotating subset of {rotation_key()[:12]}: EVCLUST_COVER_ROWS={','.join(map(str, picked))}"

@@ -19,7 +19,7 @@ import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from cosim import random_config, run, selected_simulators  # noqa: E402
+from cosim import icarus_share, random_config, run, selected_simulators  # noqa: E402
 from switch_cover import (  # noqa: E402
     COUNT, HEIGHT, SWITCHES, T_FRAME_US, WIDTH, all_pairs, cover, cover_stream, full, live_stream, pairs, row_params, selected_rows,
 )  # fmt: skip
@@ -83,6 +83,18 @@ def test_a_stream_that_reports_nothing_exercises_no_switch():
     assert len(switch_cover.dead_switches(row, cover_stream(1, 5))) == sum(len(v) - 1 for v in SWITCHES.values())
     with pytest.raises(AssertionError, match=f"{row.name}: none of 3 streams exercises every switch"):
         switch_cover.live_stream.__wrapped__(row, count=5, tries=3)
+
+
+def test_the_icarus_share_is_a_stable_subset_and_everything_under_cosim_full(monkeypatch):
+    items = [f"case{i}" for i in range(20)]
+    monkeypatch.delenv("EVCLUST_COVER", raising=False)
+    share = icarus_share(items, 4, "vectors")
+    assert len(set(share)) == 4 and set(share) <= set(items)
+    assert share == [item for item in items if item in share]  # in the list's order
+    assert icarus_share(items, 4, "vectors") == share  # every xdist worker draws the same
+    assert icarus_share(items, 50, "vectors") == items  # more than there are: all
+    monkeypatch.setenv("EVCLUST_COVER", "all")
+    assert icarus_share(items, 4, "vectors") == items
 
 
 def test_the_rotating_subset_follows_the_environment(monkeypatch):
