@@ -17,7 +17,9 @@ def pytest_terminal_summary(terminalreporter):
 
         rows, how = selected_rows()
         terminalreporter.write_line(f"switch cover: {len(rows)} of {len(cover())} rows ({how})")
-    if any("[icarus" in getattr(r, "nodeid", "") for outcome in ("passed", "failed", "error") for r in terminalreporter.stats.get(outcome, ())):
+    shared = ("test_vector_case_replays", "test_random_streams", "test_a_reset_in_the_middle", "test_the_core_with_its_constants_built_in")
+    if any("[icarus" in r.nodeid and any(name in r.nodeid for name in shared)
+           for outcome in ("passed", "failed", "error") for r in terminalreporter.stats.get(outcome, ()) if hasattr(r, "nodeid")):  # fmt: skip
         import sys
         from pathlib import Path
 

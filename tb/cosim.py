@@ -130,6 +130,19 @@ def header_width(header: str, name: str) -> int:
     return int(re.search(rf"localparam integer {name} = (\d+);", header).group(1))
 
 
+async def pipeline_edge(dut, advance: int) -> None:
+    """One clock edge of a leaf with a pipeline register (`clk`, `advance`), driven by hand: the
+    register takes its inputs only if `advance` is high."""
+    from cocotb.triggers import Timer
+
+    dut.advance.value = advance
+    dut.clk.value = 1
+    await Timer(1, unit="ns")
+    dut.clk.value = 0
+    dut.advance.value = 0
+    await Timer(1, unit="ns")
+
+
 async def checked_vectors(dut, body) -> None:
     """A unit testbench's cocotb side: `await body(dut, config)` gives (error or None, cases
     checked); both go where the pytest side reads them (config["out"]), and an error fails the test."""

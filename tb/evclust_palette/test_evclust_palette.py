@@ -32,6 +32,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 try:
     import cocotb
     from cocotb.triggers import Timer
+
+    from cosim import pipeline_edge
 except ImportError:  # collected by pytest without cocotb: the pytest half still reports why
     cocotb = None
 
@@ -120,14 +122,6 @@ if cocotb is not None:
         pipelined = config["stages"] == 2
         bg_max = (1 << config["widths"]["BG_BITS"]) - 1
 
-        async def edge(advance: int):
-            dut.advance.value = advance
-            dut.clk.value = 1
-            await Timer(1, unit="ns")
-            dut.clk.value = 0
-            dut.advance.value = 0
-            await Timer(1, unit="ns")
-
         dut.clk.value, dut.rst.value, dut.advance.value = 0, 0, 0
         for _ in range(SETTINGS):
             pal = Palette(config, rng)
@@ -146,12 +140,12 @@ if cocotb is not None:
                     dut.mixing.value, dut.vote_contrast.value = mixing, vote_contrast
                     await Timer(1, unit="ns")
                     if pipelined:
-                        await edge(1)  # stage 1 moves on to another event and background; stage 2 must not
+                        await pipeline_edge(dut, 1)  # stage 1 moves on to another event and background; stage 2 must not
                         dut.lum.value, dut.cb.value, dut.cr.value = (rng.randrange(256) for _ in range(3))
                         dut.bg_y.value, dut.bg_cb.value, dut.bg_cr.value = (rng.randrange(bg_max + 1) for _ in range(3))
                         await Timer(1, unit="ns")
                         if rng.random() < 0.1:
-                            await edge(0)  # no advance: the register keeps its case
+                            await pipeline_edge(dut, 0)  # no advance: the register keeps its case
                     got = (int(dut.class_index.value), int(dut.vote.value))
                     if pipelined:
                         dut.lum.value, dut.cb.value, dut.cr.value = lum, cb, cr

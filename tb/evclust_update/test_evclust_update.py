@@ -29,7 +29,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 try:
     import cocotb
 
-    from cosim import checked_vectors, header_width, leaf_model
+    from cosim import checked_vectors, header_width, leaf_model, pipeline_edge
     from cocotb.triggers import Timer
 except ImportError:  # collected by pytest without cocotb: the pytest half still reports why
     cocotb = None
@@ -139,14 +139,6 @@ if cocotb is not None:
         def read(names):
             return {name: getattr(dut, name).value.to_signed() if name in signed else int(getattr(dut, name).value) for name in names}
 
-        async def edge(advance: int):
-            dut.advance.value = advance
-            dut.clk.value = 1
-            await Timer(1, unit="ns")
-            dut.clk.value = 0
-            dut.advance.value = 0
-            await Timer(1, unit="ns")
-
         def mismatch(S, s, event, got, want):
             diff = {name: (got[name], want[name]) for name in want if got[name] != want[name]}
             return f"slot {S[s].tolist()}, event {event}: (RTL, model) {diff}" if diff else None
@@ -162,12 +154,12 @@ if cocotb is not None:
             else:
                 error = mismatch(S, s, event, read({"step_saturations"}), {"step_saturations": want["step_saturations"]})
                 if error is None:
-                    await edge(1)
+                    await pipeline_edge(dut, 1)
                     apply(*rng.choice(all_cases), constants=False)  # stage 1 moves on; stage 2 must not
                     await Timer(1, unit="ns")
                     error = mismatch(S, s, event, read(stage2), {name: want[name] for name in stage2})
                 if error is None and rng.random() < 0.2:
-                    await edge(0)  # no advance: the register keeps its case
+                    await pipeline_edge(dut, 0)  # no advance: the register keeps its case
                     error = mismatch(S, s, event, read(stage2), {name: want[name] for name in stage2})
             checked += 1
             if error:
