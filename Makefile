@@ -6,7 +6,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 BUILD  := build
 
-.PHONY: formal setup demo demo-video results-video bench-peers test cosim cosim-full coverage lint synth timing bench results report params vectors generalize clean
+.PHONY: formal setup demo demo-video results-video bench-peers test test-full cosim cosim-full coverage lint synth timing bench results report params vectors generalize clean
 
 setup: $(STAMP)
 
@@ -32,9 +32,16 @@ demo: $(STAMP)
 	@echo "pictures: $(DEMO)_events.png $(DEMO)_tracks.png $(DEMO)_tracks.mp4 $(DEMO)_velocity.png $(DEMO)_colour.png"
 
 # worksteal: a worker that runs out of tests takes some of the other's, so a long test near the
-# end does not leave a core idle.
+# end does not leave a core idle. `make test` is the tier CI runs (under 20 minutes on 2 cores):
+# of the runs marked `rotating` (vector cases, random streams, reset points, built-in-constants
+# cases, switch-cover rows, broken proofs) it runs the anchors and a share drawn from the commit
+# hash for each simulator (tb/cosim.py: cosim_share), so successive commits rotate through them.
+# `make test-full` runs every one of them, whole, under both simulators.
 test: $(STAMP)
 	$(PY) -m pytest -q -n auto --dist worksteal
+
+test-full: $(STAMP)
+	EVCLUST_COVER=all $(PY) -m pytest -q -n auto --dist worksteal
 
 # Co-simulation of the RTL against the fixed model under one simulator: SIM=icarus|verilator
 # (`make test` runs both).
@@ -42,15 +49,11 @@ SIM ?= verilator
 cosim: $(STAMP)
 	SIM=$(SIM) $(PY) -m pytest -q -n auto tb
 
-# Every configuration the model supports against the fixed model, under both simulators: the
-# pairwise cover of the switches (tb/switch_cover.py), every row, and the paper's configuration
-# at N = 4 and 16. `make test` runs two rows of the cover, chosen from the commit hash, and
-# Icarus on the first 3,000 events of two random streams: here they run whole. Icarus also
-# replays every vector case, random stream, reset point and built-in-constants case here, of
-# which `make test` runs a subset drawn from the commit hash (tb/cosim.py: icarus_share).
+# Every co-simulation whole, under both simulators: every vector case, stream, reset point and
+# built-in-constants case, every row of the switches' pairwise cover (tb/switch_cover.py) and
+# the paper's configuration at N = 4 and 16 (`make test` runs a rotating share of them).
 cosim-full: $(STAMP)
-	EVCLUST_COVER=all $(PY) -m pytest -q -n auto tb/evclust_core/test_every_configuration.py
-	EVCLUST_COVER=all SIM=icarus $(PY) -m pytest -q -n auto tb/evclust_core/test_evclust_core.py -k "random_streams or axi_lite or vector_case or reset or built_in"
+	EVCLUST_COVER=all $(PY) -m pytest -q -n auto --dist worksteal tb
 
 # Functional coverage of the RTL over every co-simulation (tb/, the whole switch cover, both
 # simulators): each run saves its bins in build/coverage/; the merged table, holes named, goes

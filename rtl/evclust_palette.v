@@ -175,20 +175,7 @@ module evclust_palette #(
     localparam integer S2_W = 6 * 10 + P * CMP_W + P * MIXING_Q_W + P * P + CLASS_W + VOTE_W;
     wire [S2_W-1:0] s2_in = {u_y10, u_cb10, u_cr10, bi_y, bi_cb, bi_cr, s1_d_end, s1_q, s1_before, s1_nearest, s1_vote};
     wire [S2_W-1:0] s2;
-    generate
-        if (STAGES == 2) begin : registered
-            reg [S2_W-1:0] operands;
-            always @(posedge clk)
-                if (rst)
-                    operands <= {S2_W{1'b0}};
-                else if (advance)
-                    operands <= s2_in;
-            assign s2 = operands;
-        end else begin : direct
-            assign s2 = s2_in;
-            wire unused_clock = &{1'b0, clk, rst, advance};
-        end
-    endgenerate
+    evclust_stage_reg #(.W(S2_W), .STAGES(STAGES)) stage_2 (.clk(clk), .rst(rst), .advance(advance), .d(s2_in), .q(s2));
     wire signed [9:0]      s2_u_y, s2_u_cb, s2_u_cr;
     wire [9:0]             s2_bi_y, s2_bi_cb, s2_bi_cr;  // the background's integer colour (0..255)
     wire [P*CMP_W-1:0]     s2_d_end;

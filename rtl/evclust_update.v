@@ -114,18 +114,8 @@ module evclust_update #(
                              rx, ry, gamma, vmx, vmy, i_px[DP_W-1:0], i_py[DP_W-1:0], i_norm[DN_W-1:0],
                              i_cy[DC_W-1:0], i_ccb[DC_W-1:0], i_ccr[DC_W-1:0]};
     wire [S2_W-1:0] s2;
-    generate
-        if (STAGES == 2) begin : registered
-            reg [S2_W-1:0] operands;
-            always @(posedge clk)
-                if (advance)
-                    operands <= s2_in;
-            assign s2 = operands;
-        end else begin : direct
-            assign s2 = s2_in;
-            wire unused_clock = &{1'b0, clk, advance};
-        end
-    endgenerate
+    // No reset: stage 2's increments are committed only for an event that advanced into it.
+    evclust_stage_reg #(.W(S2_W), .STAGES(STAGES)) stage_2 (.clk(clk), .rst(1'b0), .advance(advance), .d(s2_in), .q(s2));
     assign {s2_step_x, s2_step_y, s2_g_x, s2_g_y, s2_r_x, s2_r_y, s2_gamma, s2_v_x, s2_v_y, s2_d_px, s2_d_py, s2_d_norm,
             s2_d_cy, s2_d_ccb, s2_d_ccr} = s2;
 

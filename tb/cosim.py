@@ -28,8 +28,8 @@ def selected_simulators() -> tuple[str, ...]:
 
 
 def full() -> bool:
-    """EVCLUST_COVER=all (`make cosim-full`): every switch-cover row, every vector case and reset
-    under Icarus too, and the longer runs."""
+    """EVCLUST_COVER=all (`make test-full`, `make cosim-full`): every switch-cover row, vector case,
+    stream, reset point and broken proof under both simulators, and the longer runs."""
     return os.environ.get("EVCLUST_COVER", "").lower() == "all"
 
 
@@ -51,11 +51,12 @@ def rotating_subset(count: int, size: int, salt: str) -> list[int]:
     return sorted(np.random.default_rng(seed).choice(count, min(size, count), replace=False).tolist())
 
 
-def icarus_share(items, size: int, salt: str) -> list:
-    """What Icarus runs of `items` in `make test`: a rotating subset of `size`; all of them under
-    `make cosim-full`. (Verilator, some 30 times faster per cycle, runs them all.)"""
+def cosim_share(items, size: int, salt: str, sim: str = "") -> list:
+    """What `make test` runs of `items` under simulator `sim`: a rotating subset of `size`, drawn
+    apart for each simulator (so that one commit covers more of the list); all of them under
+    `make test-full` (EVCLUST_COVER=all). Tests that take a share carry the `rotating` marker."""
     items = list(items)
-    return items if full() else [items[i] for i in rotating_subset(len(items), size, salt)]
+    return items if full() else [items[i] for i in rotating_subset(len(items), size, f"{salt}:{sim}" if sim else salt)]
 
 
 # Model-in-the-loop configurations: two parameter sets whose formats differ (the presets' filters

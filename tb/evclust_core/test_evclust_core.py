@@ -366,7 +366,7 @@ if cocotb is not None:
 # ------------------------------------------------------------------------------------------
 # pytest: build per parameter set, launch, check.
 
-from cosim import CONFIGURATIONS, FORMAT_VARIANTS, full, icarus_share, random_config, run, selected_simulators  # noqa: E402
+from cosim import CONFIGURATIONS, FORMAT_VARIANTS, cosim_share, full, random_config, run, selected_simulators  # noqa: E402
 
 from evclust.vectors import CASES  # noqa: E402
 
@@ -382,21 +382,20 @@ def _case_header(name: str) -> str:
     return load_case(VECTORS / name).header
 
 
-# Verilator replays every vector case in `make test`. Icarus, some 30 times slower per cycle,
-# replays the cases that anchor the schedule and the pipeline, and ICARUS_ROTATING more drawn from
-# the commit hash (tb/cosim.py's rotating subset: successive commits cover them all); `make
-# cosim-full` replays every case under Icarus too.
-ICARUS_CASES = ("traffic_clip", "pipelined_traffic", "pipelined_eviction_voids", "table_full")
-ICARUS_ROTATING = 4
+# `make test` replays, under each simulator, the cases that anchor the schedule and the pipeline
+# and ROTATING_CASES more drawn from the commit hash for that simulator (tb/cosim.py's rotating
+# subset: successive commits cover them all); `make test-full` replays every case under both.
+ANCHOR_CASES = ("traffic_clip", "pipelined_traffic", "pipelined_eviction_voids", "table_full")
+ROTATING_CASES = 4
 
 
 def replayed_cases() -> list[tuple[str, str]]:
     """(simulator, case) pairs this run replays."""
-    others = [case for case in CASES if case not in ICARUS_CASES]
-    icarus = [*ICARUS_CASES, *icarus_share(others, ICARUS_ROTATING, "vectors")]
-    return [(sim, case) for sim in SIMS for case in (CASES if sim == "verilator" else icarus)]
+    others = [case for case in CASES if case not in ANCHOR_CASES]
+    return [(sim, case) for sim in SIMS for case in (*ANCHOR_CASES, *cosim_share(others, ROTATING_CASES, "vectors", sim))]
 
 
+@pytest.mark.rotating
 @pytest.mark.parametrize("sim, case", replayed_cases())
 def test_vector_case_replays_bit_exact(sim, case):
     result = run(sim, _case_header(case), "replay_vectors", {"cases": [str(VECTORS / case)], "seed": 1, "gap": GAP, "stall": STALL})
@@ -404,10 +403,11 @@ def test_vector_case_replays_bit_exact(sim, case):
     assert result["cases"][case]["records"] == json.loads((VECTORS / case / "manifest.json").read_text())["counts"]["records"]
 
 
-BUILT_IN_CASES = ("traffic_clip", "table_full", "merge_edges")  # all under Verilator, one under Icarus
+BUILT_IN_CASES = ("traffic_clip", "table_full", "merge_edges")  # one a simulator in make test
 
 
-@pytest.mark.parametrize("sim, case", [(sim, c) for sim in SIMS for c in (BUILT_IN_CASES if sim == "verilator" else icarus_share(BUILT_IN_CASES, 1, "built-in"))])
+@pytest.mark.rotating
+@pytest.mark.parametrize("sim, case", [(sim, c) for sim in SIMS for c in cosim_share(BUILT_IN_CASES, 1, "built-in", sim)])
 def test_the_core_with_its_constants_built_in_replays_bit_exact(sim, case):
     # RUNTIME_CONFIG = 0: the header's constants folded into the datapath, the cfg port unread.
     config = {"cases": [str(VECTORS / case)], "seed": 2, "gap": GAP, "stall": STALL}
@@ -435,11 +435,11 @@ def _random_config(preset, n_clusters, seed, count, **extra):
     return random_config(preset, n_clusters, seed, count, **({"gap": GAP, "stall": STALL} | extra))
 
 
-STREAMS = [(preset, n) for preset in CONFIGURATIONS for n in (4, 16)]  # all under Verilator, half under Icarus
+STREAMS = [(preset, n) for preset in CONFIGURATIONS for n in (4, 16)]  # half of them a simulator in make test
 
 
-@pytest.mark.parametrize("sim, preset, n_clusters", [(sim, *stream) for sim in SIMS
-                                                     for stream in (STREAMS if sim == "verilator" else icarus_share(STREAMS, len(STREAMS) // 2, "streams"))])  # fmt: skip
+@pytest.mark.rotating
+@pytest.mark.parametrize("sim, preset, n_clusters", [(sim, *stream) for sim in SIMS for stream in cosim_share(STREAMS, len(STREAMS) // 2, "streams", sim)])
 def test_random_streams_match_the_model_in_the_loop(sim, preset, n_clusters):
     # EVCLUST_SEED=n draws other streams than the committed seeds.
     seed = int(os.environ.get("EVCLUST_SEED", 1000)) + n_clusters
@@ -526,10 +526,11 @@ def test_the_two_format_sets_differ():
     assert [line for line in a.splitlines() if "_W =" in line] != [line for line in b.splitlines() if "_W =" in line]
 
 
-RESET_CYCLES = (5, 1501, 4003)  # in the mixing table's fill, early, late: all under Verilator, one under Icarus
+RESET_CYCLES = (5, 1501, 4003)  # in the mixing table's fill, early, late: one a simulator in make test
 
 
-@pytest.mark.parametrize("sim, reset_cycle", [(sim, c) for sim in SIMS for c in (RESET_CYCLES if sim == "verilator" else icarus_share(RESET_CYCLES, 1, "reset"))])
+@pytest.mark.rotating
+@pytest.mark.parametrize("sim, reset_cycle", [(sim, c) for sim in SIMS for c in cosim_share(RESET_CYCLES, 1, "reset", sim)])
 def test_a_reset_in_the_middle_of_a_stream_recovers_the_models_state_after_reset(sim, reset_cycle):
     # The small configuration learns its background and refreshes the mixing table, so state a
     # reset forgets to clear would show; the part before the reset runs with gaps and stalls.

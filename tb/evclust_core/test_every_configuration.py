@@ -19,7 +19,7 @@ import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from cosim import icarus_share, random_config, run, selected_simulators  # noqa: E402
+from cosim import cosim_share, random_config, run, selected_simulators  # noqa: E402
 from switch_cover import (  # noqa: E402
     COUNT, HEIGHT, SWITCHES, T_FRAME_US, WIDTH, all_pairs, cover, cover_stream, full, live_stream, pairs, row_params, selected_rows,
 )  # fmt: skip
@@ -85,16 +85,18 @@ def test_a_stream_that_reports_nothing_exercises_no_switch():
         switch_cover.live_stream.__wrapped__(row, count=5, tries=3)
 
 
-def test_the_icarus_share_is_a_stable_subset_and_everything_under_cosim_full(monkeypatch):
+def test_the_share_is_a_stable_subset_drawn_apart_per_simulator_and_everything_under_test_full(monkeypatch):
     items = [f"case{i}" for i in range(20)]
     monkeypatch.delenv("EVCLUST_COVER", raising=False)
-    share = icarus_share(items, 4, "vectors")
+    share = cosim_share(items, 4, "vectors", "icarus")
     assert len(set(share)) == 4 and set(share) <= set(items)
     assert share == [item for item in items if item in share]  # in the list's order
-    assert icarus_share(items, 4, "vectors") == share  # every xdist worker draws the same
-    assert icarus_share(items, 50, "vectors") == items  # more than there are: all
+    assert cosim_share(items, 4, "vectors", "icarus") == share  # every xdist worker draws the same
+    # The simulators draw apart: the chance that two 4-of-20 draws coincide is 1 in 4845.
+    assert cosim_share(items, 4, "vectors", "verilator") != share
+    assert cosim_share(items, 50, "vectors", "icarus") == items  # more than there are: all
     monkeypatch.setenv("EVCLUST_COVER", "all")
-    assert icarus_share(items, 4, "vectors") == items
+    assert cosim_share(items, 4, "vectors", "icarus") == items
 
 
 def test_the_rotating_subset_follows_the_environment(monkeypatch):
@@ -113,6 +115,7 @@ def test_the_rotating_subset_follows_the_environment(monkeypatch):
     assert selected_rows() == (rows, how)  # the same on every call: every xdist worker agrees
 
 
+@pytest.mark.rotating
 @pytest.mark.parametrize("row", ROWS, ids=lambda row: row.name)
 @pytest.mark.parametrize("sim", SIMS)
 def test_switch_cover_row_matches_the_model_in_the_loop(sim, row, tmp_path):

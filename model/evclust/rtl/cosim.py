@@ -33,6 +33,7 @@ BENCHES = {
     "evclust_top2": ((), TB_DIR.parent / "evclust_top2", "test_evclust_top2"),
     "evclust_update": ((), TB_DIR.parent / "evclust_update", "test_evclust_update"),
     "evclust_commit": ((), TB_DIR.parent / "evclust_commit", "test_evclust_commit"),
+    "evclust_stage_reg": ((), TB_DIR.parent / "evclust_stage_reg", "test_evclust_stage_reg"),
 }
 
 
