@@ -36,9 +36,10 @@ demo: $(STAMP)
 # of the runs marked `rotating` (vector cases, random streams, reset points, built-in-constants
 # cases, switch-cover rows, broken proofs) it runs the anchors and a share drawn from the commit
 # hash for each simulator (tb/cosim.py: cosim_share), so successive commits rotate through them.
-# `make test-full` runs every one of them, whole, under both simulators.
+# `make test-full` runs every one of them, whole, under both simulators. --durations: the
+# slowest tests at the end of a CI log, where the budget goes.
 test: $(STAMP)
-	$(PY) -m pytest -q -n auto --dist worksteal
+	$(PY) -m pytest -q -n auto --dist worksteal --durations=15
 
 test-full: $(STAMP)
 	EVCLUST_COVER=all $(PY) -m pytest -q -n auto --dist worksteal
