@@ -9,7 +9,7 @@ preset and with the defaults, the object layer on.
 
 from __future__ import annotations
 
-import common  # noqa: F401  (first: pins every thread pool to one core)
+import common  # first: pins every thread pool to one core
 
 import argparse
 import datetime
@@ -55,7 +55,7 @@ def main() -> int:
         "## Clusterer speed",
         "",
         f"Command: `make bench` (= `.venv/bin/python bench/clusterer.py --write docs/BENCHMARKS.md`), "
-        f"run {datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC.",
+        f"run {datetime.datetime.now(datetime.UTC):%Y-%m-%d %H:%M} UTC.",
         "",
         "Machine:",
         "",
@@ -71,7 +71,9 @@ def main() -> int:
         "|---|---|---|---:|---:|---:|---:|---:|---:|",
     ]
     for name, config, model, n, events, records, median, best in rows:
-        lines.append(f"| {name} | {config} | {model} | {n} | {events:,} | {records:,} | {median:.3f} | {best:.3f} | {events / median / 1e6:.2f} |")
+        lines.append(
+            f"| {name} | {config} | {model} | {n} | {events:,} | {records:,} | {median:.3f} | {best:.3f} | {events / median / 1e6:.2f} |"
+        )
     lines.append("")
     for config in ("preset", "defaults"):
         rate = {r[2]: r[4] / r[6] / 1e6 for r in rows if r[0] == "traffic" and r[1] == config}

@@ -30,7 +30,9 @@ def machine() -> list[str]:
     simd = [f for f in ("avx2", "avx512f", "fma") if flags and f in flags.group(1).split()]
     mem = re.search(r"^MemTotal:\s*(\d+) kB", Path("/proc/meminfo").read_text(), re.M) if Path("/proc/meminfo").exists() else None
     cpu = model.group(1).strip() if model else (platform.processor() or "unknown CPU")
-    extra = ", ".join(x for x in (f"{float(mhz.group(1)):.0f} MHz" if mhz else "", f"cache {cache.group(1)}" if cache else "", "/".join(simd)) if x)
+    extra = ", ".join(
+        x for x in (f"{float(mhz.group(1)):.0f} MHz" if mhz else "", f"cache {cache.group(1)}" if cache else "", "/".join(simd)) if x
+    )
     load = ", ".join(f"{v:.2f}" for v in os.getloadavg())
     return [
         f"- CPU: {cpu} ({extra}); {os.cpu_count()} logical cores; memory {int(mem.group(1)) / 2**20:.1f} GiB" if mem else f"- CPU: {cpu}",
@@ -54,5 +56,3 @@ def write_section(path: Path, section: str, start: str, end: str) -> None:
         text = "# Benchmarks\n\nMeasured by `make bench`; each section is rewritten by the script that owns it.\n\n" + section
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(text)
-
-

@@ -17,7 +17,7 @@
 
 from __future__ import annotations
 
-import common  # noqa: F401  (first: pins every thread pool to one core)
+import common  # first: pins every thread pool to one core
 
 import argparse
 import datetime
@@ -131,7 +131,7 @@ def reading(paths: dict[str, Path], repeat: int) -> list[str]:
             wall, count = best_of(repeat, fn(path))
             assert count == N_READ, (name, count)
             cells.append(f"{N_READ / wall / 1e6:.1f}")
-        for library, (make, formats) in LIBRARIES.items():
+        for make, formats in LIBRARIES.values():
             if name not in formats:
                 cells.append("–")
                 continue
@@ -179,10 +179,23 @@ def memory(repeat_formats=("aedat4", "evt3", "hdf5")) -> list[str]:
     rows = ["| input | events | wall time | peak memory (max RSS) | track records | output size |", "|---|---:|---:|---:|---:|---:|"]
     for name, path in paths.items():
         out = WORK / f"traffic_{name}.parquet"
-        cmd = [str(ROOT / ".venv" / "bin" / "evclust"), "track", str(path), "-o", str(out), "--params", "traffic", "--frame-us", "50000", "-q"]
+        cmd = [
+            str(ROOT / ".venv" / "bin" / "evclust"),
+            "track",
+            str(path),
+            "-o",
+            str(out),
+            "--params",
+            "traffic",
+            "--frame-us",
+            "50000",
+            "-q",
+        ]
         # A fresh wrapper process per run: RUSAGE_CHILDREN is then the peak of this one child.
-        wrapper = ("import resource, subprocess, sys; done = subprocess.run(sys.argv[1:]); "
-                   "print(resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss, file=sys.stderr); sys.exit(done.returncode)")
+        wrapper = (
+            "import resource, subprocess, sys; done = subprocess.run(sys.argv[1:]); "
+            "print(resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss, file=sys.stderr); sys.exit(done.returncode)"
+        )
         start = time.perf_counter()
         done = subprocess.run([sys.executable, "-c", wrapper, *cmd], capture_output=True, text=True)
         wall = time.perf_counter() - start
@@ -190,7 +203,9 @@ def memory(repeat_formats=("aedat4", "evt3", "hdf5")) -> list[str]:
             raise SystemExit(f"{' '.join(cmd)} failed: {done.stderr.strip()}")
         peak_kb = int(done.stderr.strip().splitlines()[-1])
         records = done.stdout.split(" track records")[0].rsplit(" ", 1)[-1]
-        rows.append(f"| {name} ({path.stat().st_size / 2**30:.2f} GiB) | {N_TRACK:,} | {wall:.1f} s | {peak_kb / 2**20:.2f} GiB | {records} | {out.stat().st_size / 2**20:.1f} MiB |")
+        rows.append(
+            f"| {name} ({path.stat().st_size / 2**30:.2f} GiB) | {N_TRACK:,} | {wall:.1f} s | {peak_kb / 2**20:.2f} GiB | {records} | {out.stat().st_size / 2**20:.1f} MiB |"
+        )
         print(rows[-1], flush=True)
     return rows
 

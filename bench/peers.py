@@ -18,13 +18,11 @@ from __future__ import annotations
 import argparse
 import datetime
 import os
-import statistics
 import sys
 import time
 from pathlib import Path
 
 import cv2
-import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 PEERS = ROOT / "build" / "peers"
@@ -123,7 +121,7 @@ def main() -> int:
     try:
         import esim_py  # noqa: F401
     except ImportError:
-        raise SystemExit(f"esim_py is not built in {PEERS / 'esim_py'}: run `make bench-peers`")
+        raise SystemExit(f"esim_py is not built in {PEERS / 'esim_py'}: run `make bench-peers`") from None
     sys.path.insert(0, str(ROOT / "bench"))
     from simulator import VIDEO as PAN_DISKS, ensure_video  # its `common` pins every pool to one thread: undone below
 
@@ -134,7 +132,9 @@ def main() -> int:
     videos = {"pan_disks": PAN_DISKS, "vtest": ROOT / "build" / "video" / "vtest.avi"}
     videos = {k: v for k, v in videos.items() if v.exists()}
     rows = measure(videos, args.repeat)
-    cpu = next((line.split(":", 1)[1].strip() for line in Path("/proc/cpuinfo").read_text().splitlines() if line.startswith("model name")), "?")
+    cpu = next(
+        (line.split(":", 1)[1].strip() for line in Path("/proc/cpuinfo").read_text().splitlines() if line.startswith("model name")), "?"
+    )
     section = "\n".join([
         START, "## The simulator beside ESIM (esim_py)", "",
         f"Measured {datetime.date.today()} by `make bench-peers` (`bench/peers.py`): {cpu}, {os.cpu_count()} cores. "

@@ -8,7 +8,7 @@ the placed Fmax (issue 12; `make timing` first).
 
 from __future__ import annotations
 
-import common  # noqa: F401  (first: pins every thread pool to one core)
+import common  # first: pins every thread pool to one core
 
 import argparse
 import datetime
@@ -52,10 +52,17 @@ def sustained(rows) -> list[str]:
     """Events per second at the placed Fmax (make timing's N = 16 result): the traffic clip's
     counted cycles per event times the clock."""
     timing = ROOT / "build" / "timing" / "results.json"
-    fmax = {r["n_clusters"]: r for r in json.loads(timing.read_text()) if r.get("configuration") == "defaults" and not r.get("static")} if timing.exists() else {}
+    fmax = (
+        {r["n_clusters"]: r for r in json.loads(timing.read_text()) if r.get("configuration") == "defaults" and not r.get("static")}
+        if timing.exists()
+        else {}
+    )
     if 16 not in fmax:
-        return ["", "Sustained rate at Fmax: not computed in this run: no result of `make timing` for the defaults at N = 16 in "
-                    "build/timing/results.json (the placed figures in the section below are of the RTL they name)."]
+        return [
+            "",
+            "Sustained rate at Fmax: not computed in this run: no result of `make timing` for the defaults at N = 16 in "
+            "build/timing/results.json (the placed figures in the section below are of the RTL they name).",
+        ]
     mhz = fmax[16]["fmax_mhz"]
     if mhz is None:
         return ["", "Sustained rate at Fmax: none: the N = 16 core of `make timing` does not fit the part (section below)."]
@@ -83,7 +90,7 @@ def main() -> int:
         "## RTL: cycles and co-simulation speed",
         "",
         f"Command: `make bench` (= `.venv/bin/python bench/rtl.py --write docs/BENCHMARKS.md`), "
-        f"run {datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC, on the machine above.",
+        f"run {datetime.datetime.now(datetime.UTC):%Y-%m-%d %H:%M} UTC, on the machine above.",
         "",
         "Cycles, counted by the harness (tb/evclust_core/evclust_tb.v) while every vector case replays "
         "with no input gap and no output stall. `filter` cycles are those with `filter_active` high (a step's phase, "
@@ -96,7 +103,7 @@ def main() -> int:
         "clock edges from the one that takes an event to the one that writes its slot (the harness stamps both); the "
         "largest is an event taken as a filter step begins, which waits in stage A for the whole step. In the "
         "`pipelined_*` cases (update_delay = 1) the edge stamped is the one that decides the event; its update is "
-        "written as the next event finishes (docs/RTL.md, \"Pipeline semantics\").",
+        'written as the next event finishes (docs/RTL.md, "Pipeline semantics").',
         "",
         "| case | N | events | cycles | cycles/event | cycles/event outside sweeps | sweeps | cycles/sweep | evictions + drops "
         "| object unit cycles/step | core held (cycles) | latency, edges: min / mean / max |",

@@ -20,7 +20,7 @@ Mpixel-frames/s = W*H*frames / wall / 1e6; Mev/s = events / wall / 1e6.
 
 from __future__ import annotations
 
-import common  # noqa: F401  (first: pins every thread pool to one core)
+import common  # first: pins every thread pool to one core
 
 import argparse
 import dataclasses
@@ -29,18 +29,18 @@ import statistics
 import sys
 import time
 from pathlib import Path
-from typing import Callable
+from collections.abc import Callable
 
 import cv2
 import numpy as np
-from tqdm import tqdm  # noqa: E402
+from tqdm import tqdm
 
-from evclust.colour import RGB_TO_YCBCR  # noqa: E402
-from evclust.events.format import EVENT_DTYPE  # noqa: E402
-from evclust.scenes import Scene, load_scene  # noqa: E402
-from evclust.scenes.synthetic import SyntheticSource  # noqa: E402
-from evclust.scenes.video import VideoSource  # noqa: E402
-from evclust.simulator import EFFECTS, make_simulator, simulate_scene  # noqa: E402
+from evclust.colour import RGB_TO_YCBCR
+from evclust.events.format import EVENT_DTYPE
+from evclust.scenes import Scene, load_scene
+from evclust.scenes.synthetic import SyntheticSource
+from evclust.scenes.video import VideoSource
+from evclust.simulator import EFFECTS, make_simulator, simulate_scene
 
 ROOT = Path(__file__).resolve().parents[1]
 VIDEO = ROOT / "build" / "bench" / "pan_disks.avi"
@@ -299,7 +299,7 @@ def effect_costs(name: str, load: Callable[[], Scene], frames: list[np.ndarray],
     costs = []
     for effect, params in effects.items():
         scene = with_effects(load(), {effect: params})
-        t = timed(f"{name}: {effect} alone", lambda: len(make_simulator(scene).run(frames).events), repeat)
+        t = timed(f"{name}: {effect} alone", lambda scene=scene: len(make_simulator(scene).run(frames).events), repeat)
         costs.append(EffectCost(name, effect, t.events, t))
     return costs
 

@@ -23,7 +23,7 @@ import time
 import zlib
 from pathlib import Path
 
-import common  # noqa: F401  (first: pins every thread pool to one core)
+import common  # first: pins every thread pool to one core
 
 from evclust.clusterer import ClustererParams
 from evclust.clusterer.run import prepare_run, track_stream
@@ -96,7 +96,10 @@ def configurations(truth) -> list[str]:
         _, meta = prepare_run(source.meta, params, "float")
         meta = dataclasses.replace(meta, per_frame=True)  # thinned as `evclust track --per-frame` does, and scored so
         files = {kind: VIDEO_DIR / f"vtest_config_{kind}.parquet" for kind in ("clusters", "objects")}
-        with track_writer(files["clusters"], meta) as clusters, track_writer(files["objects"], dataclasses.replace(meta, kind="objects")) as objects:
+        with (
+            track_writer(files["clusters"], meta) as clusters,
+            track_writer(files["objects"], dataclasses.replace(meta, kind="objects")) as objects,
+        ):
             thin = {"clusters": PerFrame(clusters.write, meta.t_frame_us), "objects": PerFrame(objects.write, meta.t_frame_us)}
             run = track_stream(source.chunks(), source.meta, params, sink=thin["clusters"].write, object_sink=thin["objects"].write)
             for thinner in thin.values():

@@ -51,7 +51,7 @@ def header(n: int, **update) -> str:
 
 
 def synth(label: str, text: str, snapshot, top: str = "evclust_core") -> dict:
-    beat = lambda s, step: print(f"  {label}: {s:5.0f} s, {step}", file=sys.stderr)  # noqa: E731
+    beat = lambda s, step: print(f"  {label}: {s:5.0f} s, {step}", file=sys.stderr)
     figures = synthesise(text, label, False, beat, snapshot, top=top, static=True)
     print(f"synth: {label} done in {figures['wall_s'] / 60:.1f} min{' (cached)' if figures['cached'] else ''}", file=sys.stderr)
     return figures
@@ -120,12 +120,14 @@ def section(all_on: dict, costs: dict, objects: dict, support: tuple, tracking: 
     bought = ""
     if tracking and "no object layer" in tracking and "default" in tracking:
         on, off = tracking["default"]["figures"], tracking["no object layer"]["figures"]
-        bought = (f" With it, on the tuning split: HOTA {_pct(on['HOTA'])} against {_pct(off['HOTA'])} for the cluster records "
-                  f"of the same run, {on['tracks_per_object']:.2f} tracks per object against {off['tracks_per_object']:.2f}.")
+        bought = (
+            f" With it, on the tuning split: HOTA {_pct(on['HOTA'])} against {_pct(off['HOTA'])} for the cluster records "
+            f"of the same run, {on['tracks_per_object']:.2f} tracks per object against {off['tracks_per_object']:.2f}."
+        )
     return "\n".join([
         START,
         f"Hardware: `.venv/bin/python synth/ablation.py --write docs/TUNING.md`, run "
-        f"{datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC, RTL at {rtl}: Yosys `synth_xilinx` (the flow "
+        f"{datetime.datetime.now(datetime.UTC):%Y-%m-%d %H:%M} UTC, RTL at {rtl}: Yosys `synth_xilinx` (the flow "
         f"of `make synth`) on 480×270 at 20 fps, the defaults with every addition on (the scaled seek at "
         f"{SEEK_SCALE_TUNED}, its last tuned scale) and one switched off at a time, the constants built in, "
         f"N = {N_SMALL} and {N_LARGE}; per slot is the slope over N of what the addition adds, shared what remains at "
@@ -144,7 +146,12 @@ def section(all_on: dict, costs: dict, objects: dict, support: tuple, tracking: 
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--figures", type=Path, default=BUILD / "ablation.json", help="tracking figures of `generalize --ablation --json` (default: %(default)s)")
+    parser.add_argument(
+        "--figures",
+        type=Path,
+        default=BUILD / "ablation.json",
+        help="tracking figures of `generalize --ablation --json` (default: %(default)s)",
+    )
     parser.add_argument("--write", type=Path, metavar="TUNING.md", help="rewrite this file's ablation section")
     args = parser.parse_args()
     snapshot = rtl_snapshot()

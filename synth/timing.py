@@ -22,7 +22,7 @@ from evclust.rtl.synth import rtl_snapshot
 from evclust.rtl.timing import BUILD, PART, TARGET_MHZ, place_and_route
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from synth import defaults_header, params_header  # noqa: E402
+from synth import defaults_header, params_header
 
 ROOT = Path(__file__).resolve().parents[1]
 START, END = "<!-- bench:timing:start -->", "<!-- bench:timing:end -->"
@@ -55,7 +55,7 @@ def table(rows) -> str:
     lines = [head, "|" + "---|" * (head.count("|") - 1)]
     for r in rows:
         res, avail, cp = r["resources"], r["available"], r["critical_path"]
-        pct = lambda k: f"{res[k]:,} ({100 * res[k] / avail[k]:.0f} %)" if avail[k] else f"{res[k]:,}"  # noqa: E731
+        pct = lambda k, res=res, avail=avail: f"{res[k]:,} ({100 * res[k] / avail[k]:.0f} %)" if avail[k] else f"{res[k]:,}"
         fmax = f"{r['fmax_mhz']:.1f}" if r["fmax_mhz"] is not None else "does not fit"
         path = f"{cp['cells']} ({cp['carry_cells']}), {cp['logic_ns']:.1f} + {cp['routing_ns']:.1f}" if cp else "none"
         lines.append(
@@ -73,6 +73,7 @@ TARGETS = {16: {"fmax": 100.0, "lut4": 0.80}, 64: {"fmax": 80.0, "lut4": 1.0}}
 
 def datasheet(rows) -> str:
     """docs/RTL.md's place-and-route table: one column per run, the targets beside."""
+
     def cell(r, key):
         res, avail = r["resources"][key], r["available"][key]
         return f"{res:,} ({100 * res / avail:.0f} %)" if avail else f"{res:,}"
@@ -83,8 +84,10 @@ def datasheet(rows) -> str:
             return ""
         fmax_ok = r["fmax_mhz"] is not None and r["fmax_mhz"] >= target["fmax"]
         area_ok = r["fits"] and r["resources"]["lut4"] <= target["lut4"] * r["available"]["lut4"]
-        return (f"Fmax ≥ {target['fmax']:.0f} MHz: {'PASS' if fmax_ok else '**FAIL**'}; "
-                f"logic ≤ {100 * target['lut4']:.0f} % and multipliers ≤ {r['available']['mult18']}: {'PASS' if area_ok else '**FAIL**'}")
+        return (
+            f"Fmax ≥ {target['fmax']:.0f} MHz: {'PASS' if fmax_ok else '**FAIL**'}; "
+            f"logic ≤ {100 * target['lut4']:.0f} % and multipliers ≤ {r['available']['mult18']}: {'PASS' if area_ok else '**FAIL**'}"
+        )
 
     heads = [f"{r['configuration']}{' (constants built in)' if r.get('static') else ''}, N = {r['n_clusters']}" for r in rows]
     lines = [
@@ -94,8 +97,14 @@ def datasheet(rows) -> str:
         "",
         "| figure | " + " | ".join(heads) + " |",
         "|---|" + "---:|" * len(rows),
-        "| Fmax | " + " | ".join((f"{r['fmax_mhz']:.1f} MHz" + ("" if r["routed"] else " (placement estimate, not routed)"))
-                                  if r["fmax_mhz"] is not None else "does not fit" for r in rows) + " |",
+        "| Fmax | "
+        + " | ".join(
+            (f"{r['fmax_mhz']:.1f} MHz" + ("" if r["routed"] else " (placement estimate, not routed)"))
+            if r["fmax_mhz"] is not None
+            else "does not fit"
+            for r in rows
+        )
+        + " |",
         "| logic cells (TRELLIS_COMB) | " + " | ".join(cell(r, "lut4") for r in rows) + " |",
         "| flip-flops | " + " | ".join(cell(r, "ff") for r in rows) + " |",
         "| 18×18 multipliers (MULT18X18D) | " + " | ".join(cell(r, "mult18") for r in rows) + " |",
@@ -115,7 +124,7 @@ def section(rows) -> str:
         "## RTL: place and route for Lattice ECP5 (Fmax)",
         "",
         f"Command: `{command()}`, run "
-        f"{datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC on the machine above, RTL at {rows[0]['rtl']}. "
+        f"{datetime.datetime.now(datetime.UTC):%Y-%m-%d %H:%M} UTC on the machine above, RTL at {rows[0]['rtl']}. "
         f"Flow: {rows[0]['tools']}: `synth_ecp5`, then `nextpnr-ecp5 {' '.join(PART['nextpnr'])} --out-of-context "
         f"--freq {TARGET_MHZ} --router router2 --seed 1` ({PART['device']}, speed grade 8; no IO buffers: the core is an IP block). The "
         "core as users build it, its parameters in run-time registers (RUNTIME_CONFIG = 1), the widths of each parameter "
@@ -134,8 +143,13 @@ def section(rows) -> str:
             lines.append(f"- {r['configuration']}, N = {r['n_clusters']}: not placed: the design needs more cells than the part has.")
             continue
         # The project's own lines (not Yosys's techmap files), file name and line, in path order.
-        where = list(dict.fromkeys(Path(src.split(":")[0]).name + ":" + src.split(":")[1].split(".")[0]
-                                   for src in cp.get("sources", []) if ":" in src and Path(src.split(":")[0]).name.startswith("evclust_")))
+        where = list(
+            dict.fromkeys(
+                Path(src.split(":")[0]).name + ":" + src.split(":")[1].split(".")[0]
+                for src in cp.get("sources", [])
+                if ":" in src and Path(src.split(":")[0]).name.startswith("evclust_")
+            )
+        )
         shown = ", ".join(where)
         lines.append(f"- {r['configuration']}, N = {r['n_clusters']}: `{cp.get('from')}` to `{cp.get('to')}`, through the lines {shown}.")
     return "\n".join(lines + [END, ""])
@@ -143,8 +157,13 @@ def section(rows) -> str:
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--runs", type=parse_run, nargs="+", default=[parse_run(r) for r in RUNS],
-                        help=f"configuration:N[:placed] runs (default: {' '.join(RUNS)})")
+    parser.add_argument(
+        "--runs",
+        type=parse_run,
+        nargs="+",
+        default=[parse_run(r) for r in RUNS],
+        help=f"configuration:N[:placed] runs (default: {' '.join(RUNS)})",
+    )
     parser.add_argument("--no-route", action="store_true", help="stop after placement (nextpnr's estimate)")
     parser.add_argument("--json", type=Path, default=BUILD / "timing" / "results.json", help="raw figures (default: %(default)s)")
     parser.add_argument("--write", type=Path, metavar="BENCHMARKS.md", help="rewrite this file's timing section")
@@ -156,7 +175,7 @@ def main():
     try:
         for name, n, placed in args.runs:
             print(f"timing: {name}, N={n} ...", file=sys.stderr)
-            beat = lambda step, s, detail, n=n: print(f"  N={n}: {step} {s:5.0f} s {detail}", file=sys.stderr)  # noqa: E731
+            beat = lambda step, s, detail, n=n: print(f"  N={n}: {step} {s:5.0f} s {detail}", file=sys.stderr)
             label = f"{name}-n{n}{'-static' if args.static else ''}"
             figures = place_and_route(HEADERS[name](n), label, not (args.no_route or placed), beat, snapshot, static=args.static)
             rows.append(figures | {"configuration": name, "n_clusters": n, "static": args.static})

@@ -7,7 +7,8 @@ from __future__ import annotations
 
 
 def pytest_terminal_summary(terminalreporter):
-    ran = [r for outcome in ("passed", "failed", "error") for r in terminalreporter.stats.get(outcome, ()) if hasattr(r, "nodeid")]
+    # Test reports only: a collection's report (--collect-only, a collection error) has no keywords.
+    ran = [r for outcome in ("passed", "failed", "error") for r in terminalreporter.stats.get(outcome, ()) if hasattr(r, "keywords")]
     if not any("rotating" in r.keywords for r in ran):
         return
     from cosim import full, rotation_key  # tb/, on the path as the conftest's folder

@@ -113,14 +113,14 @@ def random_config(name: str, n_clusters: int, seed: int, count: int, formats: di
 LEAF_BUILDS = {"traffic": (480, 270, 50000.0), "defaults": (160, 120, 16666.0)}
 
 
-def leaf_model(build: str):
+def leaf_model(name: str):
     """The fixed model of a LEAF_BUILDS build: its formats, constants and globals are what the
     leaf benches drive the module with and compare against."""
     from evclust.clusterer import ClustererParams, load_params
     from evclust.fixed.model import FixedClusterer
 
-    width, height, t_frame = LEAF_BUILDS[build]
-    params = ClustererParams(n_clusters=4) if build == "defaults" else load_params(build)[0].model_copy(update={"n_clusters": 4})
+    width, height, t_frame = LEAF_BUILDS[name]
+    params = ClustererParams(n_clusters=4) if name == "defaults" else load_params(name)[0].model_copy(update={"n_clusters": 4})
     return FixedClusterer(params, width, height, t_frame)
 
 

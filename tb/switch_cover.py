@@ -21,7 +21,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from cosim import full, rotating_subset, rotation_key  # noqa: F401  (full: the tests' switch)
+from cosim import full, rotating_subset, rotation_key  # full: the tests' switch, imported from here
 
 # The small sensor of tb/cosim.py's "small" configuration.
 WIDTH, HEIGHT, T_FRAME_US = 64, 48, 10000.0
@@ -67,7 +67,7 @@ class Row(NamedTuple):
     def name(self) -> str:
         return f"row{self.index:02d}-" + "-".join(self.settings)
 
-    def flipped(self, switch: str, value: str) -> "Row":
+    def flipped(self, switch: str, value: str) -> Row:
         return Row(self.index, tuple((self.values | {switch: value}).values()))
 
 

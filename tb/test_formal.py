@@ -46,8 +46,11 @@ BREAKAGES = {
         "wire sweep_advance = state == ST_SWEEP && (!rec_valid || rec_ready);",
         "wire sweep_advance = state == ST_SWEEP;",
         # The overwritten record is also one that the sweep's record accounting misses.
-        ("assert (rec_valid && rec_data == $past(rec_data));", "assert (f_offered[f_s] == (f_out[f_s] && f_reported[f_s]));",
-         "assert (&f_visited && f_out == f_kept"),
+        (
+            "assert (rec_valid && rec_data == $past(rec_data));",
+            "assert (f_offered[f_s] == (f_out[f_s] && f_reported[f_s]));",
+            "assert (&f_visited && f_out == f_kept",
+        ),
     ),
     "core traces an event twice": (
         "evclust_core",
@@ -77,8 +80,12 @@ BREAKAGES = {
         "evclust_core",
         "        if (rec_valid && rec_ready)\n            rec_valid <= 1'b0;\n",
         "        if (rec_valid && rec_ready)\n            rec_valid <= 1'b1;\n",
-        ("!f_recorded[f_rec_slot]);", "assert (&f_visited && f_out == f_kept", "assert (state == ST_SWEEP || f_after_sweep);",
-         "assert (f_offered[f_s] == (f_out[f_s] && f_reported[f_s]));"),
+        (
+            "!f_recorded[f_rec_slot]);",
+            "assert (&f_visited && f_out == f_kept",
+            "assert (state == ST_SWEEP || f_after_sweep);",
+            "assert (f_offered[f_s] == (f_out[f_s] && f_reported[f_s]));",
+        ),
     ),
     # The reference build (MERGE = 0) never merges and still proves with this core: only the
     # merge-enabled job sees the MERGE state hang.
@@ -86,7 +93,10 @@ BREAKAGES = {
         "evclust_core",
         "wire                  div_start = state == ST_MERGE && !m_started;",
         "wire                  div_start = state == ST_MERGE;",
-        ("assert (!f_filter || f_filter_cycles < F_FILTER_BOUND);", "f_filter_cycles + f_merge_x_count <= f_sweep_cycles + 2 + MERGE_MOMENT_W);"),
+        (
+            "assert (!f_filter || f_filter_cycles < F_FILTER_BOUND);",
+            "f_filter_cycles + f_merge_x_count <= f_sweep_cycles + 2 + MERGE_MOMENT_W);",
+        ),
     ),
     "object unit overwrites an object record before it is taken": (
         "evclust_objects",

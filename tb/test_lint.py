@@ -9,9 +9,9 @@ import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from lint import lint  # noqa: E402
+from lint import lint
 
-from evclust.vectors.read import load_case  # noqa: E402
+from evclust.vectors.read import load_case
 
 VECTORS = Path(__file__).resolve().parents[1] / "vectors"
 

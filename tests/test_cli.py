@@ -125,7 +125,7 @@ def _write_video(path, frames_rgb, fps=30):
 
 def test_a_video_and_the_same_frames_as_images_give_the_same_events(tmp_path, capsys):
     source = load_scene("crossing").source
-    frames = [np.clip(np.rint(source.render(k)), 0, 255).astype(np.uint8) for k in range(0, 40)]
+    frames = [np.clip(np.rint(source.render(k)), 0, 255).astype(np.uint8) for k in range(40)]
     video = tmp_path / "crossing.avi"
     _write_video(video, frames)
     # The codec is lossless, so both inputs hold exactly the same frames.
@@ -151,7 +151,9 @@ def test_console_script_reports_bad_input_without_traceback(tmp_path):
     exe = __import__("shutil").which("evclust") or str(__import__("pathlib").Path(sys.executable).parent / "evclust")
     result = subprocess.run([exe, "simulate", "nosuch", "-o", str(tmp_path / "e.npz")], capture_output=True, text=True)
     assert result.returncode == 2
-    assert result.stderr.strip().splitlines() == ["evclust: error: unknown scene 'nosuch': built-in scenes are crossing, grey_on_grey, pedestrian, slow, traffic"]
+    assert result.stderr.strip().splitlines() == [
+        "evclust: error: unknown scene 'nosuch': built-in scenes are crossing, grey_on_grey, pedestrian, slow, traffic"
+    ]
 
 
 def test_a_video_with_a_truth_csv_beside_it_passes_the_truth_through(tmp_path, capsys):

@@ -76,11 +76,20 @@ OVERWRITES = {
     "simulate -o = its scene": (["simulate", "{d}/scene.toml", "-o", "{d}/scene.toml"], ["SCENE"]),
     "simulate --truth = its scene": (["simulate", "{d}/scene.toml", "-o", "{d}/new.npz", "--truth", "{d}/scene.toml"], ["--truth"]),
     "simulate --truth = -o": (["simulate", "{d}/scene.toml", "-o", "{d}/new.csv", "--truth", "{d}/new.csv"], ["another output"]),
-    "simulate --truth = -o, an existing file": (["simulate", "{d}/scene.toml", "-o", "{d}/gt.csv", "--truth", "{d}/gt.csv"], ["another output"]),
+    "simulate --truth = -o, an existing file": (
+        ["simulate", "{d}/scene.toml", "-o", "{d}/gt.csv", "--truth", "{d}/gt.csv"],
+        ["another output"],
+    ),
     "score --json = its tracks": (["score", "{d}/tracks.csv", "--truth", "{d}/gt.csv", "--json", "{d}/tracks.csv"], ["--json"]),
     "score --json = its truth": (["score", "{d}/tracks.csv", "--truth", "{d}/gt.csv", "--json", "{d}/gt.csv"], ["--json"]),
-    "score --json = a symlink to its truth": (["score", "{d}/tracks.csv", "--truth", "{d}/gt.csv", "--json", "{d}/gt_symlink.csv"], ["--json"]),
-    "score --json = its tracks through a symlink given as tracks": (["score", "{d}/tracks_symlink.csv", "--truth", "{d}/gt.csv", "--json", "{d}/tracks.csv"], ["--json"]),
+    "score --json = a symlink to its truth": (
+        ["score", "{d}/tracks.csv", "--truth", "{d}/gt.csv", "--json", "{d}/gt_symlink.csv"],
+        ["--json"],
+    ),
+    "score --json = its tracks through a symlink given as tracks": (
+        ["score", "{d}/tracks_symlink.csv", "--truth", "{d}/gt.csv", "--json", "{d}/tracks.csv"],
+        ["--json"],
+    ),
     "show -o = its events": (["show", "{d}/ev.npz", "-o", "{d}/ev.npz"], ["EVENTS"]),
     "render -o = its events": (["render", "{d}/ev.npz", "{d}/tracks.csv", "-o", "{d}/ev.npz"], ["EVENTS"]),
     "render -o = its tracks": (["render", "{d}/ev.npz", "{d}/tracks.csv", "-o", "{d}/tracks.csv"], ["TRACKS"]),
@@ -88,8 +97,14 @@ OVERWRITES = {
     "plot -o = its truth": (["plot", "{d}/tracks.csv", "--truth", "{d}/gt.csv", "-o", "{d}/gt.csv"], ["--truth"]),
     "formats --registers = its parameters": (["formats", "--params", "{d}/params.toml", "--registers", "{d}/params.toml"], ["--params"]),
     "formats --c-header = --verilog": (["formats", "--verilog", "{d}/x.vh", "--c-header", "{d}/x.vh"], ["another output"]),
-    "formats --verilog = --write-for's file": (["formats", "--write-for", "{d}/params.toml", "--verilog", "{d}/params.toml"], ["--write-for"]),
-    "tune -o = its parameters": (["tune", "{d}/scene.toml", "--params", "{d}/params.toml", "-o", "{d}/params.toml", "--trials", "1", "-q"], ["--params"]),
+    "formats --verilog = --write-for's file": (
+        ["formats", "--write-for", "{d}/params.toml", "--verilog", "{d}/params.toml"],
+        ["--write-for"],
+    ),
+    "tune -o = its parameters": (
+        ["tune", "{d}/scene.toml", "--params", "{d}/params.toml", "-o", "{d}/params.toml", "--trials", "1", "-q"],
+        ["--params"],
+    ),
     "tune -o = its scene": (["tune", "{d}/scene.toml", "-o", "{d}/scene.toml", "--trials", "1", "-q"], ["SCENE"]),
 }
 
@@ -137,13 +152,22 @@ def test_a_full_device_is_reported_as_one_line(argv, files, tmp_path, capsys):
 def test_simulate_writes_both_outputs_or_neither(files, tmp_path, capsys):
     """--truth that cannot be written (its folder is a file): the event file is not left either."""
     folder = work_folder(files, tmp_path)
-    assert_refused(capsys, folder, ["simulate", str(folder / "scene.toml"), "-o", str(folder / "new.npz"), "--truth", str(folder / "tracks.csv" / "gt.csv"), "-q"])
+    assert_refused(
+        capsys,
+        folder,
+        ["simulate", str(folder / "scene.toml"), "-o", str(folder / "new.npz"), "--truth", str(folder / "tracks.csv" / "gt.csv"), "-q"],
+    )
 
 
 def test_sigterm_mid_run_leaves_no_temporary_or_partial_file(files, tmp_path):
     """A long simulation killed with SIGTERM: exit 143, one line, nothing left in the folder."""
     folder = work_folder(files, tmp_path)
-    long_scene = SCENE.replace("frames = 6", "frames = 4000").replace("frames = 5,", "frames = 3999,").replace("width = 40", "width = 640").replace("height = 30", "height = 480")
+    long_scene = (
+        SCENE.replace("frames = 6", "frames = 4000")
+        .replace("frames = 5,", "frames = 3999,")
+        .replace("width = 40", "width = 640")
+        .replace("height = 30", "height = 480")
+    )
     (folder / "long.toml").write_text(long_scene)
     before = snapshot(folder)
     proc = subprocess.Popen([sys.executable, "-c", "import sys; from evclust.cli import main; sys.exit(main())", "simulate", str(folder / "long.toml"), "-o", str(folder / "long.npz"), "-q"],
@@ -203,18 +227,45 @@ MALFORMED = {
     "npz of garbage": ({"bad.npz": b"PK\x03\x04 not a zip at all"}, ["track", "{d}/bad.npz", "-o", "{d}/out.csv", "-q"]),
     "zero-byte h5": ({"bad.h5": b""}, ["track", "{d}/bad.h5", "-o", "{d}/out.csv", "-q"]),
     "h5 without events": ({"bad.h5": lambda p, f: _h5(p, {"other": [1, 2, 3]})}, ["track", "{d}/bad.h5", "-o", "{d}/out.csv", "-q"]),
-    "h5 with events as a group": ({"bad.h5": lambda p, f: _h5(p, {"events": {"width": 40}})}, ["track", "{d}/bad.h5", "-o", "{d}/out.csv", "-q"]),
+    "h5 with events as a group": (
+        {"bad.h5": lambda p, f: _h5(p, {"events": {"width": 40}})},
+        ["track", "{d}/bad.h5", "-o", "{d}/out.csv", "-q"],
+    ),
     "zero-byte scene": ({"bad.toml": b""}, ["simulate", "{d}/bad.toml", "-o", "{d}/out.npz", "-q"]),
-    "scene not UTF-8": ({"bad.toml": b"width = 40\nlabel = \"\xff\xfe\"\n"}, ["simulate", "{d}/bad.toml", "-o", "{d}/out.npz", "-q"]),
-    "params not UTF-8": ({"bad.toml": b"[clusterer]\nn_clusters = \xff\n"}, ["track", "{d}/ev.npz", "-o", "{d}/out.csv", "--params", "{d}/bad.toml", "-q"]),
-    "params of the wrong type": ({"bad.toml": b"[clusterer]\nn_clusters = \"many\"\n"}, ["track", "{d}/ev.npz", "-o", "{d}/out.csv", "--params", "{d}/bad.toml", "-q"]),
+    "scene not UTF-8": ({"bad.toml": b'width = 40\nlabel = "\xff\xfe"\n'}, ["simulate", "{d}/bad.toml", "-o", "{d}/out.npz", "-q"]),
+    "params not UTF-8": (
+        {"bad.toml": b"[clusterer]\nn_clusters = \xff\n"},
+        ["track", "{d}/ev.npz", "-o", "{d}/out.csv", "--params", "{d}/bad.toml", "-q"],
+    ),
+    "params of the wrong type": (
+        {"bad.toml": b'[clusterer]\nn_clusters = "many"\n'},
+        ["track", "{d}/ev.npz", "-o", "{d}/out.csv", "--params", "{d}/bad.toml", "-q"],
+    ),
     "params not TOML": ({"bad.toml": b"[clusterer\n"}, ["track", "{d}/ev.npz", "-o", "{d}/out.csv", "--params", "{d}/bad.toml", "-q"]),
-    "scene velocity NaN": ({"bad.toml": _scene_with(**{"velocity = [2.0, 0.0]": "velocity = [nan, 0.0]"})}, ["simulate", "{d}/bad.toml", "-o", "{d}/out.npz", "-q"]),
-    "scene velocity inf": ({"bad.toml": _scene_with(**{"velocity = [2.0, 0.0]": "velocity = [inf, 0.0]"})}, ["simulate", "{d}/bad.toml", "-o", "{d}/out.npz", "-q"]),
-    "scene start NaN": ({"bad.toml": _scene_with(**{"start = [10, 15]": "start = [nan, 15]"})}, ["simulate", "{d}/bad.toml", "-o", "{d}/out.npz", "-q"]),
-    "scene size inf": ({"bad.toml": _scene_with(**{"size = [8, 8]": "size = [inf, 8]"})}, ["simulate", "{d}/bad.toml", "-o", "{d}/out.npz", "-q"]),
-    "scene size negative": ({"bad.toml": _scene_with(**{"size = [8, 8]": "size = [-8, 8]"})}, ["simulate", "{d}/bad.toml", "-o", "{d}/out.npz", "-q"]),
-    "scene colour out of range": ({"bad.toml": _scene_with(**{"colour = [210, 40, 40]": "colour = [999, 40, 40]"})}, ["simulate", "{d}/bad.toml", "-o", "{d}/out.npz", "-q"]),
+    "scene velocity NaN": (
+        {"bad.toml": _scene_with(**{"velocity = [2.0, 0.0]": "velocity = [nan, 0.0]"})},
+        ["simulate", "{d}/bad.toml", "-o", "{d}/out.npz", "-q"],
+    ),
+    "scene velocity inf": (
+        {"bad.toml": _scene_with(**{"velocity = [2.0, 0.0]": "velocity = [inf, 0.0]"})},
+        ["simulate", "{d}/bad.toml", "-o", "{d}/out.npz", "-q"],
+    ),
+    "scene start NaN": (
+        {"bad.toml": _scene_with(**{"start = [10, 15]": "start = [nan, 15]"})},
+        ["simulate", "{d}/bad.toml", "-o", "{d}/out.npz", "-q"],
+    ),
+    "scene size inf": (
+        {"bad.toml": _scene_with(**{"size = [8, 8]": "size = [inf, 8]"})},
+        ["simulate", "{d}/bad.toml", "-o", "{d}/out.npz", "-q"],
+    ),
+    "scene size negative": (
+        {"bad.toml": _scene_with(**{"size = [8, 8]": "size = [-8, 8]"})},
+        ["simulate", "{d}/bad.toml", "-o", "{d}/out.npz", "-q"],
+    ),
+    "scene colour out of range": (
+        {"bad.toml": _scene_with(**{"colour = [210, 40, 40]": "colour = [999, 40, 40]"})},
+        ["simulate", "{d}/bad.toml", "-o", "{d}/out.npz", "-q"],
+    ),
     "scene width zero": ({"bad.toml": _scene_with(**{"width = 40": "width = 0"})}, ["simulate", "{d}/bad.toml", "-o", "{d}/out.npz", "-q"]),
     "scene fps NaN": ({"bad.toml": _scene_with(**{"fps = 30": "fps = nan"})}, ["simulate", "{d}/bad.toml", "-o", "{d}/out.npz", "-q"]),
     "--fps NaN": ({}, ["simulate", "{d}/scene.toml", "-o", "{d}/out.npz", "--fps", "nan", "-q"]),
@@ -236,10 +287,11 @@ MALFORMED = {
     "formats --params with tau_us = inf": ({"bad.toml": b"[clusterer]\ntau_us = inf\n"}, ["formats", "--params", "{d}/bad.toml"]),
     "formats --params with NaN": ({"bad.toml": b"[clusterer]\nalpha_pos = nan\n"}, ["formats", "--params", "{d}/bad.toml"]),
     "formats --width NaN-like": ({}, ["formats", "--width", "0"]),
-    "fixed model with tau_us = inf": ({"bad.toml": b"[clusterer]\ntau_us = inf\n"}, ["track", "{d}/ev.npz", "-o", "{d}/out.csv", "--model", "fixed", "--params", "{d}/bad.toml", "-q"]),
+    "fixed model with tau_us = inf": (
+        {"bad.toml": b"[clusterer]\ntau_us = inf\n"},
+        ["track", "{d}/ev.npz", "-o", "{d}/out.csv", "--model", "fixed", "--params", "{d}/bad.toml", "-q"],
+    ),
 }
-
-
 
 
 def _npz_meta(meta) -> callable:
@@ -278,37 +330,39 @@ def _h5_from_good(attrs: dict | None = None, reshape: str | None = None) -> call
 
 TRACK = ["track", "{d}/bad.npz", "-o", "{d}/out.csv", "-q"]
 TRACK_H5 = ["track", "{d}/bad.h5", "-o", "{d}/out.csv", "-q"]
-MALFORMED.update({
-    "npz meta width a string": ({"bad.npz": _npz_meta({"width": "wide"})}, TRACK),
-    "npz meta width negative": ({"bad.npz": _npz_meta({"width": -40})}, TRACK),
-    "npz meta width zero": ({"bad.npz": _npz_meta({"width": 0})}, TRACK),
-    "npz meta sensor 60000 x 60000": ({"bad.npz": _npz_meta({"width": 60000, "height": 60000})}, TRACK),
-    "npz meta t_frame_us negative": ({"bad.npz": _npz_meta({"t_frame_us": -33333.0})}, TRACK),
-    "npz meta t_frame_us a list": ({"bad.npz": _npz_meta({"t_frame_us": [1, 2]})}, TRACK),
-    "npz meta not JSON": ({"bad.npz": _npz_meta(__import__("numpy").array("{not json"))}, TRACK),
-    "npz meta a number array": ({"bad.npz": _npz_meta(__import__("numpy").arange(3))}, TRACK),
-    "npz meta JSON list": ({"bad.npz": _npz_meta(__import__("numpy").array("[1, 2]"))}, TRACK),
-    "h5 width a string": ({"bad.h5": _h5_from_good({"width": "wide"})}, TRACK_H5),
-    "h5 width an array": ({"bad.h5": _h5_from_good({"width": [40, 40]})}, TRACK_H5),
-    "h5 height negative": ({"bad.h5": _h5_from_good({"height": -30})}, TRACK_H5),
-    "h5 sensor 60000 x 60000": ({"bad.h5": _h5_from_good({"width": 60000, "height": 60000})}, TRACK_H5),
-    "h5 field t two-dimensional": ({"bad.h5": _h5_from_good(reshape="t")}, TRACK_H5),
-    "h5 field x two-dimensional": ({"bad.h5": _h5_from_good(reshape="x")}, TRACK_H5),
-})
-
-
+MALFORMED.update(
+    {
+        "npz meta width a string": ({"bad.npz": _npz_meta({"width": "wide"})}, TRACK),
+        "npz meta width negative": ({"bad.npz": _npz_meta({"width": -40})}, TRACK),
+        "npz meta width zero": ({"bad.npz": _npz_meta({"width": 0})}, TRACK),
+        "npz meta sensor 60000 x 60000": ({"bad.npz": _npz_meta({"width": 60000, "height": 60000})}, TRACK),
+        "npz meta t_frame_us negative": ({"bad.npz": _npz_meta({"t_frame_us": -33333.0})}, TRACK),
+        "npz meta t_frame_us a list": ({"bad.npz": _npz_meta({"t_frame_us": [1, 2]})}, TRACK),
+        "npz meta not JSON": ({"bad.npz": _npz_meta(__import__("numpy").array("{not json"))}, TRACK),
+        "npz meta a number array": ({"bad.npz": _npz_meta(__import__("numpy").arange(3))}, TRACK),
+        "npz meta JSON list": ({"bad.npz": _npz_meta(__import__("numpy").array("[1, 2]"))}, TRACK),
+        "h5 width a string": ({"bad.h5": _h5_from_good({"width": "wide"})}, TRACK_H5),
+        "h5 width an array": ({"bad.h5": _h5_from_good({"width": [40, 40]})}, TRACK_H5),
+        "h5 height negative": ({"bad.h5": _h5_from_good({"height": -30})}, TRACK_H5),
+        "h5 sensor 60000 x 60000": ({"bad.h5": _h5_from_good({"width": 60000, "height": 60000})}, TRACK_H5),
+        "h5 field t two-dimensional": ({"bad.h5": _h5_from_good(reshape="t")}, TRACK_H5),
+        "h5 field x two-dimensional": ({"bad.h5": _h5_from_good(reshape="x")}, TRACK_H5),
+    }
+)
 
 
 # Unbounded work: refused at once, before anything is allocated or drawn.
 SIM = ["simulate", "{d}/bad.toml", "-o", "{d}/out.npz", "-q"]
-MALFORMED.update({
-    "scene 40000 x 25000": ({"bad.toml": _scene_with(**{"width = 40": "width = 40000", "height = 30": "height = 25000"})}, SIM),
-    "scene wider than 65535": ({"bad.toml": _scene_with(**{"width = 40": "width = 70000"})}, SIM),
-    "scene of 10^12 frames": ({"bad.toml": _scene_with(**{"frames = 6": "frames = 1000000000000"})}, SIM),
-    "object of 10^8 px": ({"bad.toml": _scene_with(**{"size = [8, 8]": "size = [10000, 10000]"})}, SIM),
-    "sensor threshold 1e-300": ({"bad.toml": (SCENE + "[sensor]\nthreshold_on = 1e-300\n").encode()}, SIM),
-    "sensor threshold 0": ({"bad.toml": (SCENE + "[sensor]\nthreshold_off = 0\n").encode()}, SIM),
-})
+MALFORMED.update(
+    {
+        "scene 40000 x 25000": ({"bad.toml": _scene_with(**{"width = 40": "width = 40000", "height = 30": "height = 25000"})}, SIM),
+        "scene wider than 65535": ({"bad.toml": _scene_with(**{"width = 40": "width = 70000"})}, SIM),
+        "scene of 10^12 frames": ({"bad.toml": _scene_with(**{"frames = 6": "frames = 1000000000000"})}, SIM),
+        "object of 10^8 px": ({"bad.toml": _scene_with(**{"size = [8, 8]": "size = [10000, 10000]"})}, SIM),
+        "sensor threshold 1e-300": ({"bad.toml": (SCENE + "[sensor]\nthreshold_on = 1e-300\n").encode()}, SIM),
+        "sensor threshold 0": ({"bad.toml": (SCENE + "[sensor]\nthreshold_off = 0\n").encode()}, SIM),
+    }
+)
 
 
 def _video_with_truth(truth: bytes) -> callable:
@@ -329,12 +383,17 @@ def _video_with_truth(truth: bytes) -> callable:
 
 TRUTH_HEADER = b"frame,t_us,id,cx,cy,w,h,vx,vy,Y,Cb,Cr,label,fully_visible\n"
 VIDEO = ["simulate", "{d}/clip.avi", "-o", "{d}/out.npz", "--truth", "{d}/out.csv", "-q"]
-MALFORMED.update({
-    "video truth CSV of garbage": ({"clip.avi": _video_with_truth(b"\x00\x01garbage\n")}, VIDEO),
-    "video truth CSV without a column": ({"clip.avi": _video_with_truth(TRUTH_HEADER.replace(b",label", b"") + b"0,0,1,5,5,2,2,0,0,40,128,128,1\n")}, VIDEO),
-    "video truth CSV with NaN": ({"clip.avi": _video_with_truth(TRUTH_HEADER + b"0,0,1,nan,5,2,2,0,0,40,128,128,grey,1\n")}, VIDEO),
-    "video truth CSV not UTF-8": ({"clip.avi": _video_with_truth(TRUTH_HEADER + b"0,0,1,5,5,2,2,0,0,40,128,128,gr\xffy,1\n")}, VIDEO),
-})
+MALFORMED.update(
+    {
+        "video truth CSV of garbage": ({"clip.avi": _video_with_truth(b"\x00\x01garbage\n")}, VIDEO),
+        "video truth CSV without a column": (
+            {"clip.avi": _video_with_truth(TRUTH_HEADER.replace(b",label", b"") + b"0,0,1,5,5,2,2,0,0,40,128,128,1\n")},
+            VIDEO,
+        ),
+        "video truth CSV with NaN": ({"clip.avi": _video_with_truth(TRUTH_HEADER + b"0,0,1,nan,5,2,2,0,0,40,128,128,grey,1\n")}, VIDEO),
+        "video truth CSV not UTF-8": ({"clip.avi": _video_with_truth(TRUTH_HEADER + b"0,0,1,5,5,2,2,0,0,40,128,128,gr\xffy,1\n")}, VIDEO),
+    }
+)
 
 
 def test_an_interrupted_vector_case_leaves_the_old_case_whole_and_no_half_new_one(tmp_path, monkeypatch):
@@ -376,73 +435,89 @@ def _image_folder(width: int, height: int) -> callable:
     return write
 
 
-MALFORMED.update({
-    "images wider than 65535 px": ({"wide": _image_folder(70000, 1)}, ["simulate", "{d}/wide", "--fps", "30", "-o", "{d}/out.npz", "-q"]),
-    "images over the pixel limit": ({"big": _image_folder(8000, 4300)}, ["simulate", "{d}/big", "--fps", "30", "-o", "{d}/out.npz", "-q"]),
-})
+MALFORMED.update(
+    {
+        "images wider than 65535 px": (
+            {"wide": _image_folder(70000, 1)},
+            ["simulate", "{d}/wide", "--fps", "30", "-o", "{d}/out.npz", "-q"],
+        ),
+        "images over the pixel limit": (
+            {"big": _image_folder(8000, 4300)},
+            ["simulate", "{d}/big", "--fps", "30", "-o", "{d}/out.npz", "-q"],
+        ),
+    }
+)
 
 
 # Options out of range or of the wrong kind, and missing inputs: one line before anything runs.
 T = ["track", "{d}/ev.npz", "-o", "{d}/out.csv", "-q"]
-MALFORMED.update({
-    "no verb": ({}, []),
-    "unknown verb": ({}, ["explode"]),
-    "track without -o": ({}, ["track", "{d}/ev.npz"]),
-    "track of a missing file": ({}, ["track", "{d}/none.npz", "-o", "{d}/out.csv", "-q"]),
-    "track of a folder": ({}, ["track", "{d}/sub", "-o", "{d}/out.csv", "-q"]),
-    "track --model unknown": ({}, [*T, "--model", "quantum"]),
-    "track --params missing": ({}, [*T, "--params", "{d}/none.toml"]),
-    "track --params unknown preset": ({}, [*T, "--params", "no_such_preset"]),
-    "track --ranges with the float model": ({}, [*T, "--ranges"]),
-    "track --frame-us inf": ({}, [*T, "--frame-us", "inf"]),
-    "track --frame-us 0": ({}, [*T, "--frame-us", "0"]),
-    "track to an unknown format": ({}, ["track", "{d}/ev.npz", "-o", "{d}/out.xls", "-q"]),
-    "simulate --frames 1": ({}, ["simulate", "{d}/scene.toml", "-o", "{d}/out.npz", "--frames", "1", "-q"]),
-    "simulate --frames -5": ({}, ["simulate", "{d}/scene.toml", "-o", "{d}/out.npz", "--frames", "-5", "-q"]),
-    "simulate --frames not a number": ({}, ["simulate", "{d}/scene.toml", "-o", "{d}/out.npz", "--frames", "many", "-q"]),
-    "simulate --fps 0": ({}, ["simulate", "{d}/scene.toml", "-o", "{d}/out.npz", "--fps", "0", "-q"]),
-    "simulate --fps 1e9": ({}, ["simulate", "{d}/scene.toml", "-o", "{d}/out.npz", "--fps", "1e9", "-q"]),
-    "simulate an unknown built-in scene": ({}, ["simulate", "no_such_scene", "-o", "{d}/out.npz", "-q"]),
-    "simulate to an unknown format": ({}, ["simulate", "{d}/scene.toml", "-o", "{d}/out.xyz", "-q"]),
-    "simulate --evt unknown": ({}, ["simulate", "{d}/scene.toml", "-o", "{d}/out.raw", "--evt", "evt9", "-q"]),
-    "simulate --truth for a video without one": ({"clip.avi": _video_with_truth(b"")}, ["simulate", "{d}/clip.avi", "-o", "{d}/out.npz", "--truth", "{d}/t.csv", "-q"]),
-    "score without --truth": ({}, ["score", "{d}/tracks.csv"]),
-    "score --gate NaN": ({}, ["score", "{d}/tracks.csv", "--truth", "{d}/gt.csv", "--gate", "nan"]),
-    "score --gate inf": ({}, ["score", "{d}/tracks.csv", "--truth", "{d}/gt.csv", "--gate", "inf"]),
-    "score tracks as truth": ({}, ["score", "{d}/tracks.csv", "--truth", "{d}/tracks.csv"]),
-    "score events as tracks": ({}, ["score", "{d}/ev.npz", "--truth", "{d}/gt.csv"]),
-    "score a missing truth": ({}, ["score", "{d}/tracks.csv", "--truth", "{d}/none.csv"]),
-    "plot --kind unknown": ({}, ["plot", "{d}/tracks.csv", "--truth", "{d}/gt.csv", "-o", "{d}/p.png", "--kind", "pie"]),
-    "plot to an unknown format": ({}, ["plot", "{d}/tracks.csv", "--truth", "{d}/gt.csv", "-o", "{d}/p.bmp"]),
-    "plot --gate NaN": ({}, ["plot", "{d}/tracks.csv", "--truth", "{d}/gt.csv", "-o", "{d}/p.png", "--gate", "nan"]),
-    "plot --gt-id absent": ({}, ["plot", "{d}/tracks.csv", "--truth", "{d}/gt.csv", "-o", "{d}/p.png", "--gt-id", "999"]),
-    "show of a missing file": ({}, ["show", "{d}/none.npz", "-o", "{d}/out.png"]),
-    "show --t0 NaN": ({}, ["show", "{d}/ev.npz", "-o", "{d}/out.png", "--t0", "nan"]),
-    "show --span 0": ({}, ["show", "{d}/ev.npz", "-o", "{d}/out.png", "--span", "0"]),
-    "show --span -1": ({}, ["show", "{d}/ev.npz", "-o", "{d}/out.png", "--span", "-1"]),
-    "render --arrow-frames -1": ({}, ["render", "{d}/ev.npz", "{d}/tracks.csv", "-o", "{d}/out.png", "--arrow-frames", "-1", "-q"]),
-    "render --arrow-frames NaN": ({}, ["render", "{d}/ev.npz", "{d}/tracks.csv", "-o", "{d}/out.png", "--arrow-frames", "nan", "-q"]),
-    "render --t1 negative": ({}, ["render", "{d}/ev.npz", "{d}/tracks.csv", "-o", "{d}/out.png", "--t1", "-5", "-q"]),
-    "render a missing tracks file": ({}, ["render", "{d}/ev.npz", "{d}/none.csv", "-o", "{d}/out.png", "-q"]),
-    "formats --width 0": ({}, ["formats", "--width", "0"]),
-    "formats --height -3": ({}, ["formats", "--height", "-3"]),
-    "formats --width 70000": ({}, ["formats", "--width", "70000"]),
-    "formats --t-frame-us NaN": ({}, ["formats", "--t-frame-us", "nan"]),
-    "formats --t-frame-us -1": ({}, ["formats", "--t-frame-us", "-1"]),
-    "formats --params missing": ({}, ["formats", "--params", "{d}/none.toml"]),
-    "formats --write-for missing": ({}, ["formats", "--write-for", "{d}/none.toml"]),
-    "tune --trials 0": ({}, ["tune", "{d}/scene.toml", "-o", "{d}/best.toml", "--trials", "0", "-q"]),
-    "tune --segment 0": ({}, ["tune", "{d}/scene.toml", "-o", "{d}/best.toml", "--segment", "0", "-q"]),
-    "tune --segment NaN": ({}, ["tune", "{d}/scene.toml", "-o", "{d}/best.toml", "--segment", "nan", "-q"]),
-    "vectors --max-events 0": ({}, ["vectors", "-o", "{d}/vec", "--events", "{d}/ev.npz", "--max-events", "0"]),
-    "vectors --frame-us inf": ({}, ["vectors", "-o", "{d}/vec", "--events", "{d}/ev.npz", "--frame-us", "inf"]),
-    "vectors --events missing": ({}, ["vectors", "-o", "{d}/vec", "--events", "{d}/none.npz"]),
-    "vectors --replay without --events": ({}, ["vectors", "-o", "{d}/vec", "--replay", "icarus"]),
-    "scenes --generate -1": ({}, ["scenes", "--generate", "-1", "-o", "{d}/sc"]),
-    "scenes --split unknown": ({}, ["scenes", "--split", "nowhere", "-o", "{d}/sc"]),
-    "reference of a missing video": ({}, ["reference", "{d}/none.avi", "-o", "{d}/ref.csv", "-q"]),
-    "reference --min-area -1": ({"clip.avi": _video_with_truth(b"")}, ["reference", "{d}/clip.avi", "-o", "{d}/ref.csv", "--min-area", "-1", "-q"]),
-})
+MALFORMED.update(
+    {
+        "no verb": ({}, []),
+        "unknown verb": ({}, ["explode"]),
+        "track without -o": ({}, ["track", "{d}/ev.npz"]),
+        "track of a missing file": ({}, ["track", "{d}/none.npz", "-o", "{d}/out.csv", "-q"]),
+        "track of a folder": ({}, ["track", "{d}/sub", "-o", "{d}/out.csv", "-q"]),
+        "track --model unknown": ({}, [*T, "--model", "quantum"]),
+        "track --params missing": ({}, [*T, "--params", "{d}/none.toml"]),
+        "track --params unknown preset": ({}, [*T, "--params", "no_such_preset"]),
+        "track --ranges with the float model": ({}, [*T, "--ranges"]),
+        "track --frame-us inf": ({}, [*T, "--frame-us", "inf"]),
+        "track --frame-us 0": ({}, [*T, "--frame-us", "0"]),
+        "track to an unknown format": ({}, ["track", "{d}/ev.npz", "-o", "{d}/out.xls", "-q"]),
+        "simulate --frames 1": ({}, ["simulate", "{d}/scene.toml", "-o", "{d}/out.npz", "--frames", "1", "-q"]),
+        "simulate --frames -5": ({}, ["simulate", "{d}/scene.toml", "-o", "{d}/out.npz", "--frames", "-5", "-q"]),
+        "simulate --frames not a number": ({}, ["simulate", "{d}/scene.toml", "-o", "{d}/out.npz", "--frames", "many", "-q"]),
+        "simulate --fps 0": ({}, ["simulate", "{d}/scene.toml", "-o", "{d}/out.npz", "--fps", "0", "-q"]),
+        "simulate --fps 1e9": ({}, ["simulate", "{d}/scene.toml", "-o", "{d}/out.npz", "--fps", "1e9", "-q"]),
+        "simulate an unknown built-in scene": ({}, ["simulate", "no_such_scene", "-o", "{d}/out.npz", "-q"]),
+        "simulate to an unknown format": ({}, ["simulate", "{d}/scene.toml", "-o", "{d}/out.xyz", "-q"]),
+        "simulate --evt unknown": ({}, ["simulate", "{d}/scene.toml", "-o", "{d}/out.raw", "--evt", "evt9", "-q"]),
+        "simulate --truth for a video without one": (
+            {"clip.avi": _video_with_truth(b"")},
+            ["simulate", "{d}/clip.avi", "-o", "{d}/out.npz", "--truth", "{d}/t.csv", "-q"],
+        ),
+        "score without --truth": ({}, ["score", "{d}/tracks.csv"]),
+        "score --gate NaN": ({}, ["score", "{d}/tracks.csv", "--truth", "{d}/gt.csv", "--gate", "nan"]),
+        "score --gate inf": ({}, ["score", "{d}/tracks.csv", "--truth", "{d}/gt.csv", "--gate", "inf"]),
+        "score tracks as truth": ({}, ["score", "{d}/tracks.csv", "--truth", "{d}/tracks.csv"]),
+        "score events as tracks": ({}, ["score", "{d}/ev.npz", "--truth", "{d}/gt.csv"]),
+        "score a missing truth": ({}, ["score", "{d}/tracks.csv", "--truth", "{d}/none.csv"]),
+        "plot --kind unknown": ({}, ["plot", "{d}/tracks.csv", "--truth", "{d}/gt.csv", "-o", "{d}/p.png", "--kind", "pie"]),
+        "plot to an unknown format": ({}, ["plot", "{d}/tracks.csv", "--truth", "{d}/gt.csv", "-o", "{d}/p.bmp"]),
+        "plot --gate NaN": ({}, ["plot", "{d}/tracks.csv", "--truth", "{d}/gt.csv", "-o", "{d}/p.png", "--gate", "nan"]),
+        "plot --gt-id absent": ({}, ["plot", "{d}/tracks.csv", "--truth", "{d}/gt.csv", "-o", "{d}/p.png", "--gt-id", "999"]),
+        "show of a missing file": ({}, ["show", "{d}/none.npz", "-o", "{d}/out.png"]),
+        "show --t0 NaN": ({}, ["show", "{d}/ev.npz", "-o", "{d}/out.png", "--t0", "nan"]),
+        "show --span 0": ({}, ["show", "{d}/ev.npz", "-o", "{d}/out.png", "--span", "0"]),
+        "show --span -1": ({}, ["show", "{d}/ev.npz", "-o", "{d}/out.png", "--span", "-1"]),
+        "render --arrow-frames -1": ({}, ["render", "{d}/ev.npz", "{d}/tracks.csv", "-o", "{d}/out.png", "--arrow-frames", "-1", "-q"]),
+        "render --arrow-frames NaN": ({}, ["render", "{d}/ev.npz", "{d}/tracks.csv", "-o", "{d}/out.png", "--arrow-frames", "nan", "-q"]),
+        "render --t1 negative": ({}, ["render", "{d}/ev.npz", "{d}/tracks.csv", "-o", "{d}/out.png", "--t1", "-5", "-q"]),
+        "render a missing tracks file": ({}, ["render", "{d}/ev.npz", "{d}/none.csv", "-o", "{d}/out.png", "-q"]),
+        "formats --width 0": ({}, ["formats", "--width", "0"]),
+        "formats --height -3": ({}, ["formats", "--height", "-3"]),
+        "formats --width 70000": ({}, ["formats", "--width", "70000"]),
+        "formats --t-frame-us NaN": ({}, ["formats", "--t-frame-us", "nan"]),
+        "formats --t-frame-us -1": ({}, ["formats", "--t-frame-us", "-1"]),
+        "formats --params missing": ({}, ["formats", "--params", "{d}/none.toml"]),
+        "formats --write-for missing": ({}, ["formats", "--write-for", "{d}/none.toml"]),
+        "tune --trials 0": ({}, ["tune", "{d}/scene.toml", "-o", "{d}/best.toml", "--trials", "0", "-q"]),
+        "tune --segment 0": ({}, ["tune", "{d}/scene.toml", "-o", "{d}/best.toml", "--segment", "0", "-q"]),
+        "tune --segment NaN": ({}, ["tune", "{d}/scene.toml", "-o", "{d}/best.toml", "--segment", "nan", "-q"]),
+        "vectors --max-events 0": ({}, ["vectors", "-o", "{d}/vec", "--events", "{d}/ev.npz", "--max-events", "0"]),
+        "vectors --frame-us inf": ({}, ["vectors", "-o", "{d}/vec", "--events", "{d}/ev.npz", "--frame-us", "inf"]),
+        "vectors --events missing": ({}, ["vectors", "-o", "{d}/vec", "--events", "{d}/none.npz"]),
+        "vectors --replay without --events": ({}, ["vectors", "-o", "{d}/vec", "--replay", "icarus"]),
+        "scenes --generate -1": ({}, ["scenes", "--generate", "-1", "-o", "{d}/sc"]),
+        "scenes --split unknown": ({}, ["scenes", "--split", "nowhere", "-o", "{d}/sc"]),
+        "reference of a missing video": ({}, ["reference", "{d}/none.avi", "-o", "{d}/ref.csv", "-q"]),
+        "reference --min-area -1": (
+            {"clip.avi": _video_with_truth(b"")},
+            ["reference", "{d}/clip.avi", "-o", "{d}/ref.csv", "--min-area", "-1", "-q"],
+        ),
+    }
+)
 
 
 @pytest.mark.parametrize("case", sorted(MALFORMED))

@@ -69,7 +69,9 @@ def test_track_runs_dvs_only_files_with_colour_off(crossing_events, capsys):
 def test_tune_is_reproducible_under_a_seed(tmp_path, capsys):
     outputs = []
     for name in ("a.toml", "b.toml"):
-        code, _, err = run_cli(capsys, "tune", "crossing", "--trials", "4", "--seed", "7", "--segment", "0.5", "-o", str(tmp_path / name), "-q")
+        code, _, err = run_cli(
+            capsys, "tune", "crossing", "--trials", "4", "--seed", "7", "--segment", "0.5", "-o", str(tmp_path / name), "-q"
+        )
         assert code == 0, err
         outputs.append((tmp_path / name).read_text())
     assert outputs[0] == outputs[1]
@@ -79,7 +81,11 @@ def test_tune_is_reproducible_under_a_seed(tmp_path, capsys):
 
 @pytest.mark.parametrize(
     "args, fragment",
-    [(["--trials", "0"], "--trials 0"), (["--segment", "1.5"], "--segment 1.5"), (["--params", "nosuch"], "unknown parameter set 'nosuch'")],
+    [
+        (["--trials", "0"], "--trials 0"),
+        (["--segment", "1.5"], "--segment 1.5"),
+        (["--params", "nosuch"], "unknown parameter set 'nosuch'"),
+    ],
 )
 def test_tune_refuses_bad_options(tmp_path, capsys, args, fragment):
     code, _, err = run_cli(capsys, "tune", "crossing", "-o", str(tmp_path / "x.toml"), "-q", *args)

@@ -48,8 +48,6 @@ def run(text, **overrides):
     return sim, track_events(sim.events, sim.meta, params)
 
 
-
-
 def single_track(result):
     ids, counts = np.unique(result.tracks["id"], return_counts=True)
     return result.tracks[result.tracks["id"] == ids[np.argmax(counts)]]
@@ -61,7 +59,9 @@ def test_rigid_square_centre_and_both_velocities_converge(v, capsys):
     # θ = 0.1, so 0.4 px at β_P = 0.005. The events of one edge share a timestamp and come as a
     # burst of m ≈ 20 at distance d = 10 px, which pulls the centre by about β_P·m·d = 1 px and back.
     # Moving along an axis, one pair of edges makes events; diagonally both pairs burst.
-    sim, result = run(square_scene([(200, v)], start=(40.0, 40.0), width=480, height=480, theta=0.1), alpha_pos=0.995, alpha_vel_mcm=0.99995)
+    sim, result = run(
+        square_scene([(200, v)], start=(40.0, 40.0), width=480, height=480, theta=0.1), alpha_pos=0.995, alpha_vel_mcm=0.99995
+    )
     track = single_track(result)
     t = track["t_us"].astype(float)
     true_x = 40.0 + v[0] * t / T_FRAME  # the square's centre moves linearly
@@ -242,8 +242,8 @@ def test_ids_are_unique_and_increasing_in_creation_order():
         ("[clusterer]\nr_min = -2", "clusterer.r_min"),
         ("[clusterer]\npalette = []", "clusterer.palette"),
         ("[clusterer]\nseek_radius = 3", "seek_radius"),
-        ("[clusterer]\nn_clusters = \"many\"", "clusterer.n_clusters"),
-        ("[clusterer]\npalette_background = [\"sky\"]", "sky"),
+        ('[clusterer]\nn_clusters = "many"', "clusterer.n_clusters"),
+        ('[clusterer]\npalette_background = ["sky"]', "sky"),
         ("[clusterer]\nr_init = 100\nr_max = 50", "r_init"),
         ("[cluster]\nn_clusters = 4", "unknown table or key 'cluster'"),
         ("[clusterer\n", "malformed TOML"),

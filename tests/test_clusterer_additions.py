@@ -111,7 +111,7 @@ def test_the_noise_gate_reports_a_dense_blob_and_not_a_cluster_of_noise():
     base = classic_params(a_valid=2.0, r_init=3.0, seek_margin=3.0, n_clusters=8, v_min=0.0, filter_every=8)
     _, plain = run(base, events(rows))
     _, gated = run(base.model_copy(update={"noise_gate": 6.0}), events(rows))
-    near_blob = lambda out: (np.abs(out[:, 4] - 40) <= 4) & (np.abs(out[:, 5] - 20) <= 4)  # noqa: E731
+    near_blob = lambda out: (np.abs(out[:, 4] - 40) <= 4) & (np.abs(out[:, 5] - 20) <= 4)
     assert (~near_blob(plain)).sum() > 0  # without the gate, noise clusters are reported
     assert near_blob(gated).sum() > 0 and (~near_blob(gated)).sum() < 0.05 * (~near_blob(plain)).sum()
 

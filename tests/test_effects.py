@@ -68,8 +68,7 @@ def make_scene(
 ) -> Scene:
     """A synthetic scene parsed from TOML, so [effects.NAME] tables take the real path."""
     tables = "".join(
-        f"\n[effects.{name}]\n" + "".join(f"{k} = {json.dumps(v)}\n" for k, v in params.items())
-        for name, params in (effects or {}).items()
+        f"\n[effects.{name}]\n" + "".join(f"{k} = {json.dumps(v)}\n" for k, v in params.items()) for name, params in (effects or {}).items()
     )
     text = f"""
 name = "test"
@@ -127,7 +126,10 @@ def assert_sorted(ev: np.ndarray):
     assert np.all(np.diff(key)[same] >= 0), "ties in time not ordered by y, then x"
 
 
-def effect(name: str, geometry=SensorGeometry(64, 48, 1000.0), seed=0, **params) -> Effect:
+GEOMETRY = SensorGeometry(64, 48, 1000.0)
+
+
+def effect(name: str, geometry=GEOMETRY, seed=0, **params) -> Effect:
     (e,) = build_effects({name: params}, geometry, seed)
     return e
 
@@ -179,6 +181,7 @@ def test_a_scene_naming_one_effect_constructs_only_that_one(monkeypatch):
     real_init = Effect.__init__
     for name, cls in EFFECTS.items():
         if name == "refractory":
+
             def record(self, *args, **kwargs):
                 built.append(self.name)
                 real_init(self, *args, **kwargs)

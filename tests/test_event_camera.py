@@ -157,7 +157,7 @@ def test_malformed_aedat4_fails_with_one_line(tmp_path, content, fault):
 
 def test_evt3_outside_its_declared_sensor_is_refused(tmp_path):
     path = tmp_path / "big.raw"
-    path.write_bytes(f"% evt 3.0\n% format EVT3;width=64;height=48\n% end\n".encode() + _evt3_words([(10, 100, 3, 1)]))
+    path.write_bytes(b"% evt 3.0\n% format EVT3;width=64;height=48\n% end\n" + _evt3_words([(10, 100, 3, 1)]))
     with pytest.raises(EvclustError, match=r"big.raw: not a readable event-camera file \(x overflow \(x=100"):
         read_events(path)
 

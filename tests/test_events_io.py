@@ -100,9 +100,20 @@ def test_ties_out_of_order_are_refused(tmp_path):
         (lambda p: p.write_bytes(b"not a zip file at all"), "not a readable event file"),
         (lambda p: np.savez(p, other=np.zeros(3)), "no 'events' array"),
         (lambda p: np.savez(p, events=np.zeros(3)), "not a structured array"),
-        (lambda p: np.savez(p, events=np.zeros(3, [("t", "u8"), ("x", "u2")]), meta=np.array(META.to_json())), "missing event field(s) y, p"),
-        (lambda p: np.savez(p, events=np.zeros(3, [("t", "u8"), ("x", "u2"), ("y", "u2"), ("p", "i1"), ("q", "u1")]), meta=np.array(META.to_json())), "unknown event field(s) q"),
-        (lambda p: np.savez(p, events=np.zeros(3, [("t", "f8"), ("x", "u2"), ("y", "u2"), ("p", "i1")]), meta=np.array(META.to_json())), "field t has type float64"),
+        (
+            lambda p: np.savez(p, events=np.zeros(3, [("t", "u8"), ("x", "u2")]), meta=np.array(META.to_json())),
+            "missing event field(s) y, p",
+        ),
+        (
+            lambda p: np.savez(
+                p, events=np.zeros(3, [("t", "u8"), ("x", "u2"), ("y", "u2"), ("p", "i1"), ("q", "u1")]), meta=np.array(META.to_json())
+            ),
+            "unknown event field(s) q",
+        ),
+        (
+            lambda p: np.savez(p, events=np.zeros(3, [("t", "f8"), ("x", "u2"), ("y", "u2"), ("p", "i1")]), meta=np.array(META.to_json())),
+            "field t has type float64",
+        ),
         (lambda p: np.savez(p, events=some_events()), "metadata has no sensor width"),
     ],
 )

@@ -7,7 +7,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from evclust.clusterer import ClustererParams
-from evclust.clusterer.layout import ACT, PX, PY, RX, RY, VALID
+from evclust.clusterer.layout import ACT, PX, PY, RX, VALID
 from evclust.events import EVENT_DTYPE
 from evclust.fixed.model import FixedClusterer
 
@@ -67,7 +67,7 @@ def test_random_streams_keep_every_invariant(ev):
     records = model.feed(ev)
     S = model.slots
     live = S[S[:, VALID] == 1]
-    fp, fr, fa = model.table["centre"].frac_bits, model.table["half_size"].frac_bits, model.table["activity"].frac_bits
+    fp = model.table["centre"].frac_bits
     seek = PARAMS.seek_margin
     assert np.all(live[:, ACT] >= 0)
     assert np.all((live[:, RX] >= model.table.constants["r_min"].raw) & (live[:, RX] <= model.table.constants["r_max"].raw))

@@ -146,7 +146,7 @@ def test_a_long_soak_keeps_the_state_bounded_without_drift():
     rng = np.random.default_rng(1)
     n = 10_000_000
     t = np.arange(n, dtype=np.uint64) * np.uint64(3)  # 3 µs apart: 30 s, crossing the 32-bit wrap? no: ~0.03 of it
-    drift = (np.arange(n) / n * 200.0)
+    drift = np.arange(n) / n * 200.0
     x = np.clip(np.rint(60 + drift + rng.integers(-10, 11, n)), 0, 319).astype(np.uint16)
     y = np.clip(np.rint(120 + rng.integers(-10, 11, n)), 0, 239).astype(np.uint16)
     ev = np.zeros(n, EVENT_DTYPE)

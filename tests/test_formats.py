@@ -11,7 +11,6 @@ from pathlib import Path
 import pytest
 from fxpmath import Fxp
 
-from evclust.cli import main
 from evclust.cli.formats import reference_table
 from evclust.clusterer import ClustererParams, load_params
 from evclust.errors import EvclustError
@@ -65,7 +64,7 @@ def test_shift_only_betas_are_powers_of_two():
     for c in betas:
         assert c.raw & (c.raw - 1) == 0 and c.raw > 0, c.name
         # The nearest power of two, but a shift of at least one bit: β <= 1/2.
-        exact = 1 - getattr(params, "alpha_" + c.name[len("beta_"):])
+        exact = 1 - getattr(params, "alpha_" + c.name[len("beta_") :])
         assert c.quantised == 2.0 ** -max(1, round(-math.log2(exact)))
 
 
@@ -76,10 +75,29 @@ def test_the_guard_bits_move_every_filtered_signals_fraction_and_nothing_else(de
     params, _ = load_params("traffic")
     default = build_formats(params, 480, 270, 50000.0)
     narrow = build_formats(params, 480, 270, 50000.0, dead_band_bits=dead_band_bits)
-    filtered = {"centre", "offset", "seek_distance", "centre_step", "half_size", "size_target", "v_mcm", "mcm_norm", "v_int", "colour", "background",
-                "merge_moment",  # activity × centre
-                "obj_centre", "obj_half",  # the object layer's, in the centre's and the half-size's fraction bits
-                "r_init", "r_min", "r_max", "seek_margin", "exit_margin", "merge_v_tol", "object_gate"}  # the last seven: constants held in R's, P's and V's formats
+    filtered = {
+        "centre",
+        "offset",
+        "seek_distance",
+        "centre_step",
+        "half_size",
+        "size_target",
+        "v_mcm",
+        "mcm_norm",
+        "v_int",
+        "colour",
+        "background",
+        "merge_moment",  # activity × centre
+        "obj_centre",
+        "obj_half",  # the object layer's, in the centre's and the half-size's fraction bits
+        "r_init",
+        "r_min",
+        "r_max",
+        "seek_margin",
+        "exit_margin",
+        "merge_v_tol",
+        "object_gate",
+    }  # the last seven: constants held in R's, P's and V's formats
     shift = dead_band_bits - DEAD_BAND_BITS
     for name, fmt in default.formats.items():
         moved = narrow[name].frac_bits - fmt.frac_bits

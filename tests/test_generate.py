@@ -12,6 +12,7 @@ import cv2
 import numpy as np
 import pytest
 
+from evclust.choices import SPLITS
 from evclust.clusterer.params import DEFAULT_PALETTE
 from evclust.colour import rgb_to_ycbcr
 from evclust.errors import EvclustError
@@ -23,7 +24,6 @@ from evclust.scenes.generate import (
     SENSOR_SIZES,
     SIZE_PX,
     SPEED_PX,
-    SPLITS,
     generate_scene,
     write_scene,
 )
@@ -323,7 +323,9 @@ def test_a_square_half_covered_by_a_later_one_is_half_visible():
 def test_visibility_follows_a_moving_object_out_of_the_view():
     # A 10 px square moving left by 5 px/frame from centre 14.5 ([9.5, 19.5]): at frame k its left
     # edge is at 9.5 - 5k, so 10, 10, 10, 5, 0 px of its width are inside [-0.5, ...].
-    text = HEADER.replace("frames = 3", "frames = 5") + """
+    text = (
+        HEADER.replace("frames = 3", "frames = 5")
+        + """
 [[objects]]
 id = 1
 label = "red"
@@ -332,6 +334,7 @@ colour = [220, 40, 40]
 start = [14.5, 29.5]
 legs = [{ frames = 4, velocity = [-5.0, 0.0] }]
 """
+    )
     vis = _visible(text)
     assert vis[(0, 1)] == pytest.approx(1.0, abs=1e-4)
     assert vis[(1, 1)] == pytest.approx(1.0, abs=1e-4)

@@ -40,8 +40,23 @@ def make_tracks(*records: dict) -> np.ndarray:
     """Records with defaults: a cluster at rest with the truth's default colour."""
     out = np.zeros(len(records), dtype=TRACK_DTYPE)
     for i, r in enumerate(records):
-        row = dict(slot=0, id=1, x=0.0, y=0.0, rx=5.0, ry=5.0, activity=10.0, vx_mcm=0.0, vy_mcm=0.0,
-                   vx_int=0.0, vy_int=0.0, Y=100.0, Cb=120.0, Cr=140.0, flags=0)
+        row = dict(
+            slot=0,
+            id=1,
+            x=0.0,
+            y=0.0,
+            rx=5.0,
+            ry=5.0,
+            activity=10.0,
+            vx_mcm=0.0,
+            vy_mcm=0.0,
+            vx_int=0.0,
+            vy_int=0.0,
+            Y=100.0,
+            Cb=120.0,
+            Cr=140.0,
+            flags=0,
+        )
         row["class"] = -1
         row.update(r)
         for name in TRACK_DTYPE.names:
@@ -50,8 +65,22 @@ def make_tracks(*records: dict) -> np.ndarray:
 
 
 def gt_row(frame: int, id: int, cx: float, cy: float, **changes) -> dict:
-    row = dict(frame=frame, t_us=frame * T, id=id, cx=cx, cy=cy, w=10.0, h=10.0, vx=0.0, vy=0.0,
-               Y=100.0, Cb=120.0, Cr=140.0, label="red", fully_visible=1)
+    row = dict(
+        frame=frame,
+        t_us=frame * T,
+        id=id,
+        cx=cx,
+        cy=cy,
+        w=10.0,
+        h=10.0,
+        vx=0.0,
+        vy=0.0,
+        Y=100.0,
+        Cb=120.0,
+        Cr=140.0,
+        label="red",
+        fully_visible=1,
+    )
     row.update(changes)
     return row
 
@@ -342,8 +371,24 @@ def test_perfect_tracks_of_a_synthetic_scene_score_zero_error():
         for obj, (vx, vy) in velocity.items():
             row = next(r for r in truth if r["frame"] == k and r["id"] == obj)
             x, y = start[obj][0] + vx * (k + 0.25), start[obj][1] + vy * (k + 0.25)
-            records.append(dict(t_us=k * 40000 + 10000, step=k, id=obj, slot=obj, x=x, y=y, vx_mcm=vx, vy_mcm=vy,
-                                vx_int=vx, vy_int=vy, Y=row["Y"], Cb=row["Cb"], Cr=row["Cr"], **{"class": obj - 1}))
+            records.append(
+                dict(
+                    t_us=k * 40000 + 10000,
+                    step=k,
+                    id=obj,
+                    slot=obj,
+                    x=x,
+                    y=y,
+                    vx_mcm=vx,
+                    vy_mcm=vy,
+                    vx_int=vx,
+                    vy_int=vy,
+                    Y=row["Y"],
+                    Cb=row["Cb"],
+                    Cr=row["Cr"],
+                    **{"class": obj - 1},
+                )
+            )
     meta = make_meta(width=120, height=80, t_frame_us=40000.0)
     s = score(make_tracks(*records), meta, truth)
     assert s.n_matches == 22 and s.recall == 1.0 and s.precision == 1.0 and s.id_switches == 0
@@ -360,8 +405,19 @@ def test_format_tables_has_the_papers_rows_and_one_column_per_run():
     b = score(make_tracks(dict(t_us=0, step=0, x=50, y=50, vx_mcm=1.0)), make_meta(), truth)
     text = format_tables({"sceneA": a, "sceneB": b})
     lines = text.splitlines()
-    for heading in ("Ground Truth Range", "MCM", "Interval", "Position", "YCbCr", "Luminance", "Chrominance",
-                    "Classification", "Recall", "Precision", "ID switches"):
+    for heading in (
+        "Ground Truth Range",
+        "MCM",
+        "Interval",
+        "Position",
+        "YCbCr",
+        "Luminance",
+        "Chrominance",
+        "Classification",
+        "Recall",
+        "Precision",
+        "ID switches",
+    ):
         assert any(heading in line for line in lines), heading
     position = next(line for line in lines if line.startswith("Position"))
     assert position.split()[-2:] == ["5.000", "0.000"]

@@ -130,7 +130,7 @@ def test_the_fixed_object_layer_follows_the_float_one(name):
     assert np.unique(ff["id"]).size == np.unique(xx["id"]).size
     # Records of the same step and object: most of them (a birth or a split may come a few steps
     # apart), positions within a pixel, velocities within 0.1 px/frame.
-    key = lambda r: (int(r["step"]), int(r["id"]))  # noqa: E731
+    key = lambda r: (int(r["step"]), int(r["id"]))
     pairs = {key(r): r for r in ff}
     common = [(pairs[key(r)], r) for r in xx if key(r) in pairs]
     assert len(common) >= 0.75 * xx.size

@@ -97,6 +97,7 @@ def test_a_bright_pixel_follows_faster_than_a_dark_one():
 
     dark, bright = frames_to_half(10, 40), frames_to_half(100, 250)
     assert bright < dark
+
     # The same check on the simulator's events: the frame of the median event.
     def median_frame(low, high):
         ev = run([low] + [high] * 60, {"photoreceptor_lowpass": {"cutoff_hz": 5.0}})

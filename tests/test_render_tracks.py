@@ -47,8 +47,16 @@ def record(step: int, t_us: int, x: float, y: float, rx: float, ry: float, **fie
 
 
 def track_meta(seek: float = 3.0) -> TrackMeta:
-    return TrackMeta(width=W, height=H, t_frame_us=PERIOD, source="unit", palette=PALETTE,
-                     palette_ycbcr=PALETTE_YCBCR, palette_background=("pavement",), seek_margin=seek)
+    return TrackMeta(
+        width=W,
+        height=H,
+        t_frame_us=PERIOD,
+        source="unit",
+        palette=PALETTE,
+        palette_ycbcr=PALETTE_YCBCR,
+        palette_background=("pavement",),
+        seek_margin=seek,
+    )
 
 
 def canvas_px(u: float, k: int) -> int:
@@ -72,11 +80,13 @@ def test_png_puts_box_and_seek_region_where_the_latest_record_says(tmp_path):
     marker["t"], marker["x"], marker["y"], marker["p"] = 49990, 5, 40, 1
     marker["Y"], marker["Cb"], marker["Cr"] = 200, 128, 128
     ev = np.concatenate([ev[ev["t"] < 49990], marker, ev[ev["t"] > 49990]])
-    tracks = np.concatenate([
-        record(3, 44000, 10, 10, 3, 3),  # an older step inside the window: replaced by step 4
-        record(4, 48000, 30, 20, 6, 4, vx_mcm=0.0, vy_mcm=0.0),
-        record(5, 60000, 50, 30, 5, 5),  # after the frame time: not drawn
-    ])
+    tracks = np.concatenate(
+        [
+            record(3, 44000, 10, 10, 3, 3),  # an older step inside the window: replaced by step 4
+            record(4, 48000, 30, 20, 6, 4, vx_mcm=0.0, vy_mcm=0.0),
+            record(5, 60000, 50, 30, 5, 5),  # after the frame time: not drawn
+        ]
+    )
     path = tmp_path / "frame.png"
     assert render_png(ev, ev_meta, tracks, track_meta(seek), path, t_us=50000, scale=k) == 50000
     image = cv2.imread(str(path))
@@ -88,30 +98,33 @@ def test_png_puts_box_and_seek_region_where_the_latest_record_says(tmp_path):
     expected = (canvas_px(20 - 4, k), canvas_px(30 - 6, k), canvas_px(20 + 4, k), canvas_px(30 + 6, k))
     assert np.allclose((top, left, bottom, right), expected, atol=1)
     # The red pixels are the box outline: all four edges are complete, the inside is not red.
-    assert colour_mask(body[top, left: right + 1], "red").mean() > 0.95
-    assert colour_mask(body[bottom, left: right + 1], "red").mean() > 0.95
-    assert colour_mask(body[top: bottom + 1, left], "red").mean() > 0.95
-    assert colour_mask(body[top: bottom + 1, right], "red").mean() > 0.95
-    assert not colour_mask(body[top + 2: bottom - 1, left + 2: right - 1], "red").any()
+    assert colour_mask(body[top, left : right + 1], "red").mean() > 0.95
+    assert colour_mask(body[bottom, left : right + 1], "red").mean() > 0.95
+    assert colour_mask(body[top : bottom + 1, left], "red").mean() > 0.95
+    assert colour_mask(body[top : bottom + 1, right], "red").mean() > 0.95
+    assert not colour_mask(body[top + 2 : bottom - 1, left + 2 : right - 1], "red").any()
 
     green = np.argwhere(colour_mask(body, "green"))
     (gtop, gleft), (gbottom, gright) = green.min(axis=0), green.max(axis=0)
     expected = (canvas_px(20 - 4 - seek, k), canvas_px(30 - 6 - seek, k), canvas_px(20 + 4 + seek, k), canvas_px(30 + 6 + seek, k))
     assert np.allclose((gtop, gleft, gbottom, gright), expected, atol=1)
-    assert colour_mask(body[gbottom, gleft: gright + 1], "green").mean() > 0.95
+    assert colour_mask(body[gbottom, gleft : gright + 1], "green").mean() > 0.95
     # Neither the older record of step 3 nor the later one of step 5 is drawn.
     assert not colour_mask(body, "red")[: canvas_px(16, k) - 2].any()
-    assert not colour_mask(body, "green")[canvas_px(27, k) + 2:].any()
+    assert not colour_mask(body, "green")[canvas_px(27, k) + 2 :].any()
     # The event is a k×k block of its own colour (BT.601: Y=200, neutral chroma -> grey 200).
-    block = body[40 * k: 41 * k, 5 * k: 6 * k].astype(int)
+    block = body[40 * k : 41 * k, 5 * k : 6 * k].astype(int)
     assert np.all(np.abs(block - 200) <= 1)
     assert np.all(body[0, W * k - 1] == body[0, W * k - 2])  # an empty pixel: the dark background
     assert body[0, W * k - 1].max() < 40
 
 
 def test_latest_records_picks_the_last_step_of_the_window():
-    tracks = sort_tracks(np.concatenate([record(2, 300, 1, 1, 1, 1), record(1, 200, 1, 1, 1, 1, id=1),
-                                         record(1, 200, 1, 1, 1, 1, id=2), record(0, 100, 1, 1, 1, 1)]))
+    tracks = sort_tracks(
+        np.concatenate(
+            [record(2, 300, 1, 1, 1, 1), record(1, 200, 1, 1, 1, 1, id=1), record(1, 200, 1, 1, 1, 1, id=2), record(0, 100, 1, 1, 1, 1)]
+        )
+    )
     assert list(latest_records(tracks, 150, 250)["id"]) == [1, 2]
     assert list(latest_records(tracks, 0, 299)["step"]) == [1, 1]
     assert latest_records(tracks, 300, 400).size == 0  # the window is (t_lo, t_hi]
@@ -121,8 +134,7 @@ def test_latest_records_picks_the_last_step_of_the_window():
 def test_mp4_has_one_frame_per_period_from_t0_to_t1(tmp_path, capsys):
     ev = make_events(n_frames=12)
     ev_meta = EventMeta(width=W, height=H, source="unit", t_frame_us=PERIOD)
-    tracks = np.concatenate([record(i, int((i + 1) * PERIOD) - 5, 10 + 3 * i, 20, 5, 4, vx_mcm=3.0, vx_int=2.5)
-                             for i in range(12)])
+    tracks = np.concatenate([record(i, int((i + 1) * PERIOD) - 5, 10 + 3 * i, 20, 5, 4, vx_mcm=3.0, vx_int=2.5) for i in range(12)])
     events_path, tracks_path = tmp_path / "ev.npz", tmp_path / "tracks.csv"
     write_events(events_path, ev, ev_meta)
     write_tracks(tracks_path, tracks, track_meta())
@@ -149,8 +161,8 @@ def make_matches() -> tuple[np.ndarray, np.ndarray]:
     frames = np.r_[np.repeat(np.arange(10), 2), np.repeat(np.arange(15, 20), 2)]
     m = np.zeros(frames.size + 5, MATCH_DTYPE)
     m["frame"][: frames.size] = frames
-    m["frame"][frames.size:] = np.arange(5)
-    m["gt_id"][: frames.size], m["gt_id"][frames.size:] = 1, 2
+    m["frame"][frames.size :] = np.arange(5)
+    m["gt_id"][: frames.size], m["gt_id"][frames.size :] = 1, 2
     m["step"] = np.arange(m.size)
     m["t_us"] = (m["frame"] * PERIOD + 100 * (m["step"] % 2) + 10).astype(np.uint64)
     m["track_id"] = np.where(m["frame"] < 15, 7, 9)
@@ -187,8 +199,7 @@ def test_plot_writes_each_kind_from_match_rows(tmp_path):
     # The scatter needs events inside the cluster's box at its records, and those records.
     ev = make_events(n_frames=20, per_frame=200)
     ev_meta = EventMeta(width=W, height=H, source="unit", t_frame_us=PERIOD)
-    tracks = np.concatenate([record(int(r["step"]), int(r["t_us"]), r["x"], r["y"], 8, 8, id=int(r["track_id"]))
-                             for r in m])
+    tracks = np.concatenate([record(int(r["step"]), int(r["t_us"]), r["x"], r["y"], 8, 8, id=int(r["track_id"])) for r in m])
     path = tmp_path / "scatter.png"
     assert plot_scatter(m, ev, ev_meta, tracks, track_meta(), path, gt_id=1) == 1
     images[path.name] = cv2.imread(str(path))
@@ -206,12 +217,15 @@ def test_plot_writes_each_kind_from_match_rows(tmp_path):
 
 
 def test_plot_cli_matches_tracks_to_truth(tmp_path, capsys):
-    rows = [dict(frame=f, t_us=f * PERIOD, id=3, cx=10 + 2 * f, cy=20, w=8, h=8, vx=2, vy=0, Y=76, Cb=85, Cr=255,
-                 label="red", fully_visible=1) for f in range(8)]
+    rows = [
+        dict(frame=f, t_us=f * PERIOD, id=3, cx=10 + 2 * f, cy=20, w=8, h=8, vx=2, vy=0, Y=76, Cb=85, Cr=255, label="red", fully_visible=1)
+        for f in range(8)
+    ]
     truth_path, tracks_path = tmp_path / "gt.csv", tmp_path / "tracks.csv"
     write_truth(truth_path, rows)
-    tracks = np.concatenate([record(i, int(i * PERIOD / 2 + 10), 10 + i + 0.3, 20.2, 4, 4, vx_mcm=1.9, vx_int=2.0,
-                                    **{"class": 1}) for i in range(16)])
+    tracks = np.concatenate(
+        [record(i, int(i * PERIOD / 2 + 10), 10 + i + 0.3, 20.2, 4, 4, vx_mcm=1.9, vx_int=2.0, **{"class": 1}) for i in range(16)]
+    )
     write_tracks(tracks_path, tracks, track_meta())
     out = tmp_path / "v.png"
     assert main(["plot", str(tracks_path), "--truth", str(truth_path), "-o", str(out)]) == 0

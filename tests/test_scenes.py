@@ -36,9 +36,7 @@ def test_builtin_scenes_are_addressable_by_name_with_the_required_shape():
     assert (ped.width, ped.height, ped.fps) == (270, 480, 10) and abs(ped.frames - 277) <= 5
     assert (traffic.width, traffic.height, traffic.fps) == (480, 270, 20) and abs(traffic.frames - 291) <= 5
     labels = [o.label for o in traffic.objects]
-    assert {label: labels.count(label) for label in set(labels)} == {
-        "red": 1, "blue": 1, "yellow": 1, "white": 5, "grey": 2, "black": 2
-    }
+    assert {label: labels.count(label) for label in set(labels)} == {"red": 1, "blue": 1, "yellow": 1, "white": 5, "grey": 2, "black": 2}
     # Two lanes driving in opposite directions along the vertical axis.
     vy = [o.legs[0].velocity[1] for o in traffic.objects]
     vx = [o.legs[0].velocity[0] for o in traffic.objects]
@@ -92,7 +90,9 @@ def test_truth_csv_has_the_documented_columns(tmp_path):
 
 
 def test_rendered_object_mean_colour_matches_truth():
-    scene = scene_from_toml(TWO_LEGS.replace('shape = "ellipse"', 'shape = "rectangle"').replace("start = [20, 30]", "start = [20.5, 30.5]"))
+    scene = scene_from_toml(
+        TWO_LEGS.replace('shape = "ellipse"', 'shape = "rectangle"').replace("start = [20, 30]", "start = [20.5, 30.5]")
+    )
     frame = scene.source.render(2)
     patch = frame[28:33, 16:25]  # fully inside a 10x6 rectangle centred on (20.5, 30.5)
     assert np.allclose(patch, [210, 40, 40])

@@ -8,7 +8,7 @@ import re
 
 from evclust.cli import main
 from evclust.clusterer import ClustererParams
-from evclust.scenes.generate import SPLITS
+from evclust.choices import SPLITS
 
 SMALL_TEST_SEEDS = (1016, 1023)  # the test split's smallest scenes: one through the codec, one clean, both noisy
 SMALL_TUNING_SEED = 11  # a small clean tuning scene
@@ -20,6 +20,7 @@ def test_generalize_writes_the_page_for_a_few_scenes(tmp_path, capsys):
                  "--workers", "2", "-o", str(out), "-q"])  # fmt: skip
     assert code == 0
     text = out.read_text()
+
     # Three configurations, float and fixed of the defaults beside the paper's: what each reports
     # (the defaults' objects, the paper's clusters), then every one's cluster records.
     def overall(title):
@@ -27,8 +28,16 @@ def test_generalize_writes_the_page_for_a_few_scenes(tmp_path, capsys):
         rows = [line for line in table.splitlines() if re.match(r"\| (default|paper) \| (float|fixed) \|", line)]
         return [[cell.strip() for cell in r.split("|")[1:4]] for r in rows]
 
-    assert overall("what each configuration reports") == [["default", "float", "objects"], ["default", "fixed", "objects"], ["paper", "float", "clusters"]]
-    assert overall("cluster records") == [["default", "float", "clusters"], ["default", "fixed", "clusters"], ["paper", "float", "clusters"]]
+    assert overall("what each configuration reports") == [
+        ["default", "float", "objects"],
+        ["default", "fixed", "objects"],
+        ["paper", "float", "clusters"],
+    ]
+    assert overall("cluster records") == [
+        ["default", "float", "clusters"],
+        ["default", "fixed", "clusters"],
+        ["paper", "float", "clusters"],
+    ]
     for section in ("## Targets", "## By category: default, float model, objects", "## By category: default, float model, its cluster records",
                     "## Per scene", "## Typical failures", "## Commands", "## Fixed against float"):  # fmt: skip
         assert section in text
@@ -66,8 +75,10 @@ def test_track_prints_the_time_constants_it_chose(tmp_path, capsys):
     # 15 fps: the defaults' T_half and τ in frames times 66,667 µs (τ rounded to whole µs).
     defaults = ClustererParams()
     t_half, tau = defaults.t_half_frames * 1e6 / 15, round(defaults.tau_frames * 1e6 / 15)
-    assert (f"parameters from defaults (t_half {t_half:,.0f} µs (= {defaults.t_half_frames:g} frames), "
-            f"tau {tau:,.0f} µs (= {defaults.tau_frames:g} frames))") in line
+    assert (
+        f"parameters from defaults (t_half {t_half:,.0f} µs (= {defaults.t_half_frames:g} frames), "
+        f"tau {tau:,.0f} µs (= {defaults.tau_frames:g} frames))"
+    ) in line
 
 
 def test_suite_tuning_keeps_its_trials_in_sqlite_and_resumes(tmp_path):

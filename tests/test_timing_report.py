@@ -63,7 +63,9 @@ def test_the_cache_key_follows_the_header_the_sources_and_routing():
     key = cache_key("localparam integer N_CLUSTERS = 16;\n", sources, True, "tools 1")
     assert key == cache_key("localparam integer N_CLUSTERS = 16;\n", dict(sources), True, "tools 1")
     assert key != cache_key("localparam integer N_CLUSTERS = 4;\n", sources, True, "tools 1")
-    assert key != cache_key("localparam integer N_CLUSTERS = 16;\n", {"evclust_core.v": "module evclust_core; wire w; endmodule\n"}, True, "tools 1")
+    assert key != cache_key(
+        "localparam integer N_CLUSTERS = 16;\n", {"evclust_core.v": "module evclust_core; wire w; endmodule\n"}, True, "tools 1"
+    )
     assert key != cache_key("localparam integer N_CLUSTERS = 16;\n", sources, False, "tools 1")
     assert key != cache_key("localparam integer N_CLUSTERS = 16;\n", sources, True, "tools 2")
 
@@ -105,7 +107,7 @@ def test_the_tools_see_their_run_folder_by_relative_paths_only(tmp_path, monkeyp
         timing.place_and_route("// header\n", "check", snapshot=({"evclust_core.v": "module m; endmodule\n"}, "abc1234"))
     except timing.EvclustError:
         pass
-    (tool, args, script), = seen
+    ((tool, args, script),) = seen
     assert tool == "yosys"
     text = " ".join(args) + "\n" + script
     assert str(tmp_path) not in text and "/tmp" not in text

@@ -30,7 +30,9 @@ def recording(tmp_path_factory):
 @pytest.mark.parametrize("sim", ["icarus", "verilator"])
 def test_own_events_become_a_case_the_rtl_replays_bit_exact(recording, capsys, sim):
     out = recording / f"vec_{sim}"
-    code, stdout, err = run_cli(capsys, "vectors", "--events", str(recording / "walk.h5"), "--max-events", str(N), "-o", str(out), "--replay", sim)
+    code, stdout, err = run_cli(
+        capsys, "vectors", "--events", str(recording / "walk.h5"), "--max-events", str(N), "-o", str(out), "--replay", sim
+    )
     assert code == 0, err
     case = load_case(out / "walk")
     assert len(case.events) == N

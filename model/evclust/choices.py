@@ -7,7 +7,7 @@ without numpy, numba, OpenCV or matplotlib. The modules that use them import the
 DEFAULT_GATE_PX = 30.0  # largest centre distance of a track-object match, px (docs/METRICS.md)
 
 # The generalization suite's splits: parameters are chosen on "tuning", figures reported on "test".
-SPLITS = {"tuning": tuple(range(0, 32)), "test": tuple(range(1000, 1032))}
+SPLITS = {"tuning": tuple(range(32)), "test": tuple(range(1000, 1032))}
 
 PLOT_KINDS = ("velocity", "colour", "scatter")
 PLOT_AXES = ("index", "time")

@@ -64,7 +64,9 @@ if cocotb is not None:
         params = ClustererParams(**config["parameters"])
         width, height, t_frame = config["width"], config["height"], config["t_frame_us"]
         model = FixedClusterer(params, width, height, t_frame)
-        events, expected, expected_trace, expected_objects = model_words(model, random_stream(config["seed"], config["count"], width, height, t_frame))
+        events, expected, expected_trace, expected_objects = model_words(
+            model, random_stream(config["seed"], config["count"], width, height, t_frame)
+        )
 
         source = AxiStreamSource(AxiStreamBus.from_prefix(dut, "s_axis_event"), dut.clk, dut.rst)
         sink = AxiStreamSink(AxiStreamBus.from_prefix(dut, "m_axis_record"), dut.clk, dut.rst)
@@ -102,8 +104,10 @@ if cocotb is not None:
             await RisingEdge(dut.clk)
             bound -= 1
             if bound < 0:
-                return (f"no progress: {len(trace)} of {len(events)} events traced, {len(records)} of {len(expected)} records, "
-                        f"{len(objects)} of {len(expected_objects)} object records"), {}
+                return (
+                    f"no progress: {len(trace)} of {len(events)} events traced, {len(records)} of {len(expected)} records, "
+                    f"{len(objects)} of {len(expected_objects)} object records"
+                ), {}
         await ClockCycles(dut.clk, 4)  # a record more than the model's would show here
         while not sink.empty():
             sink.recv_nowait()

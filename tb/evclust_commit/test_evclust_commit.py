@@ -42,14 +42,12 @@ SUMS = (("px", "d_px", "px_out", "PX", "PD_PX", "CENTRE_W"), ("py", "d_py", "py_
 SIGNED = {"vmx", "vmy", "vmx_out", "vmy_out"} | {increment for _, increment, *_ in SUMS}
 
 
-
 def increment_bits(header: str, width: str | None) -> int:
     """An increment's width as evclust_increments.vh declares it: its field's and a sign (the
     size's: the wider of size_target and the half-size)."""
     if width is None:
         return max(header_width(header, "SIZE_TARGET_W"), header_width(header, "HALF_SIZE_W")) + 1
     return header_width(header, width) + 1
-
 
 
 def cases(model, header: str, seed: int):

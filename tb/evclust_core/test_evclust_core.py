@@ -53,8 +53,19 @@ class Harness:
         self.batch = max(1, min(self.depth, (rec_depth // n_clusters - 1) * filter_every))
         self.ev_mem = [dut.ev_mem[i] for i in range(self.depth)]
         self.filter_every = filter_every
-        self.stats = {"cycles": 0, "filter_cycles": 0, "filter_steps": 0, "object_wait_cycles": 0, "object_busy_cycles": 0,
-                      "object_drain_cycles": 0, "events": 0, "wall_s": 0.0, "latency_min": None, "latency_max": 0, "latency_sum": 0}
+        self.stats = {
+            "cycles": 0,
+            "filter_cycles": 0,
+            "filter_steps": 0,
+            "object_wait_cycles": 0,
+            "object_busy_cycles": 0,
+            "object_drain_cycles": 0,
+            "events": 0,
+            "wall_s": 0.0,
+            "latency_min": None,
+            "latency_max": 0,
+            "latency_sum": 0,
+        }
 
     async def reset(self, cycles: int = 3):
         self.dut.rst.value = 1
@@ -104,7 +115,15 @@ class Harness:
             objects = int(dut.objects_captured.value)
             self.objects += [int(dut.obj_mem[i].value) for i in range(objects)]
             self.object_tags += [lo + int(dut.obj_tag[i].value) for i in range(objects)]
-            for name in ("cycles", "filter_cycles", "filter_steps", "object_wait_cycles", "object_busy_cycles", "object_drain_cycles", "latency_sum"):
+            for name in (
+                "cycles",
+                "filter_cycles",
+                "filter_steps",
+                "object_wait_cycles",
+                "object_busy_cycles",
+                "object_drain_cycles",
+                "latency_sum",
+            ):
                 self.stats[name] += int(getattr(dut, name).value)
             low = int(dut.latency_min.value)
             self.stats["latency_min"] = low if self.stats["latency_min"] is None else min(self.stats["latency_min"], low)
@@ -165,7 +184,10 @@ async def _coverage(dut, counters: dict, records: list[dict]) -> dict:
     def read(handle):  # X before the first clock edge (a run refused before it starts): nothing counted
         return [int(handle[i].value) if handle[i].value.is_resolvable else 0 for i in range(len(handle))]
 
-    fsm = {name: read(handle) for name, handle in (("state", dut.cov_state), ("arc", dut.cov_arc), ("phase", dut.cov_phase), ("stream", dut.cov_stream))}
+    fsm = {
+        name: read(handle)
+        for name, handle in (("state", dut.cov_state), ("arc", dut.cov_arc), ("phase", dut.cov_phase), ("stream", dut.cov_stream))
+    }
     return run_bins(fsm, counters, records)
 
 
@@ -211,7 +233,9 @@ if cocotb is not None:
                 break
             harness = Harness(dut, case.table.n_clusters, case.params.filter_every)
             await harness.reset()
-            trace, records, tags = await harness.stream(case.events, _seed(case.name, config["seed"]), config["gap"], config["stall"], case.table.n_clusters)
+            trace, records, tags = await harness.stream(
+                case.events, _seed(case.name, config["seed"]), config["gap"], config["stall"], case.table.n_clusters
+            )
             error = _compare(case.name, case.events, case.trace, trace, case.expected, records, tags, case.table, case.objects, harness)
             counters = await registers.counters()
             # The manifest's counts, saturations of every signal included, against the RTL's status counters.
@@ -352,8 +376,9 @@ if cocotb is not None:
             events = random_stream(seed, config["count"], width, height, t_frame)
             event_list, expected, expected_trace, expected_objects = model_words(model, events)
             trace, records, tags = await harness.stream(event_list, seed, config["gap"], config["stall"], params.n_clusters)
-            error = _compare(f"stream {step + 1}", event_list, expected_trace, trace, expected, records, tags, model.table,
-                             expected_objects, harness)
+            error = _compare(
+                f"stream {step + 1}", event_list, expected_trace, trace, expected, records, tags, model.table, expected_objects, harness
+            )
             counters = await registers.counters()
             error = error or _counter_mismatch(model_counters(model.stats(), len(expected)), counters)
             if error:
@@ -439,7 +464,9 @@ STREAMS = [(preset, n) for preset in CONFIGURATIONS for n in (4, 16)]  # half of
 
 
 @pytest.mark.rotating
-@pytest.mark.parametrize("sim, preset, n_clusters", [(sim, *stream) for sim in SIMS for stream in cosim_share(STREAMS, len(STREAMS) // 2, "streams", sim)])
+@pytest.mark.parametrize(
+    "sim, preset, n_clusters", [(sim, *stream) for sim in SIMS for stream in cosim_share(STREAMS, len(STREAMS) // 2, "streams", sim)]
+)
 def test_random_streams_match_the_model_in_the_loop(sim, preset, n_clusters):
     # EVCLUST_SEED=n draws other streams than the committed seeds.
     seed = int(os.environ.get("EVCLUST_SEED", 1000)) + n_clusters
@@ -521,7 +548,7 @@ def test_the_formats_tables_other_shapes_match_the_model_in_the_loop(sim, varian
 def test_the_two_format_sets_differ():
     a, _ = _random_config("traffic", 16, 0, 0)
     b, _ = _random_config("pedestrian", 16, 0, 0)
-    widths = lambda h: {line.split("=")[0] for line in h.splitlines() if "_W =" in line and "PALETTE" not in line}  # noqa: E731
+    widths = lambda h: {line.split("=")[0] for line in h.splitlines() if "_W =" in line and "PALETTE" not in line}
     assert widths(a) == widths(b)
     assert [line for line in a.splitlines() if "_W =" in line] != [line for line in b.splitlines() if "_W =" in line]
 
@@ -591,7 +618,11 @@ def test_one_cycle_per_event_and_max_n_p_plus_the_tail_per_sweep(sim):
     assert stats["latency_min"] == 2
     step = 1 + max(manifest["n_clusters"], manifest["palette_size"]) + tail
     assert 2 < stats["latency_max"] <= 2 + step + stats["object_wait_cycles"] + 1
-    assert 2 * stats["events"] <= stats["latency_sum"] <= 2 * stats["events"] + stats["filter_steps"] * (step + 1) + stats["object_wait_cycles"]
+    assert (
+        2 * stats["events"]
+        <= stats["latency_sum"]
+        <= 2 * stats["events"] + stats["filter_steps"] * (step + 1) + stats["object_wait_cycles"]
+    )
 
 
 @pytest.mark.parametrize("sim", SIMS)
@@ -648,7 +679,10 @@ def test_a_wrong_expected_record_is_reported_field_by_field(sim, tmp_path):
         return "expected.hex"
 
     folder = _tampered_copy(tmp_path, "bursts", edit)
-    with pytest.raises(AssertionError, match=r"bursts: record 7 \(expected.hex line 8\), emitted after event \d+ \(trace.hex line \d+\): vx_int: RTL -?\d+, model -?\d+$"):
+    with pytest.raises(
+        AssertionError,
+        match=r"bursts: record 7 \(expected.hex line 8\), emitted after event \d+ \(trace.hex line \d+\): vx_int: RTL -?\d+, model -?\d+$",
+    ):
         run(sim, case.header, "replay_vectors", {"cases": [str(folder)], "seed": 1, "gap": 0, "stall": 0})
 
 

@@ -19,8 +19,8 @@ import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from cosim import cosim_share, random_config, run, selected_simulators  # noqa: E402
-from switch_cover import (  # noqa: E402
+from cosim import cosim_share, random_config, run, selected_simulators
+from switch_cover import (
     COUNT, HEIGHT, SWITCHES, T_FRAME_US, WIDTH, all_pairs, cover, cover_stream, full, live_stream, pairs, row_params, selected_rows,
 )  # fmt: skip
 
@@ -65,7 +65,9 @@ def test_the_cover_holds_every_pair_of_switch_values():
     from evclust.clusterer import load_params
 
     paper, _ = load_params("paper")  # row 0: the paper's switches, on the small sensor
-    assert all(getattr(row_params(rows[0]), name) == getattr(paper, name) for values in SWITCHES.values() for name in values[next(iter(values))])
+    assert all(
+        getattr(row_params(rows[0]), name) == getattr(paper, name) for values in SWITCHES.values() for name in values[next(iter(values))]
+    )
     for row in rows:  # each row a valid parameter set with its switches as its name says
         params = row_params(row)
         for switch, value in row.values.items():

@@ -147,7 +147,9 @@ def test_the_search_finds_the_lowest_slot_the_model_merges(sim, n):
     header = params_header(ClustererParams(n_clusters=n), WIDTH, HEIGHT, T_FRAME)
     parameters = {"N": n, "SLOT_BITS": max(1, (n - 1).bit_length()), "CENTRE_BITS": w["centre"], "HALF_BITS": w["half"], "V_BITS": w["v"],
                   "COUNT_BITS": w["count"], "V_TOL_BITS": w["v_tol"], "GROW_BITS": w["grow"], "VREL_BITS": w["vrel"]}  # fmt: skip
-    result = run(sim, header, "merge_search_vectors", {"n": n, "seed": n, "widths": w}, toplevel="evclust_merge_search", parameters=parameters)
+    result = run(
+        sim, header, "merge_search_vectors", {"n": n, "seed": n, "widths": w}, toplevel="evclust_merge_search", parameters=parameters
+    )
     assert result["checked"] == TABLES
 
 

@@ -50,8 +50,6 @@ OUTPUTS = (("d_px", "px_new", "PD_PX", "PX"), ("d_py", "py_new", "PD_PY", "PY"),
            ("d_col_cb", "col_cb_new", "PD_CCB", "CCB"), ("d_col_cr", "col_cr_new", "PD_CCR", "CCR"))  # fmt: skip
 
 
-
-
 def cases(model, header: str, seed: int):
     """(k, S, slot, event) cases: the model's constant vector (the build's, or random registers),
     a random table and an event."""
@@ -170,7 +168,7 @@ if cocotb is not None:
 # ------------------------------------------------------------------------------------------
 # pytest: build, launch, check.
 
-from cosim import LEAF_BUILDS, header_width, leaf_model, run, selected_simulators  # noqa: E402
+from cosim import header_width, leaf_model, run, selected_simulators  # noqa: E402
 
 
 @pytest.mark.parametrize("build, stages", [("traffic", 1), ("defaults", 1), ("defaults", 2)])

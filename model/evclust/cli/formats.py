@@ -27,8 +27,12 @@ def add_parser(sub) -> None:
     p.add_argument("--verilog", metavar="VH", help="write the Verilog parameter header here")
     p.add_argument("--c-header", metavar="H", help="write the register map as a C header here (a driver's)")
     p.add_argument("--registers", metavar="MD", help="write the register map as a Markdown document here")
-    p.add_argument("--write-for", metavar="P", help="print the register writes (address, value) that program parameter set P "
-                   "(.toml or preset) into the RTL built for these parameters")
+    p.add_argument(
+        "--write-for",
+        metavar="P",
+        help="print the register writes (address, value) that program parameter set P "
+        "(.toml or preset) into the RTL built for these parameters",
+    )
     p.set_defaults(run=run)
 
 

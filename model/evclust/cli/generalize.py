@@ -26,15 +26,25 @@ def add_parser(sub) -> None:
     p.add_argument("--seeds", type=int, nargs="+", metavar="SEED", help="only these seeds of the split (a quick run)")
     p.add_argument("--suite-dir", default="build/suite", metavar="DIR", help="where scenes and events are kept (default: build/suite)")
     p.add_argument("--models", default="float,fixed", help="models of the default configuration (default: float,fixed)")
-    p.add_argument("-o", "--output", metavar="MD", help="page to write (default: docs/GENERALIZATION.md; with --pipeline, docs/PIPELINE.md)")
+    p.add_argument(
+        "-o", "--output", metavar="MD", help="page to write (default: docs/GENERALIZATION.md; with --pipeline, docs/PIPELINE.md)"
+    )
     p.add_argument("--scheduler", metavar="ADDR", help="Dask scheduler address (default: a local cluster)")
     p.add_argument("--workers", type=int, metavar="N", help="local Dask workers (default: one per core)")
-    p.add_argument("--ablation", action="store_true",
-                   help="instead: the defaults with each addition beyond the paper off in turn, and the paper's (float model)")
-    p.add_argument("--pipeline", action="store_true",
-                   help="instead: what the pipeline semantics (update_delay) cost, paired over small perturbations of the defaults, "
-                        "on the test and the tuning split (float model; writes docs/PIPELINE.md by default)")
-    p.add_argument("--json", metavar="PATH", help="also write every configuration's pooled figures (what it reports, and its clusters') as JSON")
+    p.add_argument(
+        "--ablation",
+        action="store_true",
+        help="instead: the defaults with each addition beyond the paper off in turn, and the paper's (float model)",
+    )
+    p.add_argument(
+        "--pipeline",
+        action="store_true",
+        help="instead: what the pipeline semantics (update_delay) cost, paired over small perturbations of the defaults, "
+        "on the test and the tuning split (float model; writes docs/PIPELINE.md by default)",
+    )
+    p.add_argument(
+        "--json", metavar="PATH", help="also write every configuration's pooled figures (what it reports, and its clusters') as JSON"
+    )
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bars")
     p.set_defaults(run=run)
 

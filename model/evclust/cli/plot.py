@@ -23,10 +23,16 @@ def add_parser(sub) -> None:
     p.add_argument("--kind", choices=PLOT_KINDS, default="velocity", help="what to plot (default: velocity)")
     p.add_argument("--events", metavar="EVENTS", help="the event file the tracks came from (needed by --kind scatter)")
     p.add_argument("--gt-id", type=int, metavar="N", help="ground-truth object to plot (default: the one with the most matches)")
-    p.add_argument("--gate", type=float, default=DEFAULT_GATE_PX, metavar="PX",
-                   help=f"largest centre distance of a match, px (default: {DEFAULT_GATE_PX:g})")
-    p.add_argument("--x", dest="axis", choices=PLOT_AXES, default="index",
-                   help="x axis: evaluation index, as the paper, or time (default: index)")
+    p.add_argument(
+        "--gate",
+        type=float,
+        default=DEFAULT_GATE_PX,
+        metavar="PX",
+        help=f"largest centre distance of a match, px (default: {DEFAULT_GATE_PX:g})",
+    )
+    p.add_argument(
+        "--x", dest="axis", choices=PLOT_AXES, default="index", help="x axis: evaluation index, as the paper, or time (default: index)"
+    )
     p.set_defaults(run=run)
 
 

@@ -21,9 +21,13 @@ def add_parser(sub) -> None:
     p.add_argument("-o", "--output", required=True, metavar="TRUTH.csv", help="reference CSV to write")
     p.add_argument("--frames", type=int, metavar="N", help="use only the first N frames")
     p.add_argument("--fps", type=float, metavar="F", help="frame rate of an image folder (default: the video's)")
-    p.add_argument("--warmup", type=int, default=30, metavar="N", help="frames the background model learns from before objects count (default: 30)")
+    p.add_argument(
+        "--warmup", type=int, default=30, metavar="N", help="frames the background model learns from before objects count (default: 30)"
+    )
     p.add_argument("--min-area", type=int, default=400, metavar="PX", help="smallest blob that is an object, px (default: 400)")
-    p.add_argument("--params", metavar="P", help=f"parameter file or preset whose palette names the colours ({preset_list()}; default: the defaults')")
+    p.add_argument(
+        "--params", metavar="P", help=f"parameter file or preset whose palette names the colours ({preset_list()}; default: the defaults')"
+    )
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     p.set_defaults(run=run)
 

@@ -20,15 +20,20 @@ def add_parser(sub) -> None:
             "(default: the end of the busiest window)."
         ),
     )
-    p.add_argument("events", metavar="EVENTS", help="event file (.npz, .h5, .aedat4, .raw), or the scene or video the tracks came from (simulated again)")
+    p.add_argument(
+        "events",
+        metavar="EVENTS",
+        help="event file (.npz, .h5, .aedat4, .raw), or the scene or video the tracks came from (simulated again)",
+    )
     p.add_argument("tracks", metavar="TRACKS", help="track file (tracks.csv from 'evclust track')")
     p.add_argument("-o", "--output", required=True, metavar="OUT", help="video (.mp4) or picture (.png) to write")
     p.add_argument("--t0", type=float, metavar="US", help="time of the first video frame in µs (default: the first frame with events)")
     p.add_argument("--t1", type=float, metavar="US", help="time of the last video frame, or of the picture, in µs")
     p.add_argument("--window", type=float, metavar="US", help="events drawn per frame: the last US µs (default: one frame period)")
     p.add_argument("--scale", type=int, default=2, metavar="K", help="upscaling of the sensor image (default: 2)")
-    p.add_argument("--arrow-frames", type=float, default=5.0, metavar="F",
-                   help="velocity arrows show the motion over F frames (default: 5)")
+    p.add_argument(
+        "--arrow-frames", type=float, default=5.0, metavar="F", help="velocity arrows show the motion over F frames (default: 5)"
+    )
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     p.set_defaults(run=run)
 
@@ -57,8 +62,9 @@ def run(args) -> int:
     tracks, track_meta = read_tracks(args.tracks)
     common = dict(window_us=args.window, scale=args.scale, arrow_frames=args.arrow_frames)
     if suffix in VIDEO_SUFFIXES:
-        n = render_video(events, ev_meta, tracks, track_meta, out, t0_us=args.t0, t1_us=args.t1,
-                         progress=False if args.quiet else None, **common)
+        n = render_video(
+            events, ev_meta, tracks, track_meta, out, t0_us=args.t0, t1_us=args.t1, progress=False if args.quiet else None, **common
+        )
         print(f"{out}: {n} frames")
     else:
         t = render_png(events, ev_meta, tracks, track_meta, out, t_us=args.t1, **common)

@@ -57,5 +57,7 @@ def _list() -> int:
         fields = ", ".join(f"{k}={v.default!r}" for k, v in cls.Params.model_fields.items())
         doc = (cls.__doc__ or "").strip().splitlines()[0] if cls.__doc__ else ""
         print(f"  {name:<23} {fields}  {doc}")
-    print(f"generated suite: evclust scenes --generate SEED -o DIR; splits {', '.join(f'{k} (seeds {min(v)}-{max(v)})' for k, v in SPLITS.items())}")
+    print(
+        f"generated suite: evclust scenes --generate SEED -o DIR; splits {', '.join(f'{k} (seeds {min(v)}-{max(v)})' for k, v in SPLITS.items())}"
+    )
     return 0

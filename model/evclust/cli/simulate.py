@@ -20,8 +20,16 @@ def add_parser(sub) -> None:
         ),
     )
     p.add_argument("scene", metavar="SCENE", help="built-in name, scene.toml, video file or image folder")
-    p.add_argument("-o", "--output", required=True, metavar="EVENTS", help="event file to write (.npz, .h5 or .hdf5; .aedat4 or .raw EVT3 keep DVS events only, without colour)")
-    p.add_argument("--truth", metavar="GT.csv", help="also write the ground truth per frame (synthetic scenes, or a video with a CSV beside it)")
+    p.add_argument(
+        "-o",
+        "--output",
+        required=True,
+        metavar="EVENTS",
+        help="event file to write (.npz, .h5 or .hdf5; .aedat4 or .raw EVT3 keep DVS events only, without colour)",
+    )
+    p.add_argument(
+        "--truth", metavar="GT.csv", help="also write the ground truth per frame (synthetic scenes, or a video with a CSV beside it)"
+    )
     p.add_argument("--seed", type=int, metavar="N", help="seed of the sensor effects (default: the scene's)")
     p.add_argument("--frames", type=int, metavar="N", help="simulate only the first N frames")
     p.add_argument("--fps", type=float, metavar="F", help="frame rate of a video or image folder (default: the video's)")

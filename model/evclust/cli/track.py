@@ -22,15 +22,32 @@ def add_parser(sub) -> None:
             "DVS-only event files (AEDAT4, EVT, or HDF5 without colour) run with colour off."
         ),
     )
-    p.add_argument("events", metavar="EVENTS", help="event file (.npz, .h5, .aedat4 or .raw EVT2/EVT3), or a scene or video to simulate on the fly (no event file written)")
+    p.add_argument(
+        "events",
+        metavar="EVENTS",
+        help="event file (.npz, .h5, .aedat4 or .raw EVT2/EVT3), or a scene or video to simulate on the fly (no event file written)",
+    )
     p.add_argument("-o", "--output", required=True, metavar="TRACKS", help="track file to write (.csv, or .parquet: smaller and faster)")
     p.add_argument("--params", metavar="P", help=f"parameter file (.toml) or preset ({preset_list()})")
     p.add_argument("--model", default="float", choices=TRACK_MODELS, help="clusterer model (default: float)")
-    p.add_argument("--frame-us", type=float, metavar="US", help="frame period in µs, the unit of the velocities (default: the event file's; camera recordings have none)")
-    p.add_argument("--clusters", action="store_true", help="write the cluster records (the event-rate clusterer's output) instead of the objects")
+    p.add_argument(
+        "--frame-us",
+        type=float,
+        metavar="US",
+        help="frame period in µs, the unit of the velocities (default: the event file's; camera recordings have none)",
+    )
+    p.add_argument(
+        "--clusters", action="store_true", help="write the cluster records (the event-rate clusterer's output) instead of the objects"
+    )
     every = p.add_mutually_exclusive_group()
-    every.add_argument("--per-frame", action="store_true", help="one record per cluster or object per frame period, its last (the default for objects; for --clusters, far smaller outputs for videos)")
-    every.add_argument("--every-step", action="store_true", help="one record per object or cluster per filter step (the default for --clusters)")
+    every.add_argument(
+        "--per-frame",
+        action="store_true",
+        help="one record per cluster or object per frame period, its last (the default for objects; for --clusters, far smaller outputs for videos)",
+    )
+    every.add_argument(
+        "--every-step", action="store_true", help="one record per object or cluster per filter step (the default for --clusters)"
+    )
     p.add_argument("--ranges", action="store_true", help="fixed model: print each signal's range seen and its saturation count")
     p.add_argument("--beta-shift", action="store_true", help="fixed model: round every β to a power of two (shift-only filters)")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
@@ -65,7 +82,7 @@ def run(args) -> int:
         params = params.model_copy(update={"objects": False})  # the object layer would run for nothing
     per_frame = args.per_frame or (objects and not args.every_step)
     out_meta = dataclasses.replace(out_meta, per_frame=per_frame, kind="objects" if objects else "clusters")
-    discard = lambda records: None  # noqa: E731  (the other kind of record, not written)
+    discard = lambda records: None
     with track_writer(args.output, out_meta) as writer:
         thinner = PerFrame(writer.write, out_meta.t_frame_us) if per_frame else None
         sink = thinner.write if thinner else writer.write

@@ -17,9 +17,15 @@ def add_parser(sub) -> None:
         ),
     )
     p.add_argument("scene", metavar="SCENE", nargs="?", help="built-in scene name or synthetic scene .toml")
-    p.add_argument("--suite", metavar="SPLIT", help="tune one configuration over a split of the generalization suite instead (docs/TUNING.md)")
-    p.add_argument("--storage", default="sqlite:///build/tune_suite.db", metavar="URL",
-                   help="--suite: optuna RDB storage; a PostgreSQL URL lets workers on many machines share the study (default: sqlite:///build/tune_suite.db)")
+    p.add_argument(
+        "--suite", metavar="SPLIT", help="tune one configuration over a split of the generalization suite instead (docs/TUNING.md)"
+    )
+    p.add_argument(
+        "--storage",
+        default="sqlite:///build/tune_suite.db",
+        metavar="URL",
+        help="--suite: optuna RDB storage; a PostgreSQL URL lets workers on many machines share the study (default: sqlite:///build/tune_suite.db)",
+    )
     p.add_argument("--study", default="suite", metavar="NAME", help="--suite: study name; an existing study resumes (default: suite)")
     p.add_argument("--suite-dir", default="build/suite", metavar="DIR", help="--suite: where scenes and events are kept")
     p.add_argument("--scheduler", metavar="ADDR", help="--suite: Dask scheduler address (default: a local cluster)")
@@ -29,8 +35,12 @@ def add_parser(sub) -> None:
     p.add_argument("--seed", type=int, default=0, metavar="S", help="sampler seed (default 0)")
     p.add_argument("--segment", type=float, default=0.5, metavar="F", help="fraction of the scene to tune on (default 0.5)")
     p.add_argument("--params", metavar="P", help="starting parameters (.toml or preset; default: the scene's preset)")
-    p.add_argument("--only", metavar="PREFIX", help="--suite: search only the parameters whose names start with PREFIX (object_: "
-                   "the object layer alone, each scene's clusters run once per worker)")
+    p.add_argument(
+        "--only",
+        metavar="PREFIX",
+        help="--suite: search only the parameters whose names start with PREFIX (object_: "
+        "the object layer alone, each scene's clusters run once per worker)",
+    )
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     p.set_defaults(run=run)
 

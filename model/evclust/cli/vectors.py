@@ -26,10 +26,18 @@ def add_parser(sub) -> None:
     p.add_argument("--check", action="store_true", help="do not write: fail if a committed case differs from the model")
     own = p.add_argument_group("vectors from your own events")
     own.add_argument("--events", metavar="FILE", help="event file with colour (.npz, .h5, ...): write DIR/<its name>/")
-    own.add_argument("--max-events", type=int, default=DEFAULT_MAX_EVENTS, metavar="N", help=f"events to take from the start (default: {DEFAULT_MAX_EVENTS})")
+    own.add_argument(
+        "--max-events",
+        type=int,
+        default=DEFAULT_MAX_EVENTS,
+        metavar="N",
+        help=f"events to take from the start (default: {DEFAULT_MAX_EVENTS})",
+    )
     own.add_argument("--params", metavar="P", help=f"parameter file (.toml) or preset ({preset_list()}); default as for 'evclust track'")
     own.add_argument("--frame-us", type=float, metavar="US", help="frame period in µs (default: the event file's)")
-    own.add_argument("--replay", choices=SIMULATORS, help="then replay the case through the RTL under this simulator (a repository checkout)")
+    own.add_argument(
+        "--replay", choices=SIMULATORS, help="then replay the case through the RTL under this simulator (a repository checkout)"
+    )
     p.set_defaults(run=run)
 
 

@@ -15,7 +15,7 @@ from evclust.clusterer.layout import (
     ACT, BG_ACT, BG_CB, BG_CR, BG_T, BG_Y, CCB, CCR, MERGED, UNSUPPORTED, CREATED, CY, DROPPED, EV_COUNT, EVENTS, EVER_REPORTED, EVICTED, EXITED,
     EXPIRED, T_FIRST, FLAG_BORDER, FLAG_MOVING_INT, FLAG_MOVING_MCM, FLAG_NEW, GAMMA, ID, MCM_NORM, NEXT_ID, NOISE, PPX, PPY, PX,
     PD_BG, PD_BG_CB, PD_BG_CR, PD_BG_Y, PD_CCB, PD_CCR, PD_CLASS, PD_CY, PD_LIVE, PD_NORM, PD_PX, PD_PY, PD_RX, PD_RY, PD_SLOT,
-    PD_T, PD_VMX, PD_VMY, PD_VOTE, PY, RECORD_COLUMNS, REPORTED, RX, RY, SINCE_FILTER, STEP, T_FILTER, T_LAST, VALID, VI_COUNT, VIX, VIY, VMX,
+    PD_T, PD_VMX, PD_VMY, PD_VOTE, PY, REPORTED, RX, RY, SINCE_FILTER, STEP, T_FILTER, T_LAST, VALID, VI_COUNT, VIX, VIY, VMX,
     VMY,
 )  # fmt: skip
 from evclust.jit import njit
@@ -330,7 +330,9 @@ def _merge(S, H, G, s, j, k, precision):
     events average), the box covers both boxes, activities and event counts add; identity,
     velocities, colour and histogram are the survivor's (the one reported before, else the more
     active). The previous centre moves with the centre: the jump is not motion."""
-    survivor = j if (S[j, EVER_REPORTED] > S[s, EVER_REPORTED]) or (S[j, EVER_REPORTED] == S[s, EVER_REPORTED] and S[j, ACT] > S[s, ACT]) else s
+    survivor = (
+        j if (S[j, EVER_REPORTED] > S[s, EVER_REPORTED]) or (S[j, EVER_REPORTED] == S[s, EVER_REPORTED] and S[j, ACT] > S[s, ACT]) else s
+    )
     a_s, a_j = S[s, ACT], S[j, ACT]
     px = _q((a_s * S[s, PX] + a_j * S[j, PX]) / (a_s + a_j), Q_CENTRE, precision)
     py = _q((a_s * S[s, PY] + a_j * S[j, PY]) / (a_s + a_j), Q_CENTRE, precision)

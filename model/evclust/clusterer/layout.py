@@ -67,6 +67,7 @@ def support_shape(width: int, height: int, cell_bits: int) -> tuple[int, int]:
     all round so that every 3x3 neighbourhood lies inside."""
     return ((height - 1) >> cell_bits) + 3, ((width - 1) >> cell_bits) + 3
 
+
 # Track-record columns by name, as the float and fixed models write them.
 (
     R_T, R_STEP, R_SLOT, R_ID, R_X, R_Y, R_RX, R_RY, R_ACT, R_VMX, R_VMY, R_VIX, R_VIY, R_LUM, R_CB, R_CR, R_CLASS, R_FLAGS,

@@ -60,6 +60,7 @@ from evclust.jit import njit
 DT_MAX_US = (1 << 24) - 1  # Δt saturates here (16.8 s): every gain is 1 long before, and the hardware counts 24 bits
 DT_FRAMES_MAX = 1024.0 - 2.0**-24  # ... and so does Δt in frames
 
+
 def object_time_us(p, name: str, t_frame_us: float) -> int:
     """The birth, coast or keep time (`name`) in whole µs, keep at least coast, at most DT_MAX_US
     (Δt saturates there, and an object unseen that long is gone)."""
@@ -74,13 +75,18 @@ ObjectConstants = namedtuple(
         "t_frame_us",  # µs per frame: the unit of the velocities and of the filters' time constants
         "gate",  # px: the margin of every overlap test
         "link_along",  # clusters along their motion link within this multiple of their larger half-size across it
-        "v_tol", "v_rel",  # velocity agreement: L1 difference <= v_tol + v_rel·(the faster L1 speed)
+        "v_tol",
+        "v_rel",  # velocity agreement: L1 difference <= v_tol + v_rel·(the faster L1 speed)
         "track_frames",  # the α-β filter's time constant on the centre
         "rate_frames",  # ... and on the velocity, by the centre's residual
         "velocity_frames",  # the velocity's pull towards its most active member's
-        "size_frames", "colour_frames",
-        "birth_us", "coast_us", "keep_us",  # times of birth, coasting (reported) and keeping (not), µs
-        "width", "height",
+        "size_frames",
+        "colour_frames",
+        "birth_us",
+        "coast_us",
+        "keep_us",  # times of birth, coasting (reported) and keeping (not), µs
+        "width",
+        "height",
     ),
 )
 

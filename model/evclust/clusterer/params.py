@@ -147,7 +147,9 @@ class ClustererParams(BaseModel):
     @model_validator(mode="after")
     def _consistent(self):
         if self.a_min > self.a_valid:
-            raise ValueError(f"need a_min <= a_valid, got {self.a_min} > {self.a_valid}: every cluster would be freed before it is reported")
+            raise ValueError(
+                f"need a_min <= a_valid, got {self.a_min} > {self.a_valid}: every cluster would be freed before it is reported"
+            )
         if not self.r_min <= self.r_init <= self.r_max:
             raise ValueError(f"need r_min <= r_init <= r_max, got {self.r_min}, {self.r_init}, {self.r_max}")
         names = [e.name for e in self.palette]
@@ -160,7 +162,7 @@ class ClustererParams(BaseModel):
             raise ValueError("every palette entry is background: no class is left")
         return self
 
-    def resolved(self, t_frame_us: float) -> "ClustererParams":
+    def resolved(self, t_frame_us: float) -> ClustererParams:
         """The parameters in µs on a stream of frame period `t_frame_us`: a time not given in µs
         is its value in frames times the frame period (τ and the support window in whole µs,
         as the hardware counts them)."""

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import time
-from typing import Callable, Iterable
+from collections.abc import Callable, Iterable
 
 import numpy as np
 from tqdm import tqdm
@@ -161,8 +161,7 @@ def prepare_run(meta: EventMeta, params: ClustererParams, model: str) -> tuple[C
     t_frame_us = params.t_frame_us or meta.t_frame_us
     if not t_frame_us:
         raise EvclustError(
-            f"{meta.source or 'events'}: no frame period (velocities are in px/frame): "
-            "give --frame-us or set clusterer.t_frame_us"
+            f"{meta.source or 'events'}: no frame period (velocities are in px/frame): give --frame-us or set clusterer.t_frame_us"
         )
     params = params.resolved(float(t_frame_us))
     return params, track_meta(params, meta, model, float(t_frame_us))

@@ -39,7 +39,7 @@ class EventMeta:
         return json.dumps(dataclasses.asdict(self), sort_keys=True)
 
     @classmethod
-    def from_dict(cls, d: dict) -> "EventMeta":
+    def from_dict(cls, d: dict) -> EventMeta:
         """From a file's metadata, checked: EvclustError names the first value out of place."""
         known = {f.name for f in dataclasses.fields(cls)}
         meta = cls(**{k: v for k, v in d.items() if k in known})

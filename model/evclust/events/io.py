@@ -16,7 +16,7 @@ import contextlib
 import json
 import zipfile
 from pathlib import Path
-from typing import Iterator
+from collections.abc import Iterator
 
 import numpy as np
 
@@ -274,8 +274,14 @@ class _Hdf5Writer:
         fields = DVS_FIELDS + (COLOUR_FIELDS if meta.has_colour else ())
         self.datasets = {
             name: group.create_dataset(
-                name, shape=(0,), maxshape=(None,), dtype=EVENT_DTYPE[name], chunks=(1 << 16,), compression="gzip",
-                compression_opts=1, shuffle=True,
+                name,
+                shape=(0,),
+                maxshape=(None,),
+                dtype=EVENT_DTYPE[name],
+                chunks=(1 << 16,),
+                compression="gzip",
+                compression_opts=1,
+                shuffle=True,
             )  # fmt: skip
             for name in fields
         }

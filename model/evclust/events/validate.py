@@ -29,9 +29,7 @@ def validate_events(ev: np.ndarray, meta: EventMeta, name: str, offset: int = 0,
         outside = np.flatnonzero(ev[axis] >= limit)
         if outside.size:
             i = int(outside[0])
-            raise EvclustError(
-                f"{name}: record {i + offset}: {axis}={int(ev[axis][i])} is outside the {meta.width}x{meta.height} sensor"
-            )
+            raise EvclustError(f"{name}: record {i + offset}: {axis}={int(ev[axis][i])} is outside the {meta.width}x{meta.height} sensor")
     t = ev["t"]
     back = np.flatnonzero(t[1:] < t[:-1])
     if back.size:

@@ -94,7 +94,11 @@ def constant_vector(table, params, has_colour: bool) -> np.ndarray:
     k[C_EXIT_M] = raw("exit_margin")
     k[C_WIDTH], k[C_HEIGHT], k[C_COLOUR] = table.width, table.height, has_colour
     k[C_WARM], k[C_MCM_CORRECT] = params.velocity_warm_start, params.mcm_bias_correction
-    k[C_VOTE_CONTRAST], k[C_MIXING], k[C_MIX_TOL] = params.palette_vote == "contrast", params.palette_assign == "mixing", raw("mixing_tolerance")
+    k[C_VOTE_CONTRAST], k[C_MIXING], k[C_MIX_TOL] = (
+        params.palette_vote == "contrast",
+        params.palette_assign == "mixing",
+        raw("mixing_tolerance"),
+    )
     k[C_MAX_ACT] = f["activity"].raw_max
     k[C_V_FULL_BITS] = f["v_int"].int_bits
     k[C_MAX_V], k[C_MIN_V] = f["v_mcm"].raw_max, f["v_mcm"].raw_min
@@ -159,7 +163,9 @@ def _decayed(a, dt, k, table):
 @njit(cache=True, nogil=True, inline="always")
 def _decay_slot(S, s, t, k, table):
     """Decay the slot's activity to t, carrying the residual; t becomes its reference time."""
-    m, S[s, DECAY_RESIDUAL] = decay_steps_nb((t - S[s, T_LAST]) & TIME_MASK, S[s, DECAY_RESIDUAL], k[C_INV_TH], k[C_INV_TH_F], DECAY_TABLE_BITS)
+    m, S[s, DECAY_RESIDUAL] = decay_steps_nb(
+        (t - S[s, T_LAST]) & TIME_MASK, S[s, DECAY_RESIDUAL], k[C_INV_TH], k[C_INV_TH_F], DECAY_TABLE_BITS
+    )
     S[s, ACT] = decay_apply_nb(S[s, ACT], m, table, DECAY_TABLE_BITS, DECAY_FRAC_BITS, FLOOR)
     S[s, T_LAST] = t
 
@@ -439,7 +445,9 @@ def _merge(S, H, G, s, j, k, log, ranges):
     mean, floored (the sweep's one division); the box covers both boxes; activities and
     event counts add, saturated; the survivor's identity, velocities, colour and histogram."""
     up = k[C_FP] - k[C_FR]
-    survivor = j if (S[j, EVER_REPORTED] > S[s, EVER_REPORTED]) or (S[j, EVER_REPORTED] == S[s, EVER_REPORTED] and S[j, ACT] > S[s, ACT]) else s
+    survivor = (
+        j if (S[j, EVER_REPORTED] > S[s, EVER_REPORTED]) or (S[j, EVER_REPORTED] == S[s, EVER_REPORTED] and S[j, ACT] > S[s, ACT]) else s
+    )
     a_s, a_j = S[s, ACT], S[j, ACT]
     weight = a_s + a_j
     px, py = S[s, PX], S[s, PY]

@@ -68,7 +68,7 @@ class Format:
 
     @property
     def lsb(self) -> float:
-        return 2.0 ** -self.frac_bits
+        return 2.0**-self.frac_bits
 
     @property
     def raw_min(self) -> int:
@@ -153,9 +153,7 @@ def _quantise(value: float, fmt: Format, name: str, param: str) -> int:
         )
     if raw == 0 and value != 0.0:
         need = math.ceil(-math.log2(abs(value))) + 1
-        raise EvclustError(
-            f"{param}: {name} = {value:g} quantises to 0 in {fmt.q}; it needs at least {need} fractional bits"
-        )
+        raise EvclustError(f"{param}: {name} = {value:g} quantises to 0 in {fmt.q}; it needs at least {need} fractional bits")
     return raw
 
 
@@ -179,8 +177,13 @@ def build_formats(
     # The L1 distance of two points of the sensor needs one bit more than a coordinate.
     seek_int = max(coord + 1, _bits_for(p.r_max + p.seek_margin + max(width, height)))
     activity_word = activity_bits + 8
-    noise_int = max(activity_word + _bits_for(width * height) + NOISE_GATE_FRAC_BITS,
-                    _bits_for(p.noise_gate) + NOISE_GATE_FRAC_BITS + activity_word + 2 * _bits_for(2 * int(p.r_max) + 1)) - 8
+    noise_int = (
+        max(
+            activity_word + _bits_for(width * height) + NOISE_GATE_FRAC_BITS,
+            _bits_for(p.noise_gate) + NOISE_GATE_FRAC_BITS + activity_word + 2 * _bits_for(2 * int(p.r_max) + 1),
+        )
+        - 8
+    )
     betas = {
         "beta_pos": 1 - p.alpha_pos, "beta_size": 1 - p.alpha_size, "beta_vel_mcm": 1 - p.alpha_vel_mcm,
         "beta_vel_int": 1 - p.alpha_vel_int, "beta_lum": 1 - p.alpha_lum, "beta_chro": 1 - p.alpha_chro,
@@ -210,43 +213,92 @@ def build_formats(
         # V_MCM's input γ·(P_new - P) is large per event even when V is small: γ reaches ~10^4.
         # γ·step reaches γ (up to 2^14 events/frame) times a step of a px or two: as many integer
         # bits as the α step's product (V times β, < 2^63) leaves, from 12 up to 16.
-        Format("v_mcm", True, v_mcm_int, guard("beta_vel_mcm"), "state", "MCM velocity accumulator and its input, px/frame", rounding="nearest"),
+        Format(
+            "v_mcm", True, v_mcm_int, guard("beta_vel_mcm"), "state", "MCM velocity accumulator and its input, px/frame", rounding="nearest"
+        ),
         # w is a divisor: its dead band must be tiny relative to 1, not to a pixel (2^-20).
-        Format("mcm_norm", False, 1, guard("beta_vel_mcm") + 14, "state", "1 - α_vm^n: the MCM filter run on 1 (reaches 1.0)", rounding="nearest"),
+        Format(
+            "mcm_norm",
+            False,
+            1,
+            guard("beta_vel_mcm") + 14,
+            "state",
+            "1 - α_vm^n: the MCM filter run on 1 (reaches 1.0)",
+            rounding="nearest",
+        ),
         Format("v_int", True, _bits_for(v_full), guard("beta_vel_int"), "state", "interval velocity, px/frame"),
-        Format("colour", False, 8, guard("beta_chro") if p.alpha_chro >= p.alpha_lum else guard("beta_lum"), "state", "cluster colour Y, Cb, Cr"),
+        Format(
+            "colour",
+            False,
+            8,
+            guard("beta_chro") if p.alpha_chro >= p.alpha_lum else guard("beta_lum"),
+            "state",
+            "cluster colour Y, Cb, Cr",
+        ),
         Format("background", False, 8, guard("beta_bg"), "state", "background colour Y, Cb, Cr"),
         Format("gamma", False, 14, 8, "state", "γ: events per frame (the activity estimate reaches ~8000 early on)"),
-        Format("events_in_interval", False, interval_count_bits, 0, "state", "events of the cluster since the last τ boundary (a dense cluster: 10^5 in a τ)"),
+        Format(
+            "events_in_interval",
+            False,
+            interval_count_bits,
+            0,
+            "state",
+            "events of the cluster since the last τ boundary (a dense cluster: 10^5 in a τ)",
+        ),
         Format("hist", False, p.hist_bits, 0, "state", "palette histogram counter"),
         Format("id", False, 32, 0, "state", "cluster id", overflow="wrap"),
         Format("offset", True, coord, pos_frac, "intermediate", "e - P, px"),
         Format("seek_distance", False, seek_int, pos_frac, "intermediate", "L1 distance and seek bounds, px"),
         Format("centre_step", True, 4, pos_frac, "intermediate", "P_new - P, px"),
-        Format("size_target", False, coord + _bits_for(p.size_gain), guard("beta_size"), "intermediate", "g_R·|e - P|, px, before R's clamp"),
+        Format(
+            "size_target", False, coord + _bits_for(p.size_gain), guard("beta_size"), "intermediate", "g_R·|e - P|, px, before R's clamp"
+        ),
         Format("speed_sq", False, 2 * _bits_for(v_full) + 1, 16, "intermediate", "|V|², (px/frame)²"),
         Format("vote", False, 10, 0, "intermediate", "palette vote: 1, or |e - BG|₁ rounded"),
         Format("decay_residual", False, 0, 0, "state", "Δt/T_half below one decay-table step (fraction bits set below)"),
         Format("tau_phase", False, _bits_for(p.tau_us), 0, "state", "µs since the last τ boundary"),
-        Format("interval_updates", False, _bits_for(max(p.interval_warmup(), 2)), 0, "state",
-               "interval measurements so far + 1, up to the warm-up's end (0: born in this interval)"),
+        Format(
+            "interval_updates",
+            False,
+            _bits_for(max(p.interval_warmup(), 2)),
+            0,
+            "state",
+            "interval measurements so far + 1, up to the warm-up's end (0: born in this interval)",
+        ),
         Format("inv_ww", False, 33, 0, "intermediate", "2^32 / |palette_j - BG|², refreshed at filter steps"),
         Format("mixing_q", False, 1, 16, "intermediate", "mixing fraction q, clamped to [0, 1]"),
         # The MCM correction divides V·2^F by w cut to F fraction bits: V·2^20 fits an int64.
         Format("mcm_weight", False, 1, 20, "intermediate", "w to 20 fraction bits: the MCM correction's divisor"),
         Format("dt", False, 32, 0, "intermediate", "t - t_last, µs (modulo 2^32)", overflow="wrap"),
         Format("support_time", False, 32, 0, "state", "creation-support map cell: time of its latest event, µs", overflow="wrap"),
-        Format("merge_moment", False, activity_bits + coord + 1, 8 + pos_frac, "intermediate",
-               "A_s·P_s + A_j·P_j of a merge (activity × centre)"),
+        Format(
+            "merge_moment",
+            False,
+            activity_bits + coord + 1,
+            8 + pos_frac,
+            "intermediate",
+            "A_s·P_s + A_j·P_j of a merge (activity × centre)",
+        ),
         # A·W·H << 4 against gate·A_bg·(2⌊R⌋ + 1)², the raw words with the activity's 8 fraction bits.
         Format("noise_count", False, noise_int, 8, "intermediate", "A·W·H against γ_n·A_bg·box (activity × px²)"),
         # The object layer: once per filter step, over the step's cluster records.
-        Format("obj_centre", True, coord + 1, pos_frac, "state", "object centre and box edges, px (outside the sensor while it coasts out)"),
+        Format(
+            "obj_centre", True, coord + 1, pos_frac, "state", "object centre and box edges, px (outside the sensor while it coasts out)"
+        ),
         Format("obj_half", False, coord, _half_frac, "state", "object half-size, px"),
         Format("obj_velocity", True, _bits_for(v_full), OBJECT_VELOCITY_FRAC, "state", "object and cluster velocities, px/frame"),
-        Format("obj_weight", False, activity_bits + _bits_for(max(p.n_clusters - 1, 1)), 8, "intermediate", "activity of a group of clusters"),
+        Format(
+            "obj_weight", False, activity_bits + _bits_for(max(p.n_clusters - 1, 1)), 8, "intermediate", "activity of a group of clusters"
+        ),
         Format("obj_dt", False, OBJECT_DT_BITS, 0, "intermediate", "µs since the last filter step, saturated"),
-        Format("obj_dt_frames", False, OBJECT_DT_FRAMES_INT, OBJECT_DT_FRAMES_FRAC, "intermediate", "Δt in frames, saturated (every gain is 1 long before)"),
+        Format(
+            "obj_dt_frames",
+            False,
+            OBJECT_DT_FRAMES_INT,
+            OBJECT_DT_FRAMES_FRAC,
+            "intermediate",
+            "Δt in frames, saturated (every gain is 1 long before)",
+        ),
         Format("obj_gain", False, 1, OBJECT_GAIN_FRAC, "intermediate", "min(Δt/T, 1): a filter's gain over one step"),
         # v_tol + v_rel·|V|₁ with |V|₁ at most twice full scale and v_rel below 2.
         Format("obj_tolerance", False, _bits_for(v_full) + 3, OBJECT_VELOCITY_FRAC, "intermediate", "velocity tolerance, px/frame"),
@@ -269,7 +321,9 @@ def build_formats(
     for name, beta in betas.items():
         const(name, beta, False, 0, beta_bits[name], f"clusterer.alpha_{name[5:]}", f"1 - α of the {name[5:]} filter")
     const("size_gain", p.size_gain, False, _bits_for(p.size_gain), 8, "clusterer.size_gain", "g_R")
-    const("inv_t_half", 1.0 / p.t_half_us, False, 0, max(0, math.ceil(math.log2(p.t_half_us))) + 24, "clusterer.t_half_us", "1/T_half, per µs")
+    const(
+        "inv_t_half", 1.0 / p.t_half_us, False, 0, max(0, math.ceil(math.log2(p.t_half_us))) + 24, "clusterer.t_half_us", "1/T_half, per µs"
+    )
     const("gamma_global", p.gamma, False, 12, 8, "clusterer.gamma", "the paper's global γ")
     if p.tau_us != round(p.tau_us):
         raise EvclustError(f"clusterer.tau_us: {p.tau_us:g} µs; the fixed model counts τ in whole µs (use {round(p.tau_us)})")
@@ -277,16 +331,26 @@ def build_formats(
     const("gamma_per_activity", gpa, False, _bits_for(gpa), _frac_for(gpa), "clusterer.t_half_us", "ln2·T_frame/T_half")
     const("frame_per_tau", fpt, False, _bits_for(fpt), _frac_for(fpt), "clusterer.tau_us", "T_frame/τ")
     if _bits_for(gpa) > formats["gamma"].int_bits:  # a new cluster's γ is 1·ln2·T_frame/T_half, unsaturated
-        raise EvclustError(f"clusterer.t_half_us: ln2·T_frame/T_half = {gpa:.6g}; a new cluster's γ (one event's activity times it) "
-                           f"would not fit γ's format {formats['gamma'].q}: use a t_half_us above {math.log(2) * t_frame_us / 2**14:.6g} µs")
+        raise EvclustError(
+            f"clusterer.t_half_us: ln2·T_frame/T_half = {gpa:.6g}; a new cluster's γ (one event's activity times it) "
+            f"would not fit γ's format {formats['gamma'].q}: use a t_half_us above {math.log(2) * t_frame_us / 2**14:.6g} µs"
+        )
     const("inv_p", 1.0 / p.p_correction, False, _bits_for(1.0 / p.p_correction), 12, "clusterer.p_correction", "1/p of eq. (11)")
     if p.luma_weight > 0:
         const("luma_weight", p.luma_weight, False, _bits_for(p.luma_weight), 6, "clusterer.luma_weight", "w_Y")
     size = formats["half_size"]
-    for name, value, param in (("r_init", p.r_init, "clusterer.r_init"), ("r_min", p.r_min, "clusterer.r_min"), ("r_max", p.r_max, "clusterer.r_max")):
+    for name, value, param in (
+        ("r_init", p.r_init, "clusterer.r_init"),
+        ("r_min", p.r_min, "clusterer.r_min"),
+        ("r_max", p.r_max, "clusterer.r_max"),
+    ):
         const(name, value, False, size.int_bits, size.frac_bits, param, f"{name}, px")
-    const("seek_margin", p.seek_margin, False, _bits_for(p.seek_margin), pos_frac, "clusterer.seek_margin", "S, px") if p.seek_margin > 0 else None
-    const("exit_margin", p.exit_margin, False, _bits_for(p.exit_margin), pos_frac, "clusterer.exit_margin", "M, px") if p.exit_margin > 0 else None
+    const(
+        "seek_margin", p.seek_margin, False, _bits_for(p.seek_margin), pos_frac, "clusterer.seek_margin", "S, px"
+    ) if p.seek_margin > 0 else None
+    const(
+        "exit_margin", p.exit_margin, False, _bits_for(p.exit_margin), pos_frac, "clusterer.exit_margin", "M, px"
+    ) if p.exit_margin > 0 else None
     act = formats["activity"]
     for name, value in (("a_min", p.a_min), ("a_valid", p.a_valid)):
         if value > 0:
@@ -295,19 +359,59 @@ def build_formats(
     for name, value, param in (("v_min_sq", p.v_min**2, "clusterer.v_min"), ("v_exit_sq", p.v_exit**2, "clusterer.v_exit")):
         if value > 0:
             const(name, value, False, sq.int_bits, sq.frac_bits, param, f"{name[:-3]}², (px/frame)²")
-    const("cos_sq_exit", math.cos(math.radians(p.theta_exit_deg)) ** 2, False, 0, 16, "clusterer.theta_exit_deg", "cos²θ_exit") if p.theta_exit_deg < 90 else None
-    const("mixing_tolerance", p.mixing_tolerance, False, 11, 0, "clusterer.mixing_tolerance", "palette mixing tolerance") if p.mixing_tolerance > 0 else None
+    const(
+        "cos_sq_exit", math.cos(math.radians(p.theta_exit_deg)) ** 2, False, 0, 16, "clusterer.theta_exit_deg", "cos²θ_exit"
+    ) if p.theta_exit_deg < 90 else None
+    const(
+        "mixing_tolerance", p.mixing_tolerance, False, 11, 0, "clusterer.mixing_tolerance", "palette mixing tolerance"
+    ) if p.mixing_tolerance > 0 else None
     # One cluster per object (beyond the paper).
     # A scale below half a step is 0: the constant is left out, as a zero margin is.
-    some = lambda v: round(v * (1 << SCALE_FRAC_BITS)) > 0  # noqa: E731
-    const("seek_scale", p.seek_scale, False, _bits_for(p.seek_scale), SCALE_FRAC_BITS, "clusterer.seek_scale", "seek margin per px of max(Rx, Ry)") if some(p.seek_scale) else None
-    const("merge_scale", p.merge_scale, False, _bits_for(p.merge_scale), SCALE_FRAC_BITS, "clusterer.merge_scale", "merge reach per px of max(Rx, Ry)") if some(p.merge_scale) else None
+    some = lambda v: round(v * (1 << SCALE_FRAC_BITS)) > 0
+    const(
+        "seek_scale",
+        p.seek_scale,
+        False,
+        _bits_for(p.seek_scale),
+        SCALE_FRAC_BITS,
+        "clusterer.seek_scale",
+        "seek margin per px of max(Rx, Ry)",
+    ) if some(p.seek_scale) else None
+    const(
+        "merge_scale",
+        p.merge_scale,
+        False,
+        _bits_for(p.merge_scale),
+        SCALE_FRAC_BITS,
+        "clusterer.merge_scale",
+        "merge reach per px of max(Rx, Ry)",
+    ) if some(p.merge_scale) else None
     vi = formats["v_int"]
-    const("merge_v_tol", p.merge_v_tol, False, vi.int_bits, vi.frac_bits, "clusterer.merge_v_tol", "merge: L1 velocity difference, px/frame") if p.merge_v_tol > 0 else None
-    const("merge_v_rel", p.merge_v_rel, False, _bits_for(p.merge_v_rel), SCALE_FRAC_BITS, "clusterer.merge_v_rel", "merge: velocity difference per px/frame of speed") if some(p.merge_v_rel) else None
-    const("noise_gate", p.noise_gate, False, _bits_for(p.noise_gate), NOISE_GATE_FRAC_BITS, "clusterer.noise_gate", "activity over the background's, per box") if p.noise_gate > 0 else None
+    const(
+        "merge_v_tol", p.merge_v_tol, False, vi.int_bits, vi.frac_bits, "clusterer.merge_v_tol", "merge: L1 velocity difference, px/frame"
+    ) if p.merge_v_tol > 0 else None
+    const(
+        "merge_v_rel",
+        p.merge_v_rel,
+        False,
+        _bits_for(p.merge_v_rel),
+        SCALE_FRAC_BITS,
+        "clusterer.merge_v_rel",
+        "merge: velocity difference per px/frame of speed",
+    ) if some(p.merge_v_rel) else None
+    const(
+        "noise_gate",
+        p.noise_gate,
+        False,
+        _bits_for(p.noise_gate),
+        NOISE_GATE_FRAC_BITS,
+        "clusterer.noise_gate",
+        "activity over the background's, per box",
+    ) if p.noise_gate > 0 else None
     # t - T <= window for whole µs differences is t - T <= floor(window): the floor is exact.
-    const("support_window", math.floor(p.support_window_us), False, 32, 0, "clusterer.support_window_us", "creation support window, µs") if p.support_window_us >= 1 else None
+    const(
+        "support_window", math.floor(p.support_window_us), False, 32, 0, "clusterer.support_window_us", "creation support window, µs"
+    ) if p.support_window_us >= 1 else None
     _object_constants(p, t_frame_us, formats, const)
     for i, (name, ycc) in enumerate(zip(p.palette_names, p.palette_ycbcr())):
         for channel, value in zip(("Y", "CB", "CR"), ycc):
@@ -315,7 +419,9 @@ def build_formats(
     table = {k.name: k for k in c}
     residual_bits = table["inv_t_half"].fmt.frac_bits - DECAY_TABLE_BITS
     formats["decay_residual"] = dataclasses.replace(formats["decay_residual"], frac_bits=residual_bits)
-    formats["decay_table"] = Format("decay_table", False, 1, DECAY_FRAC_BITS, "constant", "2^-(i/64), i = 0..63 (entry 0 is 1.0)", rounding="nearest")
+    formats["decay_table"] = Format(
+        "decay_table", False, 1, DECAY_FRAC_BITS, "constant", "2^-(i/64), i = 0..63 (entry 0 is 1.0)", rounding="nearest"
+    )
     vi_frac = table["beta_vel_int"].fmt.frac_bits
     gains = (0, 0) + tuple(int(round((1 << vi_frac) / n)) for n in range(2, max(p.interval_warmup(), 2)))
     return FormatTable(formats, table, p.n_clusters, len(p.palette), width, height, beta_shift_only,
@@ -331,19 +437,43 @@ def _object_constants(p: ClustererParams, t_frame_us: float, formats: dict, cons
         raise EvclustError(f"clusterer.t_frame_us: {t_frame_us:g} µs; the object layer needs a frame period of at least 256 µs")
     const("inv_t_frame", 1.0 / t_frame_us, False, 0, inv_t_frame_frac, "clusterer.t_frame_us", "1/T_frame, per µs")
     const("object_gate", p.object_gate, False, centre.int_bits, centre.frac_bits, "clusterer.object_gate", "gate margin, px")
-    const("object_link_along", p.object_link_along, False, 3, SCALE_FRAC_BITS, "clusterer.object_link_along",
-          "link reach along the motion per px of half-size across it")
-    const("object_v_tol", p.object_v_tol, False, velocity.int_bits, velocity.frac_bits, "clusterer.object_v_tol", "velocity agreement, px/frame")
+    const(
+        "object_link_along",
+        p.object_link_along,
+        False,
+        3,
+        SCALE_FRAC_BITS,
+        "clusterer.object_link_along",
+        "link reach along the motion per px of half-size across it",
+    )
+    const(
+        "object_v_tol",
+        p.object_v_tol,
+        False,
+        velocity.int_bits,
+        velocity.frac_bits,
+        "clusterer.object_v_tol",
+        "velocity agreement, px/frame",
+    )
     const("object_v_rel", p.object_v_rel, False, 1, SCALE_FRAC_BITS, "clusterer.object_v_rel", "velocity agreement per px/frame of speed")
     for name in ("track", "rate", "velocity", "size", "colour"):
         frames = getattr(p, f"object_{name}_frames")
         if frames < 1.0 / (2**OBJECT_INV_T_INT - 1):
-            raise EvclustError(f"clusterer.object_{name}_frames: {frames:g}; the object filters' time constants are at least 1/{2**OBJECT_INV_T_INT - 1} frame")
-        const(f"object_inv_{name}", 1.0 / frames, False, OBJECT_INV_T_INT, OBJECT_INV_T_FRAC, f"clusterer.object_{name}_frames", f"1/T of the object's {name} filter, per frame")
+            raise EvclustError(
+                f"clusterer.object_{name}_frames: {frames:g}; the object filters' time constants are at least 1/{2**OBJECT_INV_T_INT - 1} frame"
+            )
+        const(
+            f"object_inv_{name}",
+            1.0 / frames,
+            False,
+            OBJECT_INV_T_INT,
+            OBJECT_INV_T_FRAC,
+            f"clusterer.object_{name}_frames",
+            f"1/T of the object's {name} filter, per frame",
+        )
     for name in ("birth", "coast", "keep"):
         us = object_time_us(p, name, t_frame_us)  # at most DT_MAX_US
         const(f"object_{name}_us", us, False, OBJECT_TIME_BITS, 0, f"clusterer.object_{name}_frames", f"object {name} time, µs")
-
 
 
 # Constants a parameter set may leave out (a zero margin, no luminance weight, ...): the RTL
@@ -407,7 +537,20 @@ def format_rows(table: FormatTable) -> list[tuple[str, ...]]:
     for fmt in table.formats.values():
         const = table.constants.get(fmt.name)
         value = f"{const.value:.9g} -> {const.quantised:.9g}" if const else ""
-        rows.append((fmt.role, fmt.name, fmt.q, str(fmt.word_bits), f"{fmt.min:g}..{fmt.max:g}", f"{fmt.lsb:.3g}", fmt.rounding, fmt.overflow, value, fmt.doc))
+        rows.append(
+            (
+                fmt.role,
+                fmt.name,
+                fmt.q,
+                str(fmt.word_bits),
+                f"{fmt.min:g}..{fmt.max:g}",
+                f"{fmt.lsb:.3g}",
+                fmt.rounding,
+                fmt.overflow,
+                value,
+                fmt.doc,
+            )
+        )
     return rows
 
 
@@ -415,7 +558,7 @@ def render_table(table: FormatTable) -> str:
     header = ("role", "signal", "Q", "bits", "range", "LSB", "rounding", "overflow", "constant", "meaning")
     rows = format_rows(table)
     widths = [max(len(str(r[i])) for r in rows + [header]) for i in range(len(header))]
-    line = lambda r: "  ".join(str(v).ljust(w) for v, w in zip(r, widths)).rstrip()  # noqa: E731
+    line = lambda r: "  ".join(str(v).ljust(w) for v, w in zip(r, widths)).rstrip()
     return "\n".join([line(header), line(tuple("-" * w for w in widths)), *map(line, rows)])
 
 
@@ -458,7 +601,9 @@ def _verilog_lines(table: FormatTable) -> str:
     from evclust.fixed import registers  # it builds on this module
 
     if table.n_clusters > RTL_MAX_CLUSTERS:
-        raise EvclustError(f"clusterer.n_clusters: the RTL holds at most {RTL_MAX_CLUSTERS} clusters (its trace names a slot in 8 bits), not {table.n_clusters}")
+        raise EvclustError(
+            f"clusterer.n_clusters: the RTL holds at most {RTL_MAX_CLUSTERS} clusters (its trace names a slot in 8 bits), not {table.n_clusters}"
+        )
     if table.formats["frame_per_tau"].word_bits >= 33:
         raise EvclustError("clusterer.tau_us: T_frame/tau needs 33 bits or more; the RTL counts tau boundaries in 33 bits")
     preamble = [
@@ -497,7 +642,9 @@ def _verilog_lines(table: FormatTable) -> str:
     out.append(_packed("DECAY_TABLE", entries, DECAY_FRAC_BITS + 1))
     out.append(_packed("WARMUP_GAINS", list(table.warmup_gains), table.formats["beta_vel_int"].word_bits))
     for channel in ("y", "cb", "cr"):
-        out.append(_packed(f"PALETTE_{channel.upper()}", [table.constants[f"palette_{j}_{channel}"].raw for j in range(table.palette_size)], 8))
+        out.append(
+            _packed(f"PALETTE_{channel.upper()}", [table.constants[f"palette_{j}_{channel}"].raw for j in range(table.palette_size)], 8)
+        )
     for name, value in table.options:
         out.append(f"localparam integer {name} = {value};")
     out.append(f"localparam integer BETA_SHIFT_ONLY = {int(table.beta_shift_only)};")

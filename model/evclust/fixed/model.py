@@ -42,7 +42,9 @@ class FixedClusterer:
         self.k = fixed_model.constant_vector(self.table, params, has_colour)
         self.decay = np.asarray(decay_table(self.table), dtype=np.int64)
         self.gains = np.asarray(self.table.warmup_gains, dtype=np.int64)
-        self.palette = np.array([[self.table.constants[f"palette_{j}_{c}"].raw for c in ("y", "cb", "cr")] for j in range(len(params.palette))], dtype=np.int64)
+        self.palette = np.array(
+            [[self.table.constants[f"palette_{j}_{c}"].raw for c in ("y", "cb", "cr")] for j in range(len(params.palette))], dtype=np.int64
+        )
         self.background_mask = params.background_mask()
         self.slots = np.zeros((params.n_clusters, len(SLOT_COLUMNS)), dtype=np.int64)
         self.hist = np.zeros((params.n_clusters, len(params.palette)), dtype=np.int64)

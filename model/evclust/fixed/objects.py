@@ -40,13 +40,35 @@ S_OBJ_CENTRE, S_OBJ_VELOCITY = range(len(OBJECT_SIGNALS))
 FixedObjectConstants = namedtuple(
     "FixedObjectConstants",
     (
-        "fp", "fr", "fv", "fvi", "fvm", "fa", "fc",  # fraction bits: centre, half-size, object velocity, v_int, v_mcm, activity, colour
-        "inv_t_frame", "inv_t_frame_frac",  # 1/T_frame per µs
-        "gate", "link_along", "v_tol", "v_rel",  # centre's, SCALE_FRAC_BITS, obj_velocity's, SCALE_FRAC_BITS
-        "inv_track", "inv_rate", "inv_velocity", "inv_size", "inv_colour",  # 1/T per frame, OBJECT_INV_T_FRAC
-        "birth_us", "coast_us", "keep_us", "dt_max", "dt_frames_max",
-        "last_x", "last_y",  # the last column and row, in the centre's format
-        "centre_min", "centre_max", "velocity_min", "velocity_max",
+        "fp",
+        "fr",
+        "fv",
+        "fvi",
+        "fvm",
+        "fa",
+        "fc",  # fraction bits: centre, half-size, object velocity, v_int, v_mcm, activity, colour
+        "inv_t_frame",
+        "inv_t_frame_frac",  # 1/T_frame per µs
+        "gate",
+        "link_along",
+        "v_tol",
+        "v_rel",  # centre's, SCALE_FRAC_BITS, obj_velocity's, SCALE_FRAC_BITS
+        "inv_track",
+        "inv_rate",
+        "inv_velocity",
+        "inv_size",
+        "inv_colour",  # 1/T per frame, OBJECT_INV_T_FRAC
+        "birth_us",
+        "coast_us",
+        "keep_us",
+        "dt_max",
+        "dt_frames_max",
+        "last_x",
+        "last_y",  # the last column and row, in the centre's format
+        "centre_min",
+        "centre_max",
+        "velocity_min",
+        "velocity_max",
     ),
 )
 

@@ -250,7 +250,9 @@ def c_header(table: FormatTable) -> str:
         out.append(f"#define EVCLUST_COUNT_{name.upper()} 0x{counter_address(name):03x}u")
     out.append("")
     for field in config_fields(table):
-        out.append(f"#define EVCLUST_CFG_{field.name} 0x{field.address:03x}u  /* {field.width} bits, {field.words} word(s); reset {field.reset} */")
+        out.append(
+            f"#define EVCLUST_CFG_{field.name} 0x{field.address:03x}u  /* {field.width} bits, {field.words} word(s); reset {field.reset} */"
+        )
         out.append(f"#define EVCLUST_CFG_{field.name}_WIDTH {field.width}u")
     out += ["", "#endif /* EVCLUST_REGS_H */", ""]
     return "\n".join(out)
@@ -272,7 +274,7 @@ def markdown(table: FormatTable) -> str:
         "",
         "| address | name | access | bits | reset | meaning |",
         "|---|---|---|---|---|---|",
-        f"| 0x{REG_ID:03x} | ID | RO | 32 | 0x{ID_VALUE:08x} | \"EVCL\" |",
+        f'| 0x{REG_ID:03x} | ID | RO | 32 | 0x{ID_VALUE:08x} | "EVCL" |',
         f"| 0x{REG_VERSION:03x} | VERSION | RO | 32 | {VERSION} | register map version |",
         f"| 0x{REG_CTRL:03x} | CTRL | WO | 2 | 0 | bit 0 CLEAR: restart the datapath (cluster table, background, τ phase) with the "
         "current configuration; bit 1 CLEAR_COUNTERS |",

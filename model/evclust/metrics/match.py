@@ -97,9 +97,7 @@ def _check_inputs(tracks, meta: TrackMeta, gate_px: float) -> np.ndarray:
     if missing:
         raise EvclustError(f"tracks: missing field(s) {', '.join(missing)}")
     if len(meta.palette_ycbcr) and len(meta.palette_ycbcr) != len(meta.palette):
-        raise EvclustError(
-            f"track metadata: palette has {len(meta.palette)} names but {len(meta.palette_ycbcr)} colours"
-        )
+        raise EvclustError(f"track metadata: palette has {len(meta.palette)} names but {len(meta.palette_ycbcr)} colours")
     return tracks.reshape(-1)
 
 

@@ -58,11 +58,15 @@ def format_tables(scores: Scores | Mapping[str, Scores]) -> str:
 
     velocity = [
         ("Ground Truth Range", "vx × vy [px/Tframe]", each(_range)),
-        *(row for method in S[0].velocity for row in (
-            (METHOD_NAMES[method], "RMSE [px/Tframe]", each(lambda s, m=method: _num(s.velocity[m].rmse))),
-            (METHOD_NAMES[method], "NRMSE", each(lambda s, m=method: _pct(s.velocity[m].nrmse))),
-            (METHOD_NAMES[method], "Angular", each(lambda s, m=method: _deg(s.velocity[m].angular_deg))),
-        )),  # fmt: skip
+        *(
+            row
+            for method in S[0].velocity
+            for row in (
+                (METHOD_NAMES[method], "RMSE [px/Tframe]", each(lambda s, m=method: _num(s.velocity[m].rmse))),
+                (METHOD_NAMES[method], "NRMSE", each(lambda s, m=method: _pct(s.velocity[m].nrmse))),
+                (METHOD_NAMES[method], "Angular", each(lambda s, m=method: _deg(s.velocity[m].angular_deg))),
+            )
+        ),  # fmt: skip
     ]
     colour = [
         ("Position", "RMSE [px]", each(lambda s: _num(s.position_rmse_px))),

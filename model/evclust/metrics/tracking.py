@@ -132,6 +132,7 @@ def frame_pairs(tracks: np.ndarray, meta: TrackMeta, truth, min_visible: float =
         back = where.get((int(truth["frame"][row]) - second, int(truth["id"][row])))
         v = (truth["vx"][row], truth["vy"][row])
         return back is not None and (v[0] or v[1]) and (truth["vx"][back], truth["vy"][back]) == v
+
     gt_ids, track_ids, sims, rows, frames, failures = [], [], [], [], [], []
     objects: dict[int, list] = {}
     for k in sorted(by_frame):
@@ -176,7 +177,11 @@ def frame_pairs(tracks: np.ndarray, meta: TrackMeta, truth, min_visible: float =
         sims.append(sim_c)
         for row in objs[care].tolist():
             objects.setdefault(int(truth["id"][row]), []).append(
-                (float(radius(truth["w"][row], truth["h"][row])), math.hypot(truth["vx"][row], truth["vy"][row]), max(truth["w"][row], truth["h"][row]))
+                (
+                    float(radius(truth["w"][row], truth["h"][row])),
+                    math.hypot(truth["vx"][row], truth["vy"][row]),
+                    max(truth["w"][row], truth["h"][row]),
+                )
             )
         gi, ti = linear_sum_assignment(-sim_c) if sim_c.size else (np.empty(0, np.int64), np.empty(0, np.int64))
         ok = sim_c[gi, ti] >= MATCH_SIMILARITY
@@ -197,8 +202,9 @@ def frame_pairs(tracks: np.ndarray, meta: TrackMeta, truth, min_visible: float =
     if matches.size:
         matches["class_direct"] = nearest_palette_class(np.stack([matches["Y"], matches["Cb"], matches["Cr"]], axis=1), meta)
     summary = {i: ObjectSummary(len(vals), *(float(np.mean([v[c] for v in vals])) for c in range(3))) for i, vals in objects.items()}
-    return FramePairs(gt_ids, track_ids, sims, matches, summary, np.array(frames, np.int64),
-                      np.array(failures, np.int64).reshape(-1, len(FAILURES)))
+    return FramePairs(
+        gt_ids, track_ids, sims, matches, summary, np.array(frames, np.int64), np.array(failures, np.int64).reshape(-1, len(FAILURES))
+    )
 
 
 def trackeval_data(pairs: FramePairs) -> dict:
@@ -259,9 +265,10 @@ def accuracy(matches: np.ndarray, meta: TrackMeta) -> dict:
     methods = velocity_methods(m)
     out = {"n_matches": int(m.size)}
     if m.size == 0:
-        per_method = [f"{name}_{figure}{suffix}" for name, _, _ in methods for figure in ("nrmse", "angle_deg") for suffix in ("", "_steady")]
-        return out | {k: None for k in ("position_rel_rmse", *per_method, "steady_share", "luminance_nrmse", "chrominance_nrmse",
-                                         "class_palette", "class_direct")}  # fmt: skip
+        per_method = [
+            f"{name}_{figure}{suffix}" for name, _, _ in methods for figure in ("nrmse", "angle_deg") for suffix in ("", "_steady")
+        ]
+        return out | dict.fromkeys(("position_rel_rmse", *per_method, "steady_share", "luminance_nrmse", "chrominance_nrmse", "class_palette", "class_direct"))  # fmt: skip
     out["position_rel_rmse"] = float(np.sqrt(np.mean((m["d"] / m["radius"]) ** 2)))
     gt = np.stack([m["gt_vx"], m["gt_vy"]], axis=1)
     moving = np.hypot(gt[:, 0], gt[:, 1]) > 0

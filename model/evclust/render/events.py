@@ -8,12 +8,12 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+import matplotlib.pyplot as plt
+import numpy as np
 
-from evclust.colour import ycbcr_to_rgb  # noqa: E402
-from evclust.errors import EvclustError, atomic_output  # noqa: E402
-from evclust.events.format import EventMeta  # noqa: E402
+from evclust.colour import ycbcr_to_rgb
+from evclust.errors import EvclustError, atomic_output
+from evclust.events.format import EventMeta
 
 
 def _window(ev: np.ndarray, meta: EventMeta, t0_us: float | None, span_us: float | None) -> np.ndarray:
@@ -49,7 +49,7 @@ def draw_events(ev: np.ndarray, meta: EventMeta, path: str | Path, t0_us: float 
     tall = meta.height > meta.width
     fig = plt.figure(figsize=(13, 7.5) if tall else (13, 6.5), constrained_layout=True)
     grid = fig.add_gridspec(2, 2, height_ratios=(3, 1))
-    window_ms = (f"{int(win['t'][0]) / 1e3:.1f}-{int(win['t'][-1]) / 1e3:.1f} ms" if win.size else "no events")
+    window_ms = f"{int(win['t'][0]) / 1e3:.1f}-{int(win['t'][-1]) / 1e3:.1f} ms" if win.size else "no events"
     for col, (image, title) in enumerate(((polarity, "polarity (white ON, black OFF)"), (colour, "colour carried by the events"))):
         ax = fig.add_subplot(grid[0, col])
         ax.imshow(image, interpolation="nearest")

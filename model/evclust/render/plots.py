@@ -19,15 +19,15 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+import matplotlib.pyplot as plt
+import numpy as np
 
-from evclust.choices import PLOT_AXES, PLOT_KINDS  # noqa: E402
-from evclust.colour import ycbcr_to_rgb  # noqa: E402
-from evclust.errors import EvclustError, atomic_output  # noqa: E402
-from evclust.events.format import EventMeta  # noqa: E402
-from evclust.metrics.tracking import velocity_methods  # noqa: E402
-from evclust.tracks.record import TrackMeta  # noqa: E402
+from evclust.choices import PLOT_AXES, PLOT_KINDS
+from evclust.colour import ycbcr_to_rgb
+from evclust.errors import EvclustError, atomic_output
+from evclust.events.format import EventMeta
+from evclust.metrics.tracking import velocity_methods
+from evclust.tracks.record import TrackMeta
 
 PLOT_SUFFIXES = (".png", ".svg", ".pdf")
 KINDS, AXES = PLOT_KINDS, PLOT_AXES
@@ -113,7 +113,9 @@ def _mark_events(axes, rows: np.ndarray, x: np.ndarray, axis: str, gaps, t_frame
         if change.size > 30:  # too many to read; the title lists the ids
             continue
         for k, c in enumerate(change):
-            ax.axvline((x[c - 1] + x[c]) / 2 if axis == "index" else x[c], color="0.5", lw=0.8, ls=":", label="track id change" if k == 0 else None)
+            ax.axvline(
+                (x[c - 1] + x[c]) / 2 if axis == "index" else x[c], color="0.5", lw=0.8, ls=":", label="track id change" if k == 0 else None
+            )
 
 
 def _frame_guess(rows: np.ndarray) -> float:
@@ -140,8 +142,15 @@ def _subtitle(rows: np.ndarray, gt_id: int) -> str:
     return f"object {gt_id}: {rows.size} evaluations, track id(s) {shown}"
 
 
-def plot_velocity(matches: np.ndarray, path: str | Path, gt_id: int | None = None, truth: np.ndarray | None = None,
-                  axis: str = "index", t_frame_us: float | None = None, title: str = "") -> int:
+def plot_velocity(
+    matches: np.ndarray,
+    path: str | Path,
+    gt_id: int | None = None,
+    truth: np.ndarray | None = None,
+    axis: str = "index",
+    t_frame_us: float | None = None,
+    title: str = "",
+) -> int:
     """Fig. 7: vy (top) and vx (bottom) of one object, px/frame. Returns the object id drawn."""
     path = check_plot_path(path)
     gt_id, rows = pick_object(matches, gt_id)
@@ -179,9 +188,16 @@ def _class_summary(rows: np.ndarray, palette: tuple[str, ...]) -> str:
     return f"; label {'/'.join(labels.tolist()) or '?'}, classified mostly '{top}', accuracy {100 * accuracy:.0f}%"
 
 
-def plot_colour(matches: np.ndarray, path: str | Path, gt_id: int | None = None, truth: np.ndarray | None = None,
-                axis: str = "index", t_frame_us: float | None = None, palette: tuple[str, ...] = (),
-                title: str = "") -> int:
+def plot_colour(
+    matches: np.ndarray,
+    path: str | Path,
+    gt_id: int | None = None,
+    truth: np.ndarray | None = None,
+    axis: str = "index",
+    t_frame_us: float | None = None,
+    palette: tuple[str, ...] = (),
+    title: str = "",
+) -> int:
     """Fig. 10: Y, Cb and Cr of one object; estimate green, ground truth blue. Returns the object id."""
     path = check_plot_path(path)
     gt_id, rows = pick_object(matches, gt_id)
@@ -238,8 +254,17 @@ def cluster_events(rows: np.ndarray, events: np.ndarray, tracks: np.ndarray, per
     return index, rec
 
 
-def plot_scatter(matches: np.ndarray, events: np.ndarray, ev_meta: EventMeta, tracks: np.ndarray, track_meta: TrackMeta,
-                 path: str | Path, gt_id: int | None = None, max_points: int = 40000, title: str = "") -> int:
+def plot_scatter(
+    matches: np.ndarray,
+    events: np.ndarray,
+    ev_meta: EventMeta,
+    tracks: np.ndarray,
+    track_meta: TrackMeta,
+    path: str | Path,
+    gt_id: int | None = None,
+    max_points: int = 40000,
+    title: str = "",
+) -> int:
     """Fig. 9: the colours of the events inside the matched cluster's box at its records.
 
     Panels: Cb–Cr and Y–Cb scatters, one point per event in its own colour, the palette entries
@@ -278,10 +303,24 @@ def plot_scatter(matches: np.ndarray, events: np.ndarray, ev_meta: EventMeta, tr
         ax.scatter(ycc[:, i], ycc[:, j], c=rgb, s=4, linewidths=0, alpha=0.6, rasterized=True)
         for k, name in enumerate(track_meta.palette[: len(entries)]):
             face = np.clip(ycbcr_to_rgb(entries[k]) / 255.0, 0, 1)
-            ax.scatter(entries[k, i], entries[k, j], s=110, c=[face], edgecolors="black", linewidths=1.2,
-                       marker="s" if name in background else "o", zorder=3)
-            ax.annotate(name + (" (bg)" if name in background else ""), (entries[k, i], entries[k, j]),
-                        xytext=(6, 5), textcoords="offset points", fontsize=8, zorder=4)
+            ax.scatter(
+                entries[k, i],
+                entries[k, j],
+                s=110,
+                c=[face],
+                edgecolors="black",
+                linewidths=1.2,
+                marker="s" if name in background else "o",
+                zorder=3,
+            )
+            ax.annotate(
+                name + (" (bg)" if name in background else ""),
+                (entries[k, i], entries[k, j]),
+                xytext=(6, 5),
+                textcoords="offset points",
+                fontsize=8,
+                zorder=4,
+            )
         ax.scatter(est[i], est[j], s=180, marker="*", c=EST_COLOUR, edgecolors="black", zorder=5, label="estimate (mean)")
         ax.scatter(gt[i], gt[j], s=120, marker="X", c=GT_COLOUR, edgecolors="black", zorder=5, label="ground truth (mean)")
         ax.set_xlim(0, 255)
@@ -303,17 +342,18 @@ def plot_scatter(matches: np.ndarray, events: np.ndarray, ev_meta: EventMeta, tr
             t = float(tracks["t_us"][r])
             lo, hi = np.searchsorted(t_ev, np.array([max(0, math.floor(t - period) + 1), math.floor(t) + 1], np.uint64))
             win = events[lo:hi]
-            sizes.append(int(((np.abs(win["x"] - tracks["x"][r]) <= tracks["rx"][r])
-                              & (np.abs(win["y"] - tracks["y"][r]) <= tracks["ry"][r])).sum()))
+            sizes.append(
+                int(((np.abs(win["x"] - tracks["x"][r]) <= tracks["rx"][r]) & (np.abs(win["y"] - tracks["y"][r]) <= tracks["ry"][r])).sum())
+            )
         r = int(recs[int(np.argmax(sizes))])
         # This record alone over the events of one frame period before it.
-        drawer = FrameDrawer(events, ev_meta, tracks[r: r + 1], track_meta, window_us=period, scale=scale, arrow_frames=2.0)
+        drawer = FrameDrawer(events, ev_meta, tracks[r : r + 1], track_meta, window_us=period, scale=scale, arrow_frames=2.0)
         frame = drawer.draw(float(tracks["t_us"][r]))
         pad = float(track_meta.seek_margin) + 4
         x0, y0 = to_canvas([tracks["x"][r] - tracks["rx"][r] - pad, tracks["y"][r] - tracks["ry"][r] - pad], scale)
         x1, y1 = to_canvas([tracks["x"][r] + tracks["rx"][r] + pad, tracks["y"][r] + tracks["ry"][r] + pad], scale)
         body_h = ev_meta.height * scale
-        crop = frame[max(0, y0): min(body_h, y1 + 1), max(0, x0): min(frame.shape[1], x1 + 1), ::-1]
+        crop = frame[max(0, y0) : min(body_h, y1 + 1), max(0, x0) : min(frame.shape[1], x1 + 1), ::-1]
         ax.imshow(crop, interpolation="nearest")
         ax.set_title(f"cluster {int(tracks['id'][r])} at t={int(tracks['t_us'][r]) / 1e6:.3f} s", fontsize=10)
     else:

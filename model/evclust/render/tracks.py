@@ -24,7 +24,7 @@ from tqdm import tqdm
 from evclust.colour import ycbcr_to_rgb
 from evclust.errors import EvclustError, atomic_output
 from evclust.events.format import EventMeta
-from evclust.tracks.record import RECORD_DTYPES, ObjectFlags, TrackMeta, read_tracks
+from evclust.tracks.record import RECORD_DTYPES, ObjectFlags, TrackMeta
 
 DEFAULT_FRAME_US = 33333.0
 PNG_SUFFIXES = (".png",)
@@ -194,8 +194,16 @@ def draw_tracks(canvas: np.ndarray, records: np.ndarray, meta: TrackMeta, scale:
 class FrameDrawer:
     """Draws frames at chosen times; slicing events and tracks by binary search on sorted time."""
 
-    def __init__(self, ev: np.ndarray, ev_meta: EventMeta, tracks: np.ndarray, track_meta: TrackMeta,
-                 window_us: float | None = None, scale: int = 2, arrow_frames: float = 5.0):
+    def __init__(
+        self,
+        ev: np.ndarray,
+        ev_meta: EventMeta,
+        tracks: np.ndarray,
+        track_meta: TrackMeta,
+        window_us: float | None = None,
+        scale: int = 2,
+        arrow_frames: float = 5.0,
+    ):
         if scale < 1 or scale > 16:
             raise EvclustError(f"scale {scale}: must be an integer from 1 to 16")
         if (ev_meta.width, ev_meta.height) != (track_meta.width, track_meta.height):
@@ -236,11 +244,19 @@ class FrameDrawer:
         body = canvas[: height - FOOTER_PX]  # a view: draw_tracks writes into the canvas
         draw_tracks(body, records, self.meta, k, self.arrow_frames)
         if self.meta.kind == "objects":
-            pieces = [(f"t={t_us / 1e6:.3f}s {win.size} ev {records.size} obj", TEXT), ("object (dashed: coasting)", OBJECT),
-                      (f"V (x{self.arrow_frames:g} frames)", V_INT)]
+            pieces = [
+                (f"t={t_us / 1e6:.3f}s {win.size} ev {records.size} obj", TEXT),
+                ("object (dashed: coasting)", OBJECT),
+                (f"V (x{self.arrow_frames:g} frames)", V_INT),
+            ]
         else:
-            pieces = [(f"t={t_us / 1e6:.3f}s {win.size} ev {records.size} tr", TEXT), ("box", BOX), ("seek", SEEK),
-                      ("Vmcm", V_MCM), (f"Vint (x{self.arrow_frames:g} frames)", V_INT)]
+            pieces = [
+                (f"t={t_us / 1e6:.3f}s {win.size} ev {records.size} tr", TEXT),
+                ("box", BOX),
+                ("seek", SEEK),
+                ("Vmcm", V_MCM),
+                (f"Vint (x{self.arrow_frames:g} frames)", V_INT),
+            ]
         x = 3
         for text, colour in pieces:  # as many as fit, in their own colours
             (tw, _), _ = cv2.getTextSize(text, cv2.FONT_HERSHEY_SIMPLEX, 0.35, 1)
@@ -256,9 +272,17 @@ def _check_suffix(path: Path, allowed: tuple[str, ...], what: str) -> None:
         raise EvclustError(f"{path}: a {what} must end in {' or '.join(allowed)}, not '{path.suffix or '(none)'}'")
 
 
-def render_png(ev: np.ndarray, ev_meta: EventMeta, tracks: np.ndarray, track_meta: TrackMeta, path: str | Path,
-               t_us: float | None = None, window_us: float | None = None, scale: int = 2,
-               arrow_frames: float = 5.0) -> float:
+def render_png(
+    ev: np.ndarray,
+    ev_meta: EventMeta,
+    tracks: np.ndarray,
+    track_meta: TrackMeta,
+    path: str | Path,
+    t_us: float | None = None,
+    window_us: float | None = None,
+    scale: int = 2,
+    arrow_frames: float = 5.0,
+) -> float:
     """Write one frame at t_us (default: the end of the busiest window) as a PNG; return its time."""
     path = Path(path)
     _check_suffix(path, PNG_SUFFIXES, "picture")
@@ -292,9 +316,19 @@ def frame_times(ev: np.ndarray, tracks: np.ndarray, period: float, t0_us: float 
     return t0 + period * np.arange(n)
 
 
-def render_video(ev: np.ndarray, ev_meta: EventMeta, tracks: np.ndarray, track_meta: TrackMeta, path: str | Path,
-                 t0_us: float | None = None, t1_us: float | None = None, window_us: float | None = None,
-                 scale: int = 2, arrow_frames: float = 5.0, progress: bool | None = None) -> int:
+def render_video(
+    ev: np.ndarray,
+    ev_meta: EventMeta,
+    tracks: np.ndarray,
+    track_meta: TrackMeta,
+    path: str | Path,
+    t0_us: float | None = None,
+    t1_us: float | None = None,
+    window_us: float | None = None,
+    scale: int = 2,
+    arrow_frames: float = 5.0,
+    progress: bool | None = None,
+) -> int:
     """Write an MP4 with one frame per frame period from t0 to t1; return the number of frames.
 
     progress: None shows a bar on a terminal only (tqdm's disable=None), False never, True always.

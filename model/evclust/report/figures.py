@@ -7,8 +7,8 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+import matplotlib.pyplot as plt
+import numpy as np
 
 
 def _save(fig, path: Path) -> None:
@@ -56,7 +56,7 @@ def error_vs_bits(curves: dict, defaults: dict, path: Path, title: str) -> None:
 def ranges(rows: list[tuple[str, float, float, float, float]], path: Path, title: str) -> None:
     """Per signal: the representable range (light) and the range seen (dark), on a symmetric log axis."""
     fig, ax = plt.subplots(figsize=(8, 0.45 * len(rows) + 1.2))
-    for i, (name, lo, hi, seen_lo, seen_hi) in enumerate(rows):
+    for i, (_name, lo, hi, seen_lo, seen_hi) in enumerate(rows):
         ax.barh(i, hi - lo, left=lo, color="#cfd8e3", height=0.7)
         ax.barh(i, max(seen_hi - seen_lo, 1e-9), left=seen_lo, color="#2b6cb0", height=0.4)
     ax.set_yticks(range(len(rows)), [r[0] for r in rows])

@@ -86,7 +86,9 @@ class SynthesisQueue:
             except queue.Empty:
                 return
             try:
-                self.results[label] = self._synthesise(header, label, heartbeat=self._heartbeat, snapshot=self._snapshot, on_start=self._processes.append)
+                self.results[label] = self._synthesise(
+                    header, label, heartbeat=self._heartbeat, snapshot=self._snapshot, on_start=self._processes.append
+                )
             except Exception as exc:  # reported in its row as a failure; the queue goes on
                 self.results[label] = exc
 

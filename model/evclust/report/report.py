@@ -65,7 +65,8 @@ def budget_section(name: str, result: dict, img: Path) -> list[str]:
         "",
         f"{result['reference_records']:,} float records; errors over the records both runs emit at the same filter step "
         "for the same object. Max |e| in LSBs of the output's own format "
-        + ", ".join(f"{g}: {result['table'][fmt].q}" for g, (_, fmt) in OUTPUTS.items()) + ".",
+        + ", ".join(f"{g}: {result['table'][fmt].q}" for g, (_, fmt) in OUTPUTS.items())
+        + ".",
         "",
         "| source | " + " | ".join(f"{g}: max LSB / RMS / bias / SQNR dB / share" for g in groups) + " |",
         "|---|" + "---|" * len(groups),
@@ -83,7 +84,8 @@ def budget_section(name: str, result: dict, img: Path) -> list[str]:
     lines += [
         "",
         "Sum of the sources' noise powers over the all-together power (1 when the sources add up independently): "
-        + ", ".join(f"{g} {_fmt(r, 3)} ({10 * math.log10(r):+.1f} dB)" if r > 0 else f"{g} n/a" for g, r in ratios.items()) + ".",
+        + ", ".join(f"{g} {_fmt(r, 3)} ({10 * math.log10(r):+.1f} dB)" if r > 0 else f"{g} n/a" for g, r in ratios.items())
+        + ".",
         "",
         f"![{name}: shares of the noise power]({img.name}/budget_{name}.png)",
         "",
@@ -122,7 +124,14 @@ def ranges_section(name: str, meta, events, params) -> tuple[list[str], list]:
         fmt = model.table[SIGNAL_FORMATS[signal]]
         rows.append(f"| {signal} | {fmt.q} | {fmt.min:g} .. {fmt.max:g} | {lo:.6g} .. {hi:.6g} | {saturations} |")
         plot_rows.append((signal, fmt.min, fmt.max, lo, hi))
-    lines = [f"### {name}", "", "| signal | format | representable | seen (before saturation) | saturations |", "|---|---|---|---|---:|", *rows, ""]
+    lines = [
+        f"### {name}",
+        "",
+        "| signal | format | representable | seen (before saturation) | saturations |",
+        "|---|---|---|---|---:|",
+        *rows,
+        "",
+    ]
     return lines, plot_rows
 
 
@@ -178,11 +187,14 @@ def wordlength_section(name: str, meta, events, params, truth, tick) -> list[str
     formats = build_formats(params, meta.width, meta.height, params.t_frame_us or meta.t_frame_us)
     lines = [f"### {name}", ""]
     if not w.defaults_within:
-        lines += ["The default formats themselves are not within 1 % of float on every task metric here; the search starts from them anyway.", ""]
+        lines += [
+            "The default formats themselves are not within 1 % of float on every task metric here; the search starts from them anyway.",
+            "",
+        ]
     lines += ["| signal | default | recommended | bits saved |", "|---|---|---|---:|"]
     for signal, (old, new) in w.word_bits.items():
         fmt = formats[signal]
-        q = lambda frac: f"{'S' if fmt.signed else 'U'}Q{fmt.int_bits}.{frac}"  # noqa: E731
+        q = lambda frac, fmt=fmt: f"{'S' if fmt.signed else 'U'}Q{fmt.int_bits}.{frac}"
         lines.append(f"| {signal} | {fmt.q} | {q(w.recommended[signal])} | {old - new} |")
     total_old = sum(o for o, _ in w.word_bits.values())
     total_new = sum(n for _, n in w.word_bits.values())
@@ -207,9 +219,16 @@ def velocity_section(img: Path, quick: bool, tick) -> list[str]:
         "| method | α | steady-state NRMSE | frames to converge |",
         "|---|---:|---:|---:|",
     ]
-    lines += [f"| {p.method} | {p.alpha:g} | {_pct(p.steady_nrmse)} | {_num(p.convergence_frames, 1) if p.convergence_frames is not None else 'never'} |" for p in points]
-    lines += ["", "With γ global the MCM gain is the preset's constant, not this scene's events per frame: the estimate "
-              "is off by the ratio of the two whatever the smoothing, which is why the paper's constant γ needs tuning per scene.", ""]
+    lines += [
+        f"| {p.method} | {p.alpha:g} | {_pct(p.steady_nrmse)} | {_num(p.convergence_frames, 1) if p.convergence_frames is not None else 'never'} |"
+        for p in points
+    ]
+    lines += [
+        "",
+        "With γ global the MCM gain is the preset's constant, not this scene's events per frame: the estimate "
+        "is off by the ratio of the two whatever the smoothing, which is why the paper's constant γ needs tuning per scene.",
+        "",
+    ]
     return lines
 
 
@@ -273,7 +292,9 @@ def runtime_section(scenes: dict, rtl: dict, img: Path, yosys_running: bool) -> 
         "|---|---|---:|---:|---:|---:|---:|",
     ]
     for name, model, count, ns, s in rows:
-        lines.append(f"| {name} | {model} | {count:,} | {ns:,.0f} | {_pct(best_velocity_nrmse(s))} | {_pct(s['chrominance']['nrmse'])} | {_num(s['position_rmse_px'])} |")
+        lines.append(
+            f"| {name} | {model} | {count:,} | {ns:,.0f} | {_pct(best_velocity_nrmse(s))} | {_pct(s['chrominance']['nrmse'])} | {_num(s['position_rmse_px'])} |"
+        )
         if name == first:
             points.append((model, ns, _pct(best_velocity_nrmse(s))))
     figures.runtime_bars([p[0] for p in points], [p[1] for p in points], [p[2] for p in points], img / f"runtime_{first}.png",
@@ -375,7 +396,7 @@ def write_report(out: Path, quick: bool = False, progress: bool = True) -> Path:
     scenes = {name: _scene(name, quick) for name in SCENES}
     first_meta, first_events, first_params, _, _ = scenes[SCENES[0]]
     # Yosys takes minutes per configuration: it starts now, beside the model runs.
-    beat = lambda seconds, step: bar.set_postfix_str(f"yosys {seconds / 60:.0f} min")  # noqa: E731
+    beat = lambda seconds, step: bar.set_postfix_str(f"yosys {seconds / 60:.0f} min")
     synthesis = None if quick else start_synthesis(first_params, first_meta, heartbeat=beat)
     bar.update(1)
     budget_lines, range_lines, task_lines, word_lines = [], [], [], []
@@ -419,7 +440,7 @@ def write_report(out: Path, quick: bool = False, progress: bool = True) -> Path:
         "# evclust report",
         "",
         f"Generated by `evclust report{' --quick' if quick else ''}` (`make report`) on "
-        f"{datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d}, {mode}. Every figure is a run of this command; "
+        f"{datetime.datetime.now(datetime.UTC):%Y-%m-%d}, {mode}. Every figure is a run of this command; "
         "the scenes are the built-in ones with their fixed seeds and presets.",
         "",
         "## Fixed-point error budget",

@@ -29,6 +29,8 @@ PAPER = {
         "ycbcr": (25.9, 0.11), "luminance": (25.7, 0.175), "chrominance": (3.4, 0.02), "classes": (0.792, 0.923),
     },
 }  # fmt: skip
+
+
 # Issue 3's targets: (label, how to read it from a score dict, limit, lower is better).
 def _better(*values):
     known = [v for v in values if v is not None]
@@ -159,8 +161,14 @@ def agreement_table(prepared: list[PreparedScene]) -> list[str]:
             _, a, b, rel = results[n]["rows"][k]
             cells.append("n/a" if rel is None else f"{a:.4g} / {b:.4g} / {100 * rel:.2f} %")
         lines.append(f"| {label} | " + " | ".join(cells) + " |")
-    lines.append("| filter steps reporting the same objects | " + " | ".join(f"{100 * results[n]['same_steps']:.2f} %" for n in names) + " |")
-    lines.append("| centre difference, median / max (px) | " + " | ".join(f"{_num(results[n]['centre_median'], 4)} / {_num(results[n]['centre_max'], 4)}" for n in names) + " |")
+    lines.append(
+        "| filter steps reporting the same objects | " + " | ".join(f"{100 * results[n]['same_steps']:.2f} %" for n in names) + " |"
+    )
+    lines.append(
+        "| centre difference, median / max (px) | "
+        + " | ".join(f"{_num(results[n]['centre_median'], 4)} / {_num(results[n]['centre_max'], 4)}" for n in names)
+        + " |"
+    )
     lines.append("| saturations in the fixed model | " + " | ".join(str(results[n]["saturations"] or "none") for n in names) + " |")
     lines.append("")
     return lines
@@ -178,7 +186,7 @@ class SceneResult:
     steady: dict  # velocity NRMSE where the true velocity has not changed for a second, per method
     per_label: dict  # palette accuracy per ground-truth label: (correct, evaluations)
     kind: str = "clusters"  # what the output's records are
-    clusters: "SceneResult | None" = None  # the cluster records' result, when the output is objects
+    clusters: SceneResult | None = None  # the cluster records' result, when the output is objects
 
 
 def steady_velocity(matches, truth, frames_back: int) -> dict:
@@ -218,8 +226,18 @@ def scene_results(p: PreparedScene, figures: Path | None = None) -> SceneResult:
         matches, counts = match_with_counts(records, meta, truth)
         if draw and figures is not None:
             figures.mkdir(parents=True, exist_ok=True)
-            plot_velocity(matches, figures / f"results_{name}_velocity.png", truth=truth, axis="time", t_frame_us=meta.t_frame_us, title=name)
-            plot_colour(matches, figures / f"results_{name}_colour.png", truth=truth, axis="time", t_frame_us=meta.t_frame_us, palette=meta.palette, title=name)
+            plot_velocity(
+                matches, figures / f"results_{name}_velocity.png", truth=truth, axis="time", t_frame_us=meta.t_frame_us, title=name
+            )
+            plot_colour(
+                matches,
+                figures / f"results_{name}_colour.png",
+                truth=truth,
+                axis="time",
+                t_frame_us=meta.t_frame_us,
+                palette=meta.palette,
+                title=name,
+            )
         visible, visible_counts = match_with_counts(records, meta, truth, fully_visible_only=True)
         return SceneResult(
             name, sim.events.size, records.size, origin,
@@ -265,7 +283,11 @@ def scene_table(r: SceneResult) -> list[str]:
         f"{r.events:,} events, {r.records:,} {r.kind[:-1]} records"
         + (f" ({r.clusters.records:,} cluster records)" if r.clusters is not None else "")
         + f", parameters from {r.params_origin}; {r.stats['created']} clusters created, {r.stats['exited']} freed by exit prediction"
-        + (f"; {r.stats['objects_confirmed']} objects confirmed of {r.stats['objects_created']} created." if "objects_created" in r.stats else "."),
+        + (
+            f"; {r.stats['objects_confirmed']} objects confirmed of {r.stats['objects_created']} created."
+            if "objects_created" in r.stats
+            else "."
+        ),
         "",
         f"| measure | {head} | paper |",
         "|---|" + "---:|" * len(columns) + "---:|",
@@ -278,33 +300,65 @@ def scene_table(r: SceneResult) -> list[str]:
         lines += [
             row(f"{label} velocity RMSE (px/frame)", lambda d, m=method: d[m]["rmse"], _num, paper[0] if paper else "", kinds),
             row(f"{label} velocity NRMSE", lambda d, m=method: d[m]["nrmse"], _pct, _pct(paper[1]) if paper else "", kinds),
-            row(f"{label} angular error (°)", lambda d, m=method: d[m]["angular_deg"], lambda v: _num(v, 1), paper[2] if paper else "", kinds),
+            row(
+                f"{label} angular error (°)",
+                lambda d, m=method: d[m]["angular_deg"],
+                lambda v: _num(v, 1),
+                paper[2] if paper else "",
+                kinds,
+            ),
         ]
     lines += [
         row("position RMSE (px)", lambda d: d["position_rmse_px"], _num, p and p["position"]),
-        row("YCbCr RMSE / NRMSE", lambda d: (d["ycbcr"]["rmse"], d["ycbcr"]["nrmse"]), lambda v: f"{_num(v[0], 1)} / {_pct(v[1])}", p and f"{p['ycbcr'][0]} / {_pct(p['ycbcr'][1])}"),
-        row("luminance RMSE / NRMSE", lambda d: (d["luminance"]["rmse"], d["luminance"]["nrmse"]), lambda v: f"{_num(v[0], 1)} / {_pct(v[1])}", p and f"{p['luminance'][0]} / {_pct(p['luminance'][1])}"),
-        row("chrominance RMSE / NRMSE", lambda d: (d["chrominance"]["rmse"], d["chrominance"]["nrmse"]), lambda v: f"{_num(v[0], 1)} / {_pct(v[1])}", p and f"{p['chrominance'][0]} / {_pct(p['chrominance'][1])}"),
-        row("classification direct / palette", lambda d: (d["class_direct_accuracy"], d["class_palette_accuracy"]), lambda v: f"{_pct(v[0])} / {_pct(v[1])}", p and f"{_pct(p['classes'][0])} / {_pct(p['classes'][1])}"),
+        row(
+            "YCbCr RMSE / NRMSE",
+            lambda d: (d["ycbcr"]["rmse"], d["ycbcr"]["nrmse"]),
+            lambda v: f"{_num(v[0], 1)} / {_pct(v[1])}",
+            p and f"{p['ycbcr'][0]} / {_pct(p['ycbcr'][1])}",
+        ),
+        row(
+            "luminance RMSE / NRMSE",
+            lambda d: (d["luminance"]["rmse"], d["luminance"]["nrmse"]),
+            lambda v: f"{_num(v[0], 1)} / {_pct(v[1])}",
+            p and f"{p['luminance'][0]} / {_pct(p['luminance'][1])}",
+        ),
+        row(
+            "chrominance RMSE / NRMSE",
+            lambda d: (d["chrominance"]["rmse"], d["chrominance"]["nrmse"]),
+            lambda v: f"{_num(v[0], 1)} / {_pct(v[1])}",
+            p and f"{p['chrominance'][0]} / {_pct(p['chrominance'][1])}",
+        ),
+        row(
+            "classification direct / palette",
+            lambda d: (d["class_direct_accuracy"], d["class_palette_accuracy"]),
+            lambda v: f"{_pct(v[0])} / {_pct(v[1])}",
+            p and f"{_pct(p['classes'][0])} / {_pct(p['classes'][1])}",
+        ),
         row("recall / precision", lambda d: (d["recall"], d["precision"]), lambda v: f"{_pct(v[0])} / {_pct(v[1])}", "not reported"),
         row("identity switches", lambda d: d["id_switches"], str, "not reported"),
         row("tracks per object", lambda d: d["tracks_per_object"], _num, "not reported"),
         "",
         "Velocity NRMSE in steady state (the object moves and had the same velocity one second earlier): "
-        + "; ".join(f"{level.kind} {level.steady['evaluations']:,} of {level.steady['of']:,} evaluations, "
-                    + ", ".join(f"{METHOD_LABELS[m]} {_pct(level.steady[m])}" for m in ('object', 'mcm', 'interval') if m in level.steady)
-                    for level in levels)
+        + "; ".join(
+            f"{level.kind} {level.steady['evaluations']:,} of {level.steady['of']:,} evaluations, "
+            + ", ".join(f"{METHOD_LABELS[m]} {_pct(level.steady[m])}" for m in ("object", "mcm", "interval") if m in level.steady)
+            for level in levels
+        )
         + ".",
         "",
         f"Palette classification per ground-truth label ({r.kind}): "
-        + ", ".join(f"{label} {_pct(c / n)} ({n:,})" for label, (c, n) in r.per_label.items()) + ".",
+        + ", ".join(f"{label} {_pct(c / n)} ({n:,})" for label, (c, n) in r.per_label.items())
+        + ".",
         "",
     ]
     return lines
 
 
 def target_table(results: list[SceneResult]) -> list[str]:
-    lines = ["| target | limit | " + " | ".join(f"{r.name} (all / fully visible)" for r in results) + " |", "|---|---:|" + "---:|" * len(results)]
+    lines = [
+        "| target | limit | " + " | ".join(f"{r.name} (all / fully visible)" for r in results) + " |",
+        "|---|---:|" + "---:|" * len(results),
+    ]
     for label, get, limit, lower in TARGETS:
         cells = []
         for r in results:

@@ -111,7 +111,7 @@ class RtlClusterer:
             rows[:, 0] = latest - ((latest - low) & 0xFFFFFFFF)
         return rows
 
-    def object_layer(self) -> "RtlObjects":
+    def object_layer(self) -> RtlObjects:
         """The object unit's records of each batch, as the other models' object layers give theirs."""
         return RtlObjects(self)
 

@@ -9,7 +9,24 @@ from evclust.errors import EvclustError
 REPO = Path(__file__).resolve().parents[3]
 RTL_DIR = REPO / "rtl"
 TB_DIR = REPO / "tb" / "evclust_core"
-RTL_SOURCES = ("evclust_axis.v", "evclust_core.v", "evclust_objects.v", "evclust_regs.v", "evclust_decay.v", "evclust_palette.v", "evclust_udiv.v", "evclust_top2.v", "evclust_pipediv.v", "evclust_slot_ram.v", "evclust_seek_key.v", "evclust_seek.v", "evclust_merge_search.v", "evclust_update.v", "evclust_commit.v", "evclust_stage_reg.v")
+RTL_SOURCES = (
+    "evclust_axis.v",
+    "evclust_core.v",
+    "evclust_objects.v",
+    "evclust_regs.v",
+    "evclust_decay.v",
+    "evclust_palette.v",
+    "evclust_udiv.v",
+    "evclust_top2.v",
+    "evclust_pipediv.v",
+    "evclust_slot_ram.v",
+    "evclust_seek_key.v",
+    "evclust_seek.v",
+    "evclust_merge_search.v",
+    "evclust_update.v",
+    "evclust_commit.v",
+    "evclust_stage_reg.v",
+)
 RTL_INCLUDES = ("evclust_arith.vh", "evclust_increments.vh", "evclust_require.vh")
 BUILD = REPO / "build"
 

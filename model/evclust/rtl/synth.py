@@ -72,6 +72,7 @@ def yowasp_command(tool: str) -> list[str]:
     """A yowasp tool ("yosys", "nextpnr-ecp5") in this Python, through the big-stack launcher."""
     return [sys.executable, "-c", BIG_STACK_LAUNCHER, tool]
 
+
 LUTS = [f"LUT{i}" for i in range(1, 7)]
 FFS = ["FDRE", "FDSE", "FDCE", "FDPE"]
 # LUTRAM and SRL cells with the 6-input LUTs each occupies.
@@ -107,17 +108,20 @@ def script(src: Path, out: Path, hier: bool, top: str = TOP, static: bool = Fals
     regdsp = " ".join(f"r:{reg}>0" for reg in ["AREG", "BREG", "CREG", "DREG", "ADREG", "MREG", "PREG"])
     comb = "* t:FD* %d t:RAM* %d t:SRL* %d @regdsp %d"
     reads = " ".join(str(src / f) for f in RTL_SOURCES)
-    lines = ABC9_KNOBS + [
-        # -defer: each module is elaborated with the parameters it is instantiated with, not with
-        # its defaults first (those need not match this header, and a mismatch stops elaboration).
-        f"read_verilog -defer -I{src} {reads}",
-        *([f"chparam -set RUNTIME_CONFIG 0 {top}"] if static else []),  # the header's constants built in
-        f"hierarchy -top {top}",  # (hierarchy -chparam on deferred modules trips an assertion in Yosys 0.4x)  # the header's constants built in
-        f"{SYNTH.format(top=top)}{'' if hier else ' -flatten'}",
-        f"tee -o {out / 'stat.json'} stat -json -tech xilinx",
-        f"tee -o {out / 'stat.txt'} stat -tech xilinx",  # per module when hier
-        f"write_rtlil {out / 'netlist.il'}",  # for later questions (src attributes survive on DSPs)
-    ]
+    lines = (
+        ABC9_KNOBS
+        + [
+            # -defer: each module is elaborated with the parameters it is instantiated with, not with
+            # its defaults first (those need not match this header, and a mismatch stops elaboration).
+            f"read_verilog -defer -I{src} {reads}",
+            *([f"chparam -set RUNTIME_CONFIG 0 {top}"] if static else []),  # the header's constants built in
+            f"hierarchy -top {top}",  # (hierarchy -chparam on deferred modules trips an assertion in Yosys 0.4x)  # the header's constants built in
+            f"{SYNTH.format(top=top)}{'' if hier else ' -flatten'}",
+            f"tee -o {out / 'stat.json'} stat -json -tech xilinx",
+            f"tee -o {out / 'stat.txt'} stat -tech xilinx",  # per module when hier
+            f"write_rtlil {out / 'netlist.il'}",  # for later questions (src attributes survive on DSPs)
+        ]
+    )
     if hier:
         lines.append("flatten")
     lines += [
@@ -132,14 +136,18 @@ def script(src: Path, out: Path, hier: bool, top: str = TOP, static: bool = Fals
 def rtl_version() -> str | None:
     """The last commit touching rtl/, "+dirty" when rtl/ has uncommitted changes."""
     try:
-        git = lambda *a: subprocess.run(["git", *a], cwd=REPO, capture_output=True, text=True, check=True).stdout.strip()  # noqa: E731
+        git = lambda *a: subprocess.run(["git", *a], cwd=REPO, capture_output=True, text=True, check=True).stdout.strip()
         return git("log", "-1", "--format=%h", "--", "rtl") + ("+dirty" if git("status", "--porcelain", "--", "rtl") else "")
     except (OSError, subprocess.CalledProcessError):
         return None
 
 
 def last_step(log: Path) -> str:
-    steps = [line for line in log.read_text(errors="replace").splitlines() if line[:1].isdigit() and "Executing" in line] if log.exists() else []
+    steps = (
+        [line for line in log.read_text(errors="replace").splitlines() if line[:1].isdigit() and "Executing" in line]
+        if log.exists()
+        else []
+    )
     return steps[-1].strip() if steps else "starting"
 
 
@@ -182,8 +190,12 @@ def _figures(out: Path, wall: float, hier: bool, top: str = TOP) -> dict:
         "muxf7": c.get("MUXF7", 0),
         "muxf8": c.get("MUXF8", 0),
         "depth_cells": depth,
-        "depth_by_type": {"lut": path_luts, "carry4": path.get("CARRY4", 0), "dsp48e1": path.get("DSP48E1", 0),
-                          "other": sum(path.values()) - path_luts - path.get("CARRY4", 0) - path.get("DSP48E1", 0)},  # fmt: skip
+        "depth_by_type": {
+            "lut": path_luts,
+            "carry4": path.get("CARRY4", 0),
+            "dsp48e1": path.get("DSP48E1", 0),
+            "other": sum(path.values()) - path_luts - path.get("CARRY4", 0) - path.get("DSP48E1", 0),
+        },  # fmt: skip
         "wall_s": round(wall, 1),
         "cells_by_type": dict(sorted(c.items())),
         "flow": SYNTH.format(top=top) + ("; flatten" if hier else " -flatten"),

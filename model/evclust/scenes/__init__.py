@@ -13,7 +13,7 @@ from evclust.errors import EvclustError, read_text, validation_message
 from evclust.scenes.schema import SceneSpec, SensorSpec
 from evclust.scenes.synthetic import TRUTH_COLUMNS, SyntheticSource
 from evclust.scenes.truth import write_truth
-from evclust.scenes.video import IMAGE_SUFFIXES, VideoSource
+from evclust.scenes.video import VideoSource
 
 __all__ = ["Scene", "SceneSpec", "SensorSpec", "load_scene", "scene_from_toml", "builtin_scenes", "write_truth", "TRUTH_COLUMNS"]
 

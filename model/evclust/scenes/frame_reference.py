@@ -130,7 +130,9 @@ def _rows(k, t_frame_us, rgb, blobs, flow, identities, source, palette_label) ->
         ycc = rgb[blob].astype(np.float64).mean(axis=0) @ RGB_TO_YCBCR[:, :3].T + RGB_TO_YCBCR[:, 3]
         centres.append((cx, cy))
         predicted.append((cx + vx, cy + vy))
-        found.append((cx, cy, x1 - x0 + 1, y1 - y0 + 1, vx, vy, ycc, x0 > 0 and y0 > 0 and x1 < source.width - 1 and y1 < source.height - 1))
+        found.append(
+            (cx, cy, x1 - x0 + 1, y1 - y0 + 1, vx, vy, ycc, x0 > 0 and y0 > 0 and x1 < source.width - 1 and y1 < source.height - 1)
+        )
     ids = identities.assign(np.array(centres, dtype=np.float64).reshape(-1, 2), np.array(predicted).reshape(-1, 2))
     out = []
     for ident, (cx, cy, w, h, vx, vy, ycc, inside) in zip(ids, found):

@@ -22,7 +22,6 @@ import cv2
 import numpy as np
 import tomli_w
 
-from evclust.choices import SPLITS
 from evclust.clusterer.params import DEFAULT_PALETTE
 from evclust.colour import rgb_to_ycbcr
 from evclust.errors import EvclustError, atomic_output

@@ -108,7 +108,7 @@ class SceneSpec(Strict):
         if self.video is None:
             missing = [k for k in ("width", "height", "fps", "frames") if getattr(self, k) is None]
             if missing:
-                raise ValueError(f"a synthetic scene needs {', '.join(missing)} (or video = \"path\")")
+                raise ValueError(f'a synthetic scene needs {", ".join(missing)} (or video = "path")')
             ids = [o.id for o in self.objects]
             if len(ids) != len(set(ids)):
                 raise ValueError("object ids must be unique")

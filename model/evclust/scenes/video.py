@@ -63,7 +63,9 @@ class VideoSource:
             first = cv2.cvtColor(first, cv2.COLOR_BGR2RGB)
         self.height, self.width = first.shape[:2]
         if max(self.width, self.height) > MAX_SENSOR_SIDE:  # x and y are 16-bit: wider would wrap
-            raise EvclustError(f"{self.path}: {self.width}x{self.height} frames; event coordinates hold at most {MAX_SENSOR_SIDE} px a side")
+            raise EvclustError(
+                f"{self.path}: {self.width}x{self.height} frames; event coordinates hold at most {MAX_SENSOR_SIDE} px a side"
+            )
         try:
             limits.check("SENSOR_PIXELS", self.width * self.height, f"{self.width}x{self.height} frames' pixels")
         except EvclustError as exc:
@@ -84,9 +86,7 @@ class VideoSource:
 
     def _check_size(self, frame: np.ndarray, k: int) -> np.ndarray:
         if frame.shape[:2] != (self.height, self.width):
-            raise EvclustError(
-                f"{self.path}: frame {k} is {frame.shape[1]}x{frame.shape[0]}, the first was {self.width}x{self.height}"
-            )
+            raise EvclustError(f"{self.path}: frame {k} is {frame.shape[1]}x{frame.shape[0]}, the first was {self.width}x{self.height}")
         return frame.astype(np.float32)
 
     def frames(self):

@@ -7,7 +7,17 @@ from evclust.scenes import Scene
 from evclust.simulator.effects import EFFECTS, SensorGeometry, build_effects
 from evclust.simulator.pipeline import Simulation, SimulationStream, Simulator
 
-__all__ = ["EFFECTS", "Simulation", "SimulationStream", "Simulator", "stream_scene", "SensorGeometry", "build_effects", "make_simulator", "simulate_scene"]
+__all__ = [
+    "EFFECTS",
+    "Simulation",
+    "SimulationStream",
+    "Simulator",
+    "stream_scene",
+    "SensorGeometry",
+    "build_effects",
+    "make_simulator",
+    "simulate_scene",
+]
 
 
 def make_simulator(scene: Scene, seed: int | None = None) -> Simulator:

@@ -105,6 +105,10 @@ class EventBuffer:
         by emission index (= y, then x: parts are in row order and their keys carry the offset).
 
         The keys are unique, so a plain (SIMD) sort of them gives the permutation."""
-        keys = self.keys[parts[0][0] : parts[0][0] + parts[0][1]] if len(parts) == 1 else np.concatenate([self.keys[o : o + n] for o, n in parts])
+        keys = (
+            self.keys[parts[0][0] : parts[0][0] + parts[0][1]]
+            if len(parts) == 1
+            else np.concatenate([self.keys[o : o + n] for o, n in parts])
+        )
         order = np.sort(keys) & np.uint64(0xFFFFFFFF)
         return self.words.view(EVENT_DTYPE)[order.astype(np.intp)]

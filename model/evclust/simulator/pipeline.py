@@ -8,7 +8,7 @@ import queue
 import threading
 import time
 from concurrent.futures import ThreadPoolExecutor
-from typing import Iterable
+from collections.abc import Iterable
 
 import numpy as np
 from tqdm import tqdm
@@ -48,10 +48,7 @@ class Simulation:
     def summary(self) -> str:
         n = self.n_events
         rate = n / self.scene_s if self.scene_s > 0 else 0.0
-        return (
-            f"{self.meta.source}: {self.frames} frames, {n} events, "
-            f"{rate:.4g} events/s of scene time, wall time {self.wall_s:.2f} s"
-        )
+        return f"{self.meta.source}: {self.frames} frames, {n} events, {rate:.4g} events/s of scene time, wall time {self.wall_s:.2f} s"
 
 
 def _stage(effects: list[Effect], stage: str) -> list[Effect]:
@@ -90,7 +87,7 @@ class Simulator:
         self.observer = observers[0] if observers else None
         transfer = _stage(self.effects, "transfer")
         if transfer and sensor.detector != "log":
-            raise EvclustError(f"effects.{transfer[0].name}: it bends the log detector's curve; set sensor.detector = \"log\"")
+            raise EvclustError(f'effects.{transfer[0].name}: it bends the log detector\'s curve; set sensor.detector = "log"')
         self.transfer = transfer[0] if transfer else None
         self.photoreceptor = _stage(self.effects, "photoreceptor")
         self.interval_effects = _stage(self.effects, "interval")
@@ -194,7 +191,7 @@ class Simulator:
         total: int | None = None,
         progress: bool = False,
         frame_period_us: float | None = None,
-    ) -> "SimulationStream":
+    ) -> SimulationStream:
         """Simulate the sensor over `frames`, sampled every geometry.t_sample_us, yielding the
         events interval by interval (iterate the returned stream; its `meta` is known at once).
         `frame_period_us` is the scene's frame period recorded in the metadata (velocities are per

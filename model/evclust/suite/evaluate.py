@@ -32,7 +32,7 @@ class SceneResult:
     meta: object  # the track file's TrackMeta (palette, colour)
     frames: np.ndarray  # the frame of each sample
     failures: np.ndarray  # per sample, unmatched objects and records by kind (tracking.FAILURES)
-    clusters: "SceneResult | None" = None  # the cluster records' result, when these are object records
+    clusters: SceneResult | None = None  # the cluster records' result, when these are object records
 
     @property
     def recall(self) -> float | None:

@@ -91,7 +91,7 @@ def write_page(by_split: dict, out: Path, command: str, machine: str, scenes: di
         "some cycles later. With `update_delay = D` the models say what such a core computes: event n reads the table with "
         "the updates of events up to n − D − 1 committed (a creation at once), each update is a set of increments computed "
         "from the state it read, and the increments are added, in event order, to the slot as it then is (delayed LMS). "
-        "A filter step first commits everything in flight. docs/DESIGN.md, \"Pipeline semantics\", gives the rules; "
+        'A filter step first commits everything in flight. docs/DESIGN.md, "Pipeline semantics", gives the rules; '
         "D = 0 is the paper's sequential update, bit for bit.",
         "",
         "Each row compares the float model at D against D = 0 on the defaults and on five perturbations of them "

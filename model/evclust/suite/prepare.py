@@ -17,7 +17,8 @@ from evclust import __version__
 from evclust.errors import EvclustError, atomic_output
 from evclust.events import write_events
 from evclust.scenes import load_scene, write_truth
-from evclust.scenes.generate import SPLITS, GeneratedScene, generate_scene, scene_name, write_scene
+from evclust.choices import SPLITS
+from evclust.scenes.generate import GeneratedScene, generate_scene, scene_name, write_scene
 from evclust.simulator import simulate_scene
 
 

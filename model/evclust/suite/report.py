@@ -9,8 +9,16 @@ import time
 from pathlib import Path
 
 from evclust.clusterer import ClustererParams, load_params
-from evclust.scenes.generate import SPLITS
-from evclust.suite.aggregate import SCENE_CATEGORIES, SLOW_PX_PER_FRAME, SMALL_PX, VELOCITY_METHOD_NAMES, best_velocity, by_category, figures
+from evclust.choices import SPLITS
+from evclust.suite.aggregate import (
+    SCENE_CATEGORIES,
+    SLOW_PX_PER_FRAME,
+    SMALL_PX,
+    VELOCITY_METHOD_NAMES,
+    best_velocity,
+    by_category,
+    figures,
+)
 from evclust.suite.evaluate import evaluate_scene
 from evclust.suite.figures import failure_grid
 from evclust.suite.prepare import SceneFiles, prepare_scene
@@ -63,9 +71,11 @@ def ablation_configurations() -> list[Configuration]:
         "no object layer": {"objects": False},
     }
     paper, _ = load_params("paper")
-    return [Configuration("default", d, "float")] + [Configuration(n, d.model_copy(update=u), "float") for n, u in off.items()] + [
-        Configuration("paper", paper, "float")
-    ]
+    return (
+        [Configuration("default", d, "float")]
+        + [Configuration(n, d.model_copy(update=u), "float") for n, u in off.items()]
+        + [Configuration("paper", paper, "float")]
+    )
 
 
 _best = best_velocity
@@ -178,9 +188,13 @@ def _scene_table(run: SuiteRun) -> list[str]:
 
 def _targets_table(run: SuiteRun) -> list[str]:
     f = _best(figures(run.results))
-    lines = ["Steady state: the object moves and had the same velocity one second earlier "
-             f"({_pct(f.get('steady_share'))} of the moving evaluations).", "",
-             "| target | wanted | measured | met |", "|---|---|---|---|"]
+    lines = [
+        "Steady state: the object moves and had the same velocity one second earlier "
+        f"({_pct(f.get('steady_share'))} of the moving evaluations).",
+        "",
+        "| target | wanted | measured | met |",
+        "|---|---|---|---|",
+    ]
     for key, op, want, label in TARGETS:
         got = f.get(key)
         met = got is not None and (got >= want if op == ">=" else got <= want)
@@ -229,7 +243,7 @@ def write_report(runs: list[SuiteRun], folder: Path, out: Path, split: str, seed
                  picture: Path | None, categories_of=None, title: str = "Generalization") -> str:  # fmt: skip
     """The page. `categories_of`: the configurations whose category tables are given (default: all)."""
     default = next(r for r in runs if r.configuration.name == "default" and r.configuration.model == "float")
-    files_of = lambda name: SceneFiles(name, folder)  # noqa: E731
+    files_of = lambda name: SceneFiles(name, folder)
     panels = failure_grid(default.results, files_of, default.configuration.params, picture) if picture else []
     n_events = sum(r.events for r in default.results)
     n_objects = sum(len(r.facts["objects"]) for r in default.results)
@@ -249,12 +263,11 @@ def write_report(runs: list[SuiteRun], folder: Path, out: Path, split: str, seed
         f"{n_objects} objects, {n_events:,} events. Every scene is drawn from its seed by `evclust scenes --generate SEED` "
         "(object size 8–150 px, speed 0.1–12 px/frame, 1–20 objects, uniform and textured objects on uniform, textured "
         "and gradient backgrounds, turns, crossings, occlusions, entries and exits, 10–60 fps, 160×120 to 1280×720; even "
-        "seeds through the MPEG-4 codec and back, a third with sensor noise). "
-        + held_out,
+        "seeds through the MPEG-4 codec and back, a third with sensor noise). " + held_out,
         "",
         "Figures are pooled over the split (sums of counts, not means of per-scene ratios), with the tracker sampled once "
         "per frame and objects matched at similarity ≥ 0.5 (a record within a quarter of the object's half-diagonal). "
-        "Definitions: docs/METRICS.md, \"Tracking metrics\".",
+        'Definitions: docs/METRICS.md, "Tracking metrics".',
         "",
         "## Overall: what each configuration reports",
         "",
@@ -295,15 +308,20 @@ def write_report(runs: list[SuiteRun], folder: Path, out: Path, split: str, seed
         "",
         "| configuration | model | scenes | wall time | events |",
         "|---|---|---|---|---|",
-        *(f"| {r.configuration.name} | {r.configuration.model} | {len(r.results)} | {r.wall_s:.1f} s | {sum(x.events for x in r.results):,} |" for r in runs),
+        *(
+            f"| {r.configuration.name} | {r.configuration.model} | {len(r.results)} | {r.wall_s:.1f} s | {sum(x.events for x in r.results):,} |"
+            for r in runs
+        ),
         "",
-        *commands_section((
-            "make generalize                                   # this page: the test split, default and paper, float and fixed",
-            "evclust scenes --generate 1000 -o scenes/         # one scene of the suite (TOML, truth, video for codec scenes)",
-            "evclust scenes --split test -o scenes/            # every scene of a split",
-            "evclust tune --suite tuning --trials 400 --storage sqlite:///build/tune.db   # the tuning of the defaults",
-            "evclust generalize --split test --scheduler tcp://host:8786 -o GENERALIZATION.md   # on a Dask cluster",
-        )),
+        *commands_section(
+            (
+                "make generalize                                   # this page: the test split, default and paper, float and fixed",
+                "evclust scenes --generate 1000 -o scenes/         # one scene of the suite (TOML, truth, video for codec scenes)",
+                "evclust scenes --split test -o scenes/            # every scene of a split",
+                "evclust tune --suite tuning --trials 400 --storage sqlite:///build/tune.db   # the tuning of the defaults",
+                "evclust generalize --split test --scheduler tcp://host:8786 -o GENERALIZATION.md   # on a Dask cluster",
+            )
+        ),
     ]
     return save_page(out, lines)
 

@@ -40,7 +40,7 @@ class ParquetTrackWriter:
         # Floats split by byte before zstd: their exponents and high bytes then compress well.
         floats = [name for name in self.dtype.names if self.dtype[name].kind == "f"]
         self.file = pq.ParquetWriter(tmp, self.schema, compression="zstd", use_dictionary=False,
-                                     column_encoding={name: "BYTE_STREAM_SPLIT" for name in floats})  # fmt: skip
+                                     column_encoding=dict.fromkeys(floats, "BYTE_STREAM_SPLIT"))  # fmt: skip
 
     def write(self, tracks: np.ndarray) -> None:
         import pyarrow as pa

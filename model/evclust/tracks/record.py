@@ -76,7 +76,7 @@ TRACK_SUFFIXES = (".csv", ".parquet")
 
 
 def record_kind(records: np.ndarray) -> str:
-    """"clusters" or "objects", from a record array's fields."""
+    """ "clusters" or "objects", from a record array's fields."""
     return "objects" if "members" in (np.asarray(records).dtype.names or ()) else "clusters"
 
 
@@ -120,7 +120,7 @@ class TrackMeta:
         return json.dumps(dataclasses.asdict(self), sort_keys=True)
 
     @classmethod
-    def from_dict(cls, d: dict) -> "TrackMeta":
+    def from_dict(cls, d: dict) -> TrackMeta:
         known = {f.name for f in dataclasses.fields(cls)}
         d = {k: v for k, v in d.items() if k in known}
         if d.get("kind", "clusters") not in RECORD_KINDS:
@@ -186,7 +186,9 @@ class _CheckedTrackWriter:
     def write(self, tracks: np.ndarray) -> None:
         tracks = np.asarray(tracks)
         if tracks.dtype != self.dtype:
-            raise EvclustError(f"{self.path}: records of dtype {tracks.dtype} are not {'object' if self.dtype == OBJECT_DTYPE else 'cluster'} records")
+            raise EvclustError(
+                f"{self.path}: records of dtype {tracks.dtype} are not {'object' if self.dtype == OBJECT_DTYPE else 'cluster'} records"
+            )
         if tracks.size:
             self.writer.write(tracks)
             self.count += tracks.size
@@ -219,7 +221,7 @@ def _read_csv_tracks(path: Path) -> tuple[np.ndarray, TrackMeta]:
     if not first.startswith(MAGIC):
         raise EvclustError(f"{path}: not an evclust track file (its first line must start with '{MAGIC.strip()}')")
     try:
-        data = json.loads(first[len(MAGIC):])
+        data = json.loads(first[len(MAGIC) :])
         if not isinstance(data, dict):
             raise TypeError("metadata is not a JSON object")
         meta = TrackMeta.from_dict(data)

@@ -8,7 +8,7 @@ NEW flag of a dropped first record moves to the kept one, so a track still start
 
 from __future__ import annotations
 
-from typing import Callable
+from collections.abc import Callable
 
 import numpy as np
 

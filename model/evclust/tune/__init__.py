@@ -44,7 +44,7 @@ def params_from_trial(values: dict, base: ClustererParams, t_frame_us: float) ->
     update = {}
     for name, value in values.items():
         if name.startswith("beta_"):
-            update["alpha_" + name[len("beta_"):]] = 1.0 - value
+            update["alpha_" + name[len("beta_") :]] = 1.0 - value
         elif name == "tau_frames":
             update["tau_us"] = float(round(value * t_frame_us))  # whole µs: the hardware counts τ in µs
         else:
@@ -93,10 +93,7 @@ def tune(
     base = base.resolved(t_frame_us)  # the search moves times in µs (τ in frames of this stream)
     start = trial_values(base, t_frame_us)
     # Each range grows to hold the starting value, so the first trial is exactly the base set.
-    space = [
-        (n, lo if sc == "log" and start[n] <= 0 else min(lo, start[n]), max(hi, start[n]), sc)
-        for n, lo, hi, sc in SEARCH_SPACE
-    ]
+    space = [(n, lo if sc == "log" and start[n] <= 0 else min(lo, start[n]), max(hi, start[n]), sc) for n, lo, hi, sc in SEARCH_SPACE]
     start = {n: min(max(start[n], lo), hi) for n, lo, hi, _ in space} | {n: start[n] for n, _ in CATEGORICAL}
 
     def objective(trial):
@@ -123,7 +120,7 @@ def trial_values(p: ClustererParams, t_frame_us: float) -> dict:
     values = {}
     for name, _, _, _ in SEARCH_SPACE:
         if name.startswith("beta_"):
-            values[name] = 1.0 - getattr(p, "alpha_" + name[len("beta_"):])
+            values[name] = 1.0 - getattr(p, "alpha_" + name[len("beta_") :])
         elif name == "tau_frames":
             values[name] = p.tau_us / t_frame_us
         else:
@@ -153,7 +150,7 @@ def params_to_toml(p: ClustererParams, header: str = "") -> str:
     lines = ["[clusterer]"]
     for key, value in p.model_dump(mode="json", exclude_none=True).items():
         if key == "palette":
-            entries = [f'  {{ name = {json.dumps(e["name"])}, rgb = [{", ".join(f"{c:g}" for c in e["rgb"])}] }},' for e in value]
+            entries = [f"  {{ name = {json.dumps(e['name'])}, rgb = [{', '.join(f'{c:g}' for c in e['rgb'])}] }}," for e in value]
             lines += ["palette = [", *entries, "]"]
         elif isinstance(value, list):
             lines.append(f"{key} = [{', '.join(json.dumps(v) for v in value)}]")

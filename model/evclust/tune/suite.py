@@ -75,7 +75,7 @@ def params_from_values(values: dict, base: ClustererParams) -> ClustererParams:
     update = {}
     for name, value in values.items():
         if name.startswith("beta_"):
-            update["alpha_" + name[len("beta_"):]] = 1.0 - value
+            update["alpha_" + name[len("beta_") :]] = 1.0 - value
         else:
             update[name] = value
     update["r_min"] = min(base.r_min, update.get("r_init", base.r_init))
@@ -86,8 +86,8 @@ def params_from_values(values: dict, base: ClustererParams) -> ClustererParams:
 def values_of(p: ClustererParams) -> dict:
     """The search coordinates of a parameter set (β for α; frames as they are given)."""
     values = {}
-    for name, lo, hi, _ in SUITE_SPACE:
-        v = 1.0 - getattr(p, "alpha_" + name[len("beta_"):]) if name.startswith("beta_") else getattr(p, name)
+    for name, lo, _hi, _ in SUITE_SPACE:
+        v = 1.0 - getattr(p, "alpha_" + name[len("beta_") :]) if name.startswith("beta_") else getattr(p, name)
         values[name] = v if v is not None else lo
     for name, _ in SUITE_CATEGORICAL:
         values[name] = getattr(p, name)
@@ -130,7 +130,9 @@ def split_objective(folder: str, seeds: tuple[int, ...], params: ClustererParams
     return objective(f), f
 
 
-def _worker(storage: str, study_name: str, folder: str, seeds, base: ClustererParams, trials: int, seed: int, only: str | None = None) -> int:
+def _worker(
+    storage: str, study_name: str, folder: str, seeds, base: ClustererParams, trials: int, seed: int, only: str | None = None
+) -> int:
     """One Dask task: pull `trials` trials from the shared study."""
     import optuna
 
@@ -141,7 +143,17 @@ def _worker(storage: str, study_name: str, folder: str, seeds, base: ClustererPa
 
     def objective(trial):
         value, f = split_objective(folder, seeds, suggest(trial, base, only), objects_only=bool(only) and only.startswith("object_"))
-        for key in ("HOTA", "IDF1", "recall", "precision", "tracks_per_object", "position_rel_rmse", "interval_nrmse", "mcm_nrmse", "object_nrmse"):
+        for key in (
+            "HOTA",
+            "IDF1",
+            "recall",
+            "precision",
+            "tracks_per_object",
+            "position_rel_rmse",
+            "interval_nrmse",
+            "mcm_nrmse",
+            "object_nrmse",
+        ):
             trial.set_user_attr(key, f.get(key))
         return value if math.isfinite(value) else 1e9
 
@@ -171,7 +183,7 @@ def tune_suite(
 
     optuna.logging.set_verbosity(optuna.logging.WARNING)
     if storage.startswith("sqlite:///"):
-        Path(storage[len("sqlite:///"):]).parent.mkdir(parents=True, exist_ok=True)
+        Path(storage[len("sqlite:///") :]).parent.mkdir(parents=True, exist_ok=True)
     try:
         study = optuna.create_study(study_name=study_name, storage=storage, direction="minimize", load_if_exists=True)
     except Exception as exc:  # a bad URL, an unreachable database
@@ -179,7 +191,9 @@ def tune_suite(
     if not study.trials:
         space, categorical = searched(only)
         names = {s[0] for s in space + categorical}
-        study.enqueue_trial({k: v for k, v in values_of(base).items() if k in names})  # the starting point: the search can only improve on it
+        study.enqueue_trial(
+            {k: v for k, v in values_of(base).items() if k in names}
+        )  # the starting point: the search can only improve on it
     workers = max(1, len(client.scheduler_info()["workers"]))
     shares = [trials // workers + (1 if i < trials % workers else 0) for i in range(workers)]
     done_before = len(study.trials)

@@ -82,6 +82,7 @@ class Effect:
 # ---------------------------------------------------------------------------------------------
 # Helpers shared by several effects.
 
+
 def round_us(t: np.ndarray) -> np.ndarray:
     """Float µs -> uint64 µs, rounding half up as the change detector does."""
     return np.floor(np.asarray(t, dtype=np.float64) + 0.5).astype(np.uint64)

@@ -1,0 +1,38 @@
+"""The Python passes ruff's lint and format check under the rules of pyproject.toml, as `make
+lint` runs them, so that CI (which runs `make test`) keeps it so; and a file that breaks a rule
+is caught."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+RUFF = Path(sys.executable).with_name("ruff")
+
+
+def ruff(*args: str, cwd: Path = ROOT) -> subprocess.CompletedProcess:
+    if not RUFF.exists():
+        pytest.fail(f"{RUFF}: no ruff in this environment; pip install -e '.[test]'")
+    return subprocess.run([str(RUFF), *args], cwd=cwd, capture_output=True, text=True, timeout=120)
+
+
+def test_the_repository_passes_ruff_check():
+    done = ruff("check", ".")
+    assert done.returncode == 0, done.stdout + done.stderr
+
+
+def test_the_repository_is_formatted():
+    done = ruff("format", "--check", ".")
+    assert done.returncode == 0, done.stdout + done.stderr
+
+
+def test_the_rules_catch_an_unused_import_and_a_loop_closure(tmp_path):
+    (tmp_path / "pyproject.toml").write_text((ROOT / "pyproject.toml").read_text())
+    (tmp_path / "broken.py").write_text("import os\n\nfns = []\nfor i in range(3):\n    fns.append(lambda: i)\n")
+    done = ruff("check", "--no-cache", "broken.py", cwd=tmp_path)
+    assert done.returncode == 1
+    assert "F401" in done.stdout and "B023" in done.stdout, done.stdout
