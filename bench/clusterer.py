@@ -17,7 +17,8 @@ import statistics
 import time
 from pathlib import Path
 
-from evclust.clusterer import ClustererParams, load_params, track_events
+from evclust.clusterer import ClustererParams, load_params
+from evclust.run import track_events
 from evclust.scenes import load_scene
 from evclust.simulator import simulate_scene
 

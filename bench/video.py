@@ -26,7 +26,7 @@ from pathlib import Path
 import common  # first: pins every thread pool to one core
 
 from evclust.clusterer import ClustererParams
-from evclust.clusterer.run import prepare_run, track_stream
+from evclust.run import prepare_run, track_stream
 from evclust.metrics import score
 from evclust.report.results import VIDEO_SECTION
 from evclust.scenes.truth import read_truth

@@ -136,8 +136,9 @@ def test_parquet_and_csv_track_files_hold_the_same_records(crossing_events, caps
 
 
 def test_streamed_tracking_does_not_depend_on_the_chunking(crossing_events):
-    from evclust.clusterer import ClustererParams, track_events
-    from evclust.clusterer.run import track_stream
+    from evclust.clusterer import ClustererParams
+    from evclust.run import track_events
+    from evclust.run import track_stream
     from evclust.events import EventReader
 
     reader = EventReader(crossing_events / "e.npz")

@@ -7,7 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from evclust.clusterer import ClustererParams, PaletteEntry, parse_params, track_events
+from evclust.clusterer import ClustererParams, PaletteEntry, parse_params
+from evclust.run import track_events
 from evclust.clusterer.run import FloatClusterer
 from evclust.errors import EvclustError
 from evclust.events import EVENT_DTYPE, EventMeta

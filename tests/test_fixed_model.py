@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy.optimize import linear_sum_assignment
 
-from evclust.clusterer import track_events
+from evclust.run import track_events
 from evclust.events import EVENT_DTYPE, EventMeta
 
 from testkit import classic_params, simulate_toml

@@ -15,7 +15,8 @@ from evclust.clusterer.layout import (
     O_HI_X, O_HI_Y, O_LO_X, O_LO_Y, O_MEMBERS, O_RX, O_RY, O_T_BORN, O_TOL, O_V_WEIGHT, O_VALID, O_VX, O_VY, O_X, O_Y, OBJECT_COLUMNS,
 )  # fmt: skip
 from evclust.clusterer.objects import DT_FRAMES_MAX, FloatObjects, rate_gain
-from evclust.clusterer.run import FloatClusterer, rerun_objects, rows_to_records, track_events
+from evclust.clusterer.run import FloatClusterer, rows_to_records
+from evclust.run import rerun_objects, track_events
 from evclust.fixed.formats import OBJECT_DT_FRAMES_FRAC, OBJECT_GAIN_FRAC, build_formats
 from evclust.fixed.model import FixedClusterer
 from evclust.fixed import objects as fixed_objects

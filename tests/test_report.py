@@ -6,7 +6,8 @@ import math
 
 import pytest
 
-from evclust.clusterer import load_params, track_events
+from evclust.clusterer import load_params
+from evclust.run import track_events
 from evclust.fixed.formats import build_formats, sweep_tail_cycles
 from evclust.report.budget import OUTPUTS, SOURCES, budget, emulate, noise_sum_ratio, record_errors
 from evclust.report.report import NOISE_SUM_TOLERANCE_DB, write_report

@@ -1,6 +1,6 @@
-"""The Python passes ruff's lint and format check under the rules of pyproject.toml, as `make
-lint` runs them, so that CI (which runs `make test`) keeps it so; and a file that breaks a rule
-is caught."""
+"""The Python passes ruff's lint and format check and import-linter's contracts (the layers, no
+import circles) under the rules of pyproject.toml, as `make lint` runs them, so that CI (which
+runs `make test`) keeps it so; and a file that breaks a rule is caught."""
 
 from __future__ import annotations
 
@@ -11,13 +11,17 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-RUFF = Path(sys.executable).with_name("ruff")
+BIN = Path(sys.executable).parent
+
+
+def tool(name: str, *args: str, cwd: Path = ROOT) -> subprocess.CompletedProcess:
+    if not (BIN / name).exists():
+        pytest.fail(f"{BIN / name}: not in this environment; pip install -e '.[test]'")
+    return subprocess.run([str(BIN / name), *args], cwd=cwd, capture_output=True, text=True, timeout=300)
 
 
 def ruff(*args: str, cwd: Path = ROOT) -> subprocess.CompletedProcess:
-    if not RUFF.exists():
-        pytest.fail(f"{RUFF}: no ruff in this environment; pip install -e '.[test]'")
-    return subprocess.run([str(RUFF), *args], cwd=cwd, capture_output=True, text=True, timeout=120)
+    return tool("ruff", *args, cwd=cwd)
 
 
 def test_the_repository_passes_ruff_check():
@@ -36,3 +40,9 @@ def test_the_rules_catch_an_unused_import_and_a_loop_closure(tmp_path):
     done = ruff("check", "--no-cache", "broken.py", cwd=tmp_path)
     assert done.returncode == 1
     assert "F401" in done.stdout and "B023" in done.stdout, done.stdout
+
+
+def test_the_imports_keep_the_layers_and_make_no_circle():
+    done = tool("lint-imports", "--no-cache")
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "Contracts: 2 kept, 0 broken." in done.stdout

@@ -9,7 +9,7 @@ import pytest
 
 from evclust.cli import main
 from evclust.clusterer import load_params
-from evclust.clusterer.run import track_events
+from evclust.run import track_events
 from evclust.events.io import EventReader, event_writer
 from evclust.scenes import load_scene
 from evclust.simulator import simulate_scene

@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from evclust.cli import main
-from evclust.clusterer import load_params, track_events
+from evclust.clusterer import load_params
+from evclust.run import track_events
 from evclust.events import read_events
 from evclust.vectors import event_fields
 from evclust.vectors.pack import unpack

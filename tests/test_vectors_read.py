@@ -11,7 +11,8 @@ import pytest
 
 from evclust.errors import EvclustError
 from evclust.vectors import CASES
-from evclust.vectors.pack import TRACE_FIELDS, event_fields, pack, record_fields, unpack
+from evclust.fixed.layouts import TRACE_FIELDS, event_fields, record_fields
+from evclust.vectors.pack import pack, unpack
 from evclust.vectors.read import load_case
 from evclust.vectors.scoreboard import first_mismatch
 

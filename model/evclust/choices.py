@@ -12,5 +12,5 @@ SPLITS = {"tuning": tuple(range(32)), "test": tuple(range(1000, 1032))}
 PLOT_KINDS = ("velocity", "colour", "scatter")
 PLOT_AXES = ("index", "time")
 
-TRACK_MODELS = ("float", "fixed", "rtl")  # evclust.clusterer.run.MODELS builds them
+TRACK_MODELS = ("float", "fixed", "rtl")  # evclust.run.MODELS builds them
 SIMULATORS = ("icarus", "verilator")  # evclust.rtl.cosim runs the RTL under them

@@ -2,8 +2,28 @@
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import cv2
 import numpy as np
+
+
+class NamedColour(NamedTuple):
+    name: str
+    rgb: tuple[int, int, int]
+
+
+# The colours the built-in palette names (the clusterer's default palette) and the generated
+# scenes paint their objects in, so that a scene's truth names a palette entry.
+NAMED_COLOURS = (
+    NamedColour("black", (30, 30, 30)),
+    NamedColour("grey", (128, 128, 128)),
+    NamedColour("white", (235, 235, 235)),
+    NamedColour("red", (200, 30, 30)),
+    NamedColour("green", (40, 170, 60)),
+    NamedColour("blue", (30, 60, 180)),
+    NamedColour("yellow", (230, 200, 40)),
+)
 
 # Rows: Y, Cb, Cr; last column: offset. Coefficients of ITU-T T.871 (JFIF).
 RGB_TO_YCBCR = np.array(

@@ -55,7 +55,7 @@ if cocotb is not None:
         from evclust.clusterer import ClustererParams
         from evclust.fixed.model import FixedClusterer
         from evclust.fixed.registers import COUNTERS, counter_address, model_counters
-        from evclust.vectors.pack import event_fields, object_fields, record_fields
+        from evclust.fixed.layouts import event_fields, object_fields, record_fields
         from evclust.vectors.scoreboard import first_mismatch, first_object_mismatch
         from evclust.vectors.stimulus import random_stream
         from evclust.vectors.write import model_words

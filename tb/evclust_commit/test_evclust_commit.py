@@ -153,7 +153,7 @@ from cosim import LEAF_BUILDS, header_width, leaf_model, run, selected_simulator
 @pytest.mark.parametrize("build", sorted(LEAF_BUILDS))
 @pytest.mark.parametrize("sim", selected_simulators())
 def test_the_commit_lands_an_update_as_the_model_does(sim, build):
-    from evclust.fixed.formats import verilog_header
+    from evclust.fixed.header import verilog_header
 
     header = verilog_header(leaf_model(build).table)
     result = run(sim, header, "commit_vectors", {"build": build, "seed": 13}, toplevel="evclust_commit")
@@ -164,7 +164,7 @@ def test_the_cases_reach_every_saturation_and_the_halving():
     """Each sum leaves its format at the bottom and at the top in some case, the activity and the
     event count saturate, and the histogram halves."""
     from evclust.clusterer import layout
-    from evclust.fixed.formats import verilog_header
+    from evclust.fixed.header import verilog_header
 
     model = leaf_model("traffic")
     header = verilog_header(model.table)

@@ -168,7 +168,8 @@ def _counter_mismatch(expected: dict, got: dict) -> str | None:
 
 def _records_seen(words: list[int], table) -> list[dict]:
     """Each record word's flags and class, for the coverage bins."""
-    from evclust.vectors.pack import record_fields, unpack
+    from evclust.fixed.layouts import record_fields
+    from evclust.vectors.pack import unpack
 
     fields = record_fields(table)
     names = [f[0] for f in fields]
@@ -201,7 +202,7 @@ def _seed(*parts) -> int:
 
 def _compare(name, events, expected_trace, trace, expected, records, tags, table, expected_objects=(), harness=None):
     """The first mismatch of the trace and the cluster records, else of the object records."""
-    from evclust.vectors.pack import event_fields, object_fields, record_fields
+    from evclust.fixed.layouts import event_fields, object_fields, record_fields
     from evclust.vectors.scoreboard import first_mismatch, first_object_mismatch
 
     error = first_mismatch(name, events, event_fields(table), expected_trace, trace, record_fields(table), expected, records, tags)
@@ -263,7 +264,7 @@ if cocotb is not None:
         import numpy as np
 
         from evclust.clusterer import ClustererParams
-        from evclust.fixed.formats import verilog_header
+        from evclust.fixed.header import verilog_header
         from evclust.fixed.model import FixedClusterer
         from evclust.vectors.stimulus import random_stream
         from evclust.vectors.write import model_words
@@ -664,7 +665,8 @@ def _tampered_copy(tmp_path, case: str, edit) -> Path:
 
 @pytest.mark.parametrize("sim", SIMS)
 def test_a_wrong_expected_record_is_reported_field_by_field(sim, tmp_path):
-    from evclust.vectors.pack import record_fields, pack, unpack
+    from evclust.fixed.layouts import record_fields
+    from evclust.vectors.pack import pack, unpack
     from evclust.vectors.read import load_case
 
     case = load_case(VECTORS / "bursts")

@@ -108,7 +108,8 @@ BUILDS = {"traffic": (480, 270, 50000.0), "small": (64, 48, 10000.0)}
 
 def decay_build(name: str) -> tuple[str, dict, dict]:
     """(header, module parameters, widths and table for the cocotb side) of a build."""
-    from evclust.fixed.formats import build_formats, decay_table, verilog_header
+    from evclust.fixed.formats import build_formats, decay_table
+    from evclust.fixed.header import verilog_header
 
     width, height, t_frame = BUILDS[name]
     table = build_formats(configuration_params(name, 16), width, height, t_frame)

@@ -182,7 +182,7 @@ def _width(constants: dict, name: str) -> int:
 
 def palette_build(name: str) -> tuple[str, dict, dict]:
     """(header, module parameters, cocotb configuration) of a build."""
-    from evclust.fixed.formats import verilog_header
+    from evclust.fixed.header import verilog_header
     from evclust.fixed.model import FixedClusterer
 
     width, height, t_frame = BUILDS[name]

@@ -79,7 +79,8 @@ from cosim import configuration_params, run, selected_simulators  # noqa: E402
 @pytest.mark.parametrize("depth", [4, 16, 64])
 @pytest.mark.parametrize("sim", selected_simulators())
 def test_each_read_port_shows_the_row_last_written_to_its_slot(sim, depth):
-    from evclust.fixed.formats import build_formats, verilog_header
+    from evclust.fixed.formats import build_formats
+    from evclust.fixed.header import verilog_header
 
     header = verilog_header(build_formats(configuration_params("traffic", 16), 480, 270, 50000.0))
     width, address_bits = 421, max(1, (depth - 1).bit_length())

@@ -69,7 +69,8 @@ from cosim import configuration_params, run, selected_simulators  # noqa: E402
 @pytest.mark.parametrize("stages", [1, 2])
 @pytest.mark.parametrize("sim", selected_simulators())
 def test_the_output_is_the_word_of_the_last_advance(sim, stages):
-    from evclust.fixed.formats import build_formats, verilog_header
+    from evclust.fixed.formats import build_formats
+    from evclust.fixed.header import verilog_header
 
     header = verilog_header(build_formats(configuration_params("traffic", 16), 480, 270, 50000.0))
     config = {"stages": stages, "seed": stages}

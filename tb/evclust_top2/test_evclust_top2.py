@@ -81,7 +81,8 @@ from cosim import configuration_params, run, selected_simulators  # noqa: E402
 @pytest.mark.parametrize("n", [1, 3, 16, 64])
 @pytest.mark.parametrize("sim", selected_simulators())
 def test_the_tree_gives_the_smallest_key_and_the_smallest_of_the_others(sim, n):
-    from evclust.fixed.formats import build_formats, verilog_header
+    from evclust.fixed.formats import build_formats
+    from evclust.fixed.header import verilog_header
 
     header = verilog_header(build_formats(configuration_params("traffic", 16), 480, 270, 50000.0))
     key_w = 1 + 27 + max(1, (n - 1).bit_length())  # the seek key's width at the defaults' distance format

@@ -174,7 +174,7 @@ from cosim import header_width, leaf_model, run, selected_simulators  # noqa: E4
 @pytest.mark.parametrize("build, stages", [("traffic", 1), ("defaults", 1), ("defaults", 2)])
 @pytest.mark.parametrize("sim", selected_simulators())
 def test_the_update_gives_the_models_increments_and_new_values(sim, build, stages):
-    from evclust.fixed.formats import verilog_header
+    from evclust.fixed.header import verilog_header
 
     header = verilog_header(leaf_model(build).table)
     result = run(sim, header, "update_vectors", {"build": build, "seed": 11, "stages": stages}, toplevel="evclust_update",
@@ -185,7 +185,7 @@ def test_the_update_gives_the_models_increments_and_new_values(sim, build, stage
 def test_the_cases_saturate_and_clamp():
     """The cases reach what the module must get right at the edges: gamma * step saturated to V's
     format, the size clamped at R_min and at R_max, and increments of both signs."""
-    from evclust.fixed.formats import verilog_header
+    from evclust.fixed.header import verilog_header
 
     model = leaf_model("traffic")
     header = verilog_header(model.table)

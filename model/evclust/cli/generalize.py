@@ -50,7 +50,7 @@ def add_parser(sub) -> None:
 
 
 def run(args) -> int:
-    from evclust.clusterer.run import MODELS
+    from evclust.run import MODELS
     from evclust.suite import dask_client, split_seeds
     from evclust.suite.report import ablation_configurations, default_configurations, run_configurations, write_figures, write_report
 

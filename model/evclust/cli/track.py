@@ -58,7 +58,7 @@ def run(args) -> int:
     import dataclasses
 
     from evclust.clusterer import load_params
-    from evclust.clusterer.run import prepare_run, track_stream
+    from evclust.run import prepare_run, track_stream
     from evclust.errors import EvclustError
     from evclust.simulator.source import open_events
     from evclust.tracks import track_writer

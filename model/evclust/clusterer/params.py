@@ -15,7 +15,7 @@ from typing import Annotated, Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
-from evclust.colour import rgb_to_ycbcr
+from evclust.colour import NAMED_COLOURS, rgb_to_ycbcr
 from evclust.errors import EvclustError, read_text, validation_message
 
 Alpha = Annotated[float, Field(ge=0.0, lt=1.0)]
@@ -34,15 +34,7 @@ class PaletteEntry(BaseModel):
 
 MAX_WARMUP = 64  # the interval filter's running mean covers at most this many measurements
 
-DEFAULT_PALETTE = (
-    PaletteEntry(name="black", rgb=(30, 30, 30)),
-    PaletteEntry(name="grey", rgb=(128, 128, 128)),
-    PaletteEntry(name="white", rgb=(235, 235, 235)),
-    PaletteEntry(name="red", rgb=(200, 30, 30)),
-    PaletteEntry(name="green", rgb=(40, 170, 60)),
-    PaletteEntry(name="blue", rgb=(30, 60, 180)),
-    PaletteEntry(name="yellow", rgb=(230, 200, 40)),
-)
+DEFAULT_PALETTE = tuple(PaletteEntry(name=c.name, rgb=c.rgb) for c in NAMED_COLOURS)
 
 
 class ClustererParams(BaseModel):

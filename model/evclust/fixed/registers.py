@@ -17,7 +17,7 @@ from __future__ import annotations
 import dataclasses
 
 from evclust.errors import EvclustError
-from evclust.fixed.formats import OPTIONAL_CONSTANTS, Constant, FormatTable, _options, _quantise, build_formats
+from evclust.fixed.formats import OPTIONAL_CONSTANTS, Constant, FormatTable, build_formats, quantise_constant, table_options
 
 ID_VALUE = 0x4556434C  # "EVCL"
 VERSION = 2  # 2: no saturation counters for size_target and speed_sq, which cannot overflow
@@ -45,7 +45,7 @@ CONSTANT_ORDER = (
     "inv_t_frame", "object_gate", "object_link_along", "object_v_tol", "object_v_rel", "object_inv_track", "object_inv_rate",
     "object_inv_velocity", "object_inv_size", "object_inv_colour", "object_birth_us", "object_coast_us", "object_keep_us",
 )  # fmt: skip
-# Options (formats.py `_options`) that are run-time: mux selects and values. The others are structural.
+# Options (formats.py `table_options`) that are run-time: mux selects and values. The others are structural.
 RUNTIME_OPTIONS = ("FILTER_EVERY", "TAU_US", "GAMMA_MODE", "WARM_START", "MCM_CORRECT", "VOTE_CONTRAST", "MIXING", "BG_FIXED",
                    "BACKGROUND_MASK", "BG_INIT_Y", "BG_INIT_CB", "BG_INIT_CR")  # fmt: skip
 BUILD_OPTIONS = ("MERGE", "CREATE_SUPPORT", "SUPPORT_CELL_BITS", "VI_CAP", "OBJECTS", "N_OBJECTS", "UPDATE_DELAY")
@@ -136,13 +136,13 @@ def runtime_table(build: FormatTable, params, t_frame_us: float) -> FormatTable:
     for name, const in build.constants.items():
         new = fresh.constants.get(name)
         value = new.value if new is not None else 0.0
-        raw = _quantise(value, const.fmt, name, f"clusterer ({name}, build format)") if value else 0
+        raw = quantise_constant(value, const.fmt, name, f"clusterer ({name}, build format)") if value else 0
         constants[name] = Constant(name, const.fmt, value, raw)
     for name, const in fresh.constants.items():
         if name not in constants and const.raw != 0:
             raise EvclustError(f"clusterer ({name}): {const.value:g}, but this build has no register for it (it was 0 when the RTL was "
                                "built); rebuild the header with it non-zero")  # fmt: skip
-    options = dict(_options(p, build.formats["background"]))
+    options = dict(table_options(p, build.formats["background"]))
     for name in RUNTIME_OPTIONS:
         width = _option_width(build, name)
         if not 0 <= options[name] < 1 << width:

@@ -16,7 +16,8 @@ import math
 
 import numpy as np
 
-from evclust.clusterer import ClustererParams, track_events
+from evclust.clusterer import ClustererParams
+from evclust.run import track_events
 from evclust.clusterer.float_model import PRECISION_SIGNALS
 from evclust.fixed.formats import FormatTable, build_formats, precision_table
 from evclust.metrics.scores import scored_velocity_methods

@@ -10,8 +10,10 @@ import dataclasses
 import queue
 import threading
 
-from evclust.clusterer import ClustererParams, track_events
-from evclust.fixed.formats import build_formats, verilog_header
+from evclust.clusterer import ClustererParams
+from evclust.run import track_events
+from evclust.fixed.formats import build_formats
+from evclust.fixed.header import verilog_header
 from evclust.report.budget import scene_scores
 from evclust.rtl.stream import run_stream
 

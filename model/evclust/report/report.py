@@ -11,7 +11,8 @@ from pathlib import Path
 
 from tqdm import tqdm
 
-from evclust.clusterer import load_params, track_events
+from evclust.clusterer import load_params
+from evclust.run import track_events
 from evclust.errors import atomic_output
 from evclust.fixed.formats import DEAD_BAND_BITS, build_formats
 from evclust.fixed.model import SIGNAL_FORMATS

@@ -8,7 +8,8 @@ from pathlib import Path
 
 import numpy as np
 
-from evclust.clusterer import load_params, track_events
+from evclust.clusterer import load_params
+from evclust.run import track_events
 from evclust.errors import atomic_output
 from evclust.metrics import DEFAULT_GATE_PX, match_with_counts
 from evclust.metrics.scores import class_correct, score, scored_velocity_methods, scores_from_matches

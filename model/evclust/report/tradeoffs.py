@@ -10,7 +10,8 @@ from importlib import resources
 
 import numpy as np
 
-from evclust.clusterer import ClustererParams, load_params, track_events
+from evclust.clusterer import ClustererParams, load_params
+from evclust.run import track_events
 from evclust.metrics.convergence import converged_after
 from evclust.report.budget import best_velocity_nrmse, scene_scores
 from evclust.scenes import scene_from_toml

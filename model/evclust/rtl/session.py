@@ -21,7 +21,7 @@ import numpy as np
 
 from evclust.clusterer.layout import OBJECT_RECORD_COLUMNS
 from evclust.errors import EvclustError
-from evclust.fixed.formats import verilog_header
+from evclust.fixed.header import verilog_header
 from evclust.fixed.model import FixedClusterer
 from evclust.rtl.sources import require_rtl_semantics
 from evclust.vectors.pack import event_words, object_rows, record_rows

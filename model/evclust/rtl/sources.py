@@ -50,7 +50,8 @@ def require_rtl_semantics(params) -> None:
 
 def params_header(params, width: int, height: int, t_frame_us: float, **formats) -> str:
     """evclust_params.vh for a parameter set on a sensor (`formats`: build_formats's options)."""
-    from evclust.fixed.formats import build_formats, verilog_header
+    from evclust.fixed.formats import build_formats
+    from evclust.fixed.header import verilog_header
 
     require_rtl_semantics(params)
     return verilog_header(build_formats(params, width, height, t_frame_us, **formats))

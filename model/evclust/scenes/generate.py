@@ -22,8 +22,7 @@ import cv2
 import numpy as np
 import tomli_w
 
-from evclust.clusterer.params import DEFAULT_PALETTE
-from evclust.colour import rgb_to_ycbcr
+from evclust.colour import NAMED_COLOURS, rgb_to_ycbcr
 from evclust.errors import EvclustError, atomic_output
 from evclust.scenes.schema import BackgroundSpec, LegSpec, ObjectSpec, PatchSpec, SceneSpec, SensorSpec
 from evclust.scenes.synthetic import SyntheticSource
@@ -101,7 +100,7 @@ def _stands_out(rgb, luma_range: tuple[float, float], margin: float = 0.0) -> bo
 
 def _usable_entries(luma_range) -> list:
     """Palette entries whose own colour stands out of the background."""
-    return [e for e in DEFAULT_PALETTE if _stands_out(e.rgb, luma_range)]
+    return [e for e in NAMED_COLOURS if _stands_out(e.rgb, luma_range)]
 
 
 def _object_colour(rng, luma_range: tuple[float, float]):

@@ -8,8 +8,9 @@ import time
 
 import numpy as np
 
-from evclust.clusterer import ClustererParams, track_events
-from evclust.clusterer.run import rerun_objects
+from evclust.clusterer import ClustererParams
+from evclust.run import track_events
+from evclust.run import rerun_objects
 from evclust.events import read_events
 from evclust.metrics import tracking
 from evclust.scenes.truth import read_truth

@@ -9,7 +9,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from evclust.clusterer import track_events
+from evclust.run import track_events
 from evclust.events import read_events
 from evclust.metrics.tracking import FAILURES
 from evclust.render.tracks import FrameDrawer, to_canvas

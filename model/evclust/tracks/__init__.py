@@ -18,11 +18,9 @@ from evclust.tracks.record import (
     ObjectFlags,
     TrackFlags,
     TrackMeta,
-    read_tracks,
     record_kind,
-    track_writer,
-    write_tracks,
 )
+from evclust.tracks.files import read_tracks, track_writer, write_tracks
 
 __all__ = [
     "OBJECT_DTYPE",

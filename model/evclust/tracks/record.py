@@ -1,4 +1,5 @@
-"""The two record kinds, their metadata, and track files: CSV here, Parquet in `columnar`.
+"""The two record kinds and their metadata (track files: `files`, CSV in `text`, Parquet in
+`columnar`).
 
 Cluster records (TRACK_DTYPE) are the event-rate clusterer's, one per reported cluster per
 filter step; object records (OBJECT_DTYPE) are the object layer's, one per reported object per
@@ -7,17 +8,12 @@ its metadata (`TrackMeta.kind`)."""
 
 from __future__ import annotations
 
-import contextlib
-import csv
 import dataclasses
 import enum
-import io
 import json
-from pathlib import Path
 
 import numpy as np
 
-from evclust.errors import EvclustError, atomic_output
 
 TRACK_DTYPE = np.dtype(
     [
@@ -70,8 +66,6 @@ VELOCITY_METHODS = {
     "clusters": (("mcm", "vx_mcm", "vy_mcm"), ("interval", "vx_int", "vy_int")),
     "objects": (("object", "vx", "vy"),),
 }
-_INTEGER_FIELDS = {"t_us", "step", "slot", "id", "class", "flags", "members"}
-MAGIC = "# evclust-tracks "
 TRACK_SUFFIXES = (".csv", ".parquet")
 
 
@@ -131,125 +125,3 @@ class TrackMeta:
         if "palette_ycbcr" in d:
             d["palette_ycbcr"] = tuple(tuple(float(c) for c in e) for e in d["palette_ycbcr"])
         return cls(**d)
-
-
-def _format(value, integer: bool) -> str:
-    return str(int(value)) if integer else f"{float(value):.6g}"
-
-
-class CsvTrackWriter:
-    """Records as CSV, appended chunk by chunk."""
-
-    def __init__(self, tmp: Path, meta: TrackMeta):
-        self.fields = meta.dtype.names
-        self.file = open(tmp, "w", newline="")
-        self.file.write(MAGIC + meta.to_json() + "\n")
-        self.file.write(",".join(self.fields) + "\n")
-        self.integer = [name in _INTEGER_FIELDS for name in self.fields]
-
-    def write(self, tracks: np.ndarray) -> None:
-        columns = [tracks[name].tolist() for name in self.fields]
-        self.file.writelines(",".join(_format(v, i) for v, i in zip(row, self.integer)) + "\n" for row in zip(*columns))
-
-    def close(self) -> None:
-        self.file.close()
-
-
-def _writer_class(path: Path):
-    suffix = path.suffix.lower()
-    if suffix == ".csv":
-        return CsvTrackWriter
-    if suffix == ".parquet":
-        from evclust.tracks.columnar import ParquetTrackWriter
-
-        return ParquetTrackWriter
-    raise EvclustError(f"{path}: unknown track file type '{suffix}' (use {', '.join(TRACK_SUFFIXES)})")
-
-
-@contextlib.contextmanager
-def track_writer(path: str | Path, meta: TrackMeta):
-    """Yield a writer with `.write(tracks)`; the file appears only if the block succeeds."""
-    path = Path(path)
-    cls = _writer_class(path)
-    with atomic_output(path) as tmp:
-        writer = cls(tmp, meta)
-        try:
-            yield _CheckedTrackWriter(writer, path, meta.dtype)
-        finally:
-            writer.close()
-
-
-class _CheckedTrackWriter:
-    def __init__(self, writer, path: Path, dtype: np.dtype):
-        self.writer, self.path, self.dtype, self.count = writer, path, dtype, 0
-
-    def write(self, tracks: np.ndarray) -> None:
-        tracks = np.asarray(tracks)
-        if tracks.dtype != self.dtype:
-            raise EvclustError(
-                f"{self.path}: records of dtype {tracks.dtype} are not {'object' if self.dtype == OBJECT_DTYPE else 'cluster'} records"
-            )
-        if tracks.size:
-            self.writer.write(tracks)
-            self.count += tracks.size
-
-
-def write_tracks(path: str | Path, tracks: np.ndarray, meta: TrackMeta) -> None:
-    with track_writer(path, meta) as writer:
-        writer.write(tracks)
-
-
-def read_tracks(path: str | Path) -> tuple[np.ndarray, TrackMeta]:
-    """Read a track file (.csv or .parquet): (records, TrackMeta); the records are TRACK_DTYPE
-    or OBJECT_DTYPE as `TrackMeta.kind` says."""
-    path = Path(path)
-    if not path.is_file():
-        raise EvclustError(f"{path}: no such track file")
-    if _writer_class(path) is not CsvTrackWriter:
-        from evclust.tracks.columnar import read_parquet_tracks
-
-        return read_parquet_tracks(path)
-    return _read_csv_tracks(path)
-
-
-def _read_csv_tracks(path: Path) -> tuple[np.ndarray, TrackMeta]:
-    try:
-        text = path.read_text()
-    except UnicodeDecodeError as exc:
-        raise EvclustError(f"{path}: not a text track file ({exc.reason} at byte {exc.start})") from None
-    first, _, rest = text.partition("\n")
-    if not first.startswith(MAGIC):
-        raise EvclustError(f"{path}: not an evclust track file (its first line must start with '{MAGIC.strip()}')")
-    try:
-        data = json.loads(first[len(MAGIC) :])
-        if not isinstance(data, dict):
-            raise TypeError("metadata is not a JSON object")
-        meta = TrackMeta.from_dict(data)
-    except (json.JSONDecodeError, TypeError, ValueError) as exc:
-        raise EvclustError(f"{path}: line 1: unreadable metadata ({exc})") from None
-    reader = csv.reader(io.StringIO(rest))
-    header = next(reader, None)
-    if header is None:
-        raise EvclustError(f"{path}: no header line")
-    dtype = meta.dtype
-    fields = dtype.names
-    missing = [name for name in fields if name not in header]
-    if missing:
-        raise EvclustError(f"{path}: missing column(s) {', '.join(missing)}")
-    index = [header.index(name) for name in fields]
-    limits = {name: np.iinfo(dtype[name]) for name in _INTEGER_FIELDS if name in fields}
-    rows = []
-    for line_no, row in enumerate(reader, start=3):
-        if not row:
-            continue
-        try:
-            values = tuple(float(row[i]) if name not in _INTEGER_FIELDS else int(row[i]) for i, name in zip(index, fields))
-        except (ValueError, IndexError):
-            raise EvclustError(f"{path}: line {line_no}: not a track record: {','.join(row)[:80]}") from None
-        for name, value in zip(fields, values):
-            if name in limits and not limits[name].min <= value <= limits[name].max:
-                raise EvclustError(f"{path}: line {line_no}: {name}={value} does not fit {dtype[name]}")
-            if name not in limits and not np.isfinite(value):
-                raise EvclustError(f"{path}: line {line_no}: {name} is {value}")
-        rows.append(values)
-    return np.array(rows, dtype=dtype), meta

@@ -12,7 +12,8 @@ import math
 
 import numpy as np
 
-from evclust.clusterer import ClustererParams, track_events
+from evclust.clusterer import ClustererParams
+from evclust.run import track_events
 from evclust.events import EventMeta
 from evclust.metrics import score
 

@@ -6,7 +6,7 @@ manifest and in vectors/README.md; widths come from the formats table, so they f
 """
 
 from evclust.vectors.cases import CASES
-from evclust.vectors.pack import TRACE_FIELDS, event_fields, record_fields
+from evclust.fixed.layouts import TRACE_FIELDS, event_fields, record_fields
 from evclust.vectors.write import check_vectors, write_case, write_vectors
 
 __all__ = ["CASES", "TRACE_FIELDS", "event_fields", "record_fields", "check_vectors", "write_case", "write_vectors"]

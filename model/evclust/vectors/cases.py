@@ -79,7 +79,13 @@ def timestamp_wrap() -> Case:
     rng = np.random.default_rng(11)
     t0 = (1 << 32) - 600 * 50
     rows = [(t0 + 50 * i, 10 + i // 40 + int(rng.integers(-2, 3)), 24 + int(rng.integers(-2, 3)), 180, 100, 150) for i in range(1200)]
-    return Case("a drifting blob whose 32-bit timestamps wrap in the middle of the stream", _events(rows), **SMALL, params=_small_params(), source="directed")
+    return Case(
+        "a drifting blob whose 32-bit timestamps wrap in the middle of the stream",
+        _events(rows),
+        **SMALL,
+        params=_small_params(),
+        source="directed",
+    )
 
 
 def table_full() -> Case:

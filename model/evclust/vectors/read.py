@@ -11,8 +11,9 @@ from pathlib import Path
 
 from evclust.clusterer import ClustererParams
 from evclust.errors import EvclustError
-from evclust.fixed.formats import FormatTable, build_formats, verilog_header
-from evclust.vectors.pack import TRACE_FIELDS, event_fields, object_fields, record_fields
+from evclust.fixed.formats import FormatTable, build_formats
+from evclust.fixed.header import verilog_header
+from evclust.fixed.layouts import TRACE_FIELDS, event_fields, object_fields, record_fields
 from evclust.vectors.write import FILES
 
 

@@ -3,7 +3,8 @@ mismatch field by field with the event index and the vector file lines that loca
 
 from __future__ import annotations
 
-from evclust.vectors.pack import TRACE_FIELDS, unpack
+from evclust.fixed.layouts import TRACE_FIELDS
+from evclust.vectors.pack import unpack
 
 ACTIONS = ("update", "create", "evict", "drop", "unsupported")  # fixed_model.TRACE_*
 

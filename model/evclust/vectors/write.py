@@ -17,9 +17,8 @@ from evclust.fixed.model import FixedClusterer
 from evclust.fixed.registers import SATURATING_SIGNALS
 from evclust.vectors.cases import CASES, Case
 from evclust.tracks import OBJECT_DTYPE
-from evclust.vectors.pack import (
-    TRACE_FIELDS, event_fields, event_words, hex_lines, object_fields, object_words, pack, record_fields, record_words,
-)  # fmt: skip
+from evclust.fixed.layouts import TRACE_FIELDS, event_fields, object_fields, record_fields
+from evclust.vectors.pack import event_words, hex_lines, object_words, pack, record_words
 
 FILES = ("events.hex", "expected.hex", "trace.hex", "objects.hex")
 
@@ -87,12 +86,30 @@ def write_case(name: str, folder: Path, case: Case | None = None) -> dict:
         "parameters": case.params.model_dump(mode="json", exclude_none=True),
         "format_options": case.formats,
         "constants": {c.name: c.raw for c in table.constants.values()},
-        "formats": {f.name: {"q": f.q, "signed": f.signed, "int_bits": f.int_bits, "frac_bits": f.frac_bits,
-                             "rounding": f.rounding, "overflow": f.overflow} for f in table.formats.values()},  # fmt: skip
-        "layouts": {"events.hex": _layout(event_fields(table)), "expected.hex": _layout(record_fields(table)),
-                    "trace.hex": _layout(TRACE_FIELDS), "objects.hex": _layout(object_fields(table))},  # fmt: skip
-        "counts": {"events": int(case.events.size), "records": len(record_list), "objects": len(object_list), **_counts(model),
-                   **({"object_layer": layer.stats()} if layer is not None else {})},
+        "formats": {
+            f.name: {
+                "q": f.q,
+                "signed": f.signed,
+                "int_bits": f.int_bits,
+                "frac_bits": f.frac_bits,
+                "rounding": f.rounding,
+                "overflow": f.overflow,
+            }
+            for f in table.formats.values()
+        },  # fmt: skip
+        "layouts": {
+            "events.hex": _layout(event_fields(table)),
+            "expected.hex": _layout(record_fields(table)),
+            "trace.hex": _layout(TRACE_FIELDS),
+            "objects.hex": _layout(object_fields(table)),
+        },  # fmt: skip
+        "counts": {
+            "events": int(case.events.size),
+            "records": len(record_list),
+            "objects": len(object_list),
+            **_counts(model),
+            **({"object_layer": layer.stats()} if layer is not None else {}),
+        },
         "sha256": {file: hashlib.sha256(text.encode()).hexdigest() for file, text in contents.items()},
     }
     with atomic_folder(folder) as tmp:  # a case is whole or absent, even if interrupted
