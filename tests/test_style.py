@@ -46,3 +46,12 @@ def test_the_imports_keep_the_layers_and_make_no_circle():
     done = tool("lint-imports", "--no-cache")
     assert done.returncode == 0, done.stdout + done.stderr
     assert "Contracts: 2 kept, 0 broken." in done.stdout
+
+
+def test_the_tests_mirror_the_packages():
+    # tests/<package>/ for each package's tests; only repository-wide tests stay at the top.
+    packages = {p.name for p in (ROOT / "model" / "evclust").iterdir() if (p / "__init__.py").exists()}
+    folders = {p.name for p in (ROOT / "tests").iterdir() if p.is_dir() and not p.name.startswith((".", "__"))}
+    assert folders <= packages, f"test folders that name no package: {sorted(folders - packages)}"
+    top = sorted(p.name for p in (ROOT / "tests").glob("test_*.py"))
+    assert top == ["test_readonly_install.py", "test_style.py"], top

@@ -6,8 +6,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from evclust.cli import main
 from evclust.scenes import scene_from_toml
 from evclust.simulator import simulate_scene
+
+FPS = 100.0  # square_scene's frame rate
 
 
 # One red square crossing a small sensor: the CLI tests' scene.
@@ -49,3 +52,42 @@ def classic_params(**update):
     from evclust.clusterer import ClustererParams
 
     return ClustererParams(**{**CLASSIC, **update})
+
+
+# The CLI in-process: (exit code, stdout, stderr), and the one-line error every bad input gets.
+def run_cli(capsys, *argv):
+    code = main(list(argv))
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def assert_one_line_error(code, err, *fragments):
+    assert code == 2
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("evclust: error: "), err
+    assert "Traceback" not in err
+    for fragment in fragments:
+        assert fragment in lines[0]
+
+
+def square_scene(legs, start=(40.0, 60.0), colour=(240, 240, 240), bg=(60, 60, 60), width=240, height=120, frames=None, size=20, theta=0.2):
+    frames = frames or 1 + sum(n for n, _ in legs)
+    leg_text = ", ".join(f"{{ frames = {n}, velocity = [{vx}, {vy}] }}" for n, (vx, vy) in legs)
+    return f"""
+width = {width}
+height = {height}
+fps = {FPS}
+frames = {frames}
+[sensor]
+threshold_on = {theta}
+threshold_off = {theta}
+[background]
+colour = [{bg[0]}, {bg[1]}, {bg[2]}]
+[[objects]]
+id = 1
+label = "obj"
+size = [{size}, {size}]
+colour = [{colour[0]}, {colour[1]}, {colour[2]}]
+start = [{start[0]}, {start[1]}]
+legs = [{leg_text}]
+"""

@@ -245,7 +245,7 @@ def effects_section(img: Path, tick) -> list[str]:
         "The `traffic` scene simulated without effects, then with each effect on at its defaults (one `[effects.NAME]` "
         "table), and tracked with its preset. Simulation time is the best of two runs; `vs ideal` divides it by the ideal "
         "sensor's, timed alternately with it in the same run. An effect the scene does not name is never constructed "
-        "(tests/test_effects.py makes every effect class raise if touched and simulates a scene without effects), so "
+        "(tests/simulator/test_effects.py makes every effect class raise if touched and simulates a scene without effects), so "
         "the ideal sensor's time is the floor every other row pays on top of.",
         "",
         "![effects](img/effects_traffic.png)",

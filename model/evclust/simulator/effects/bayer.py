@@ -11,7 +11,7 @@ from evclust.simulator.effects.base import Effect, EffectParams
 
 _CHANNEL = {"R": 0, "G": 1, "B": 2}
 # OpenCV names a Bayer layout after the second row's second and third pixels, so its code for a
-# pattern whose top-left 2x2 block is RGGB is "BG" (checked by tests/test_effects.py).
+# pattern whose top-left 2x2 block is RGGB is "BG" (checked by tests/simulator/test_effects.py).
 _OPENCV_CODE = {
     "RGGB": cv2.COLOR_BayerBG2RGB,
     "BGGR": cv2.COLOR_BayerRG2RGB,

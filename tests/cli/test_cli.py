@@ -13,22 +13,7 @@ from evclust.cli import main
 from evclust.events import read_events
 from evclust.scenes import load_scene
 
-from testkit import GOOD_SCENE
-
-
-def run_cli(capsys, *argv):
-    code = main(list(argv))
-    out, err = capsys.readouterr()
-    return code, out, err
-
-
-def assert_one_line_error(code, err, *fragments):
-    assert code == 2
-    lines = err.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("evclust: error: "), err
-    assert "Traceback" not in err
-    for fragment in fragments:
-        assert fragment in lines[0]
+from testkit import GOOD_SCENE, assert_one_line_error, run_cli
 
 
 @pytest.mark.parametrize("verb", ["simulate", "track", "score", "render", "plot", "show", "scenes"])

@@ -119,7 +119,7 @@ def test_a_run_may_stop_after_placement():
     import sys
     from pathlib import Path
 
-    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "synth"))
+    sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "synth"))
     import timing as script
 
     assert script.parse_run("defaults:64:placed") == ("defaults", 64, True)

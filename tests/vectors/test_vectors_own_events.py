@@ -15,7 +15,7 @@ from evclust.vectors import event_fields
 from evclust.vectors.pack import unpack
 from evclust.vectors.read import load_case
 
-from test_cli import assert_one_line_error, run_cli
+from testkit import assert_one_line_error, run_cli
 
 N = 6000
 

@@ -10,7 +10,7 @@ from evclust.cli import main
 from evclust.colour import rgb_to_ycbcr
 from evclust.scenes.truth import read_truth
 
-from test_cli import assert_one_line_error, run_cli
+from testkit import assert_one_line_error, run_cli
 
 W, H, FRAMES, WARMUP = 160, 120, 60, 15
 RED, BLUE = (220, 40, 40), (40, 60, 220)

@@ -17,9 +17,9 @@ from evclust.errors import EvclustError
 from evclust.fixed import build_formats, verilog_header
 from evclust.fixed.formats import DEAD_BAND_BITS
 
-from test_cli import assert_one_line_error, run_cli
+from testkit import assert_one_line_error, run_cli
 
-HEADER = Path(__file__).resolve().parents[1] / "rtl" / "evclust_params.vh"
+HEADER = Path(__file__).resolve().parents[2] / "rtl" / "evclust_params.vh"
 
 
 def test_the_committed_rtl_header_is_generated_from_the_table():

@@ -14,7 +14,7 @@ from evclust.fixed.registers import SATURATING_SIGNALS
 from evclust.vectors import CASES, check_vectors, record_fields
 from evclust.vectors.pack import unpack
 
-ROOT = Path(__file__).resolve().parents[1] / "vectors"
+ROOT = Path(__file__).resolve().parents[2] / "vectors"
 
 
 def test_the_committed_vectors_are_what_the_model_makes_now():

@@ -12,7 +12,7 @@ from evclust.cli import main
 from evclust.events import read_events, write_events
 from evclust.tracks import read_tracks
 
-from test_cli import assert_one_line_error, run_cli
+from testkit import assert_one_line_error, run_cli
 
 
 @pytest.fixture(scope="module")

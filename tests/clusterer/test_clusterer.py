@@ -14,33 +14,9 @@ from evclust.errors import EvclustError
 from evclust.events import EVENT_DTYPE, EventMeta
 from evclust.metrics.convergence import converged_after
 
-from testkit import classic_params, simulate_toml
+from testkit import FPS, classic_params, simulate_toml, square_scene
 
-FPS = 100.0
 T_FRAME = 1e6 / FPS
-
-
-def square_scene(legs, start=(40.0, 60.0), colour=(240, 240, 240), bg=(60, 60, 60), width=240, height=120, frames=None, size=20, theta=0.2):
-    frames = frames or 1 + sum(n for n, _ in legs)
-    leg_text = ", ".join(f"{{ frames = {n}, velocity = [{vx}, {vy}] }}" for n, (vx, vy) in legs)
-    return f"""
-width = {width}
-height = {height}
-fps = {FPS}
-frames = {frames}
-[sensor]
-threshold_on = {theta}
-threshold_off = {theta}
-[background]
-colour = [{bg[0]}, {bg[1]}, {bg[2]}]
-[[objects]]
-id = 1
-label = "obj"
-size = [{size}, {size}]
-colour = [{colour[0]}, {colour[1]}, {colour[2]}]
-start = [{start[0]}, {start[1]}]
-legs = [{leg_text}]
-"""
 
 
 def run(text, **overrides):

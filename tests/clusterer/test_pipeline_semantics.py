@@ -102,7 +102,7 @@ def test_a_stream_in_pieces_gives_what_it_gives_whole(model):
 
 
 def test_the_fixed_model_follows_the_float_model_with_the_delay():
-    # The bar of tests/test_clusterer_additions.py, D = 8: the same merges, centres within a few LSBs.
+    # The bar of tests/clusterer/test_clusterer_additions.py, D = 8: the same merges, centres within a few LSBs.
     rows = []
     for i in range(120):
         lead = int(round(30.0 + 0.25 * i))

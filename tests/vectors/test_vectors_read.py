@@ -16,7 +16,7 @@ from evclust.vectors.pack import pack, unpack
 from evclust.vectors.read import load_case
 from evclust.vectors.scoreboard import first_mismatch
 
-VECTORS = Path(__file__).resolve().parents[1] / "vectors"
+VECTORS = Path(__file__).resolve().parents[2] / "vectors"
 
 
 def _copy(tmp_path, name="gaps") -> Path:

@@ -10,7 +10,7 @@ from evclust.run import track_events
 from evclust.events import EVENT_DTYPE, EventMeta
 
 from testkit import classic_params, simulate_toml
-from test_clusterer import square_scene
+from testkit import square_scene
 
 T_FRAME = 1e4
 
