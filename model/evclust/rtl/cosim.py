@@ -23,7 +23,7 @@ INCLUDES = tuple(RTL_DIR / name for name in RTL_INCLUDES)
 TOPLEVEL = "evclust_tb"
 # The testbenches: toplevel -> (its Verilog beyond rtl/, its folder and cocotb module under tb/).
 BENCHES = {
-    "evclust_tb": ((TB_DIR / "evclust_tb.v",), TB_DIR, "test_evclust_core"),
+    "evclust_tb": ((TB_DIR / "evclust_tb.v",), TB_DIR, "evclust.rtl.harness"),
     "evclust_axis": ((), TB_DIR.parent / "evclust_axis", "test_evclust_axis"),
     "evclust_decay": ((), TB_DIR.parent / "evclust_decay", "test_evclust_decay"),
     "evclust_palette": ((), TB_DIR.parent / "evclust_palette", "test_evclust_palette"),
@@ -130,7 +130,7 @@ def _make_flags(sim: str):
 
 
 def run(sim: str, header: str, testcase: str, config: dict, toplevel: str = TOPLEVEL, parameters: dict | None = None) -> dict:
-    """Run one cocotb test of a testbench (default tb/evclust_core/test_evclust_core.py); its
+    """Run one cocotb test of a testbench (default evclust.rtl.harness on tb/evclust_core/evclust_tb.v); its
     measurements back as a dict. A failing test raises AssertionError with the testbench's message."""
     runner, build_dir = build(sim, header, toplevel, parameters)
     _, test_dir, test_module = BENCHES[toplevel]

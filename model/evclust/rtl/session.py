@@ -2,7 +2,7 @@
 fixed models (feed events, get record rows back), with the events going through evclust_core
 under Verilator.
 
-The simulator runs the cocotb test `serve` (tb/evclust_core/test_evclust_core.py) in a thread of
+The simulator runs the cocotb test `serve` (evclust.rtl.harness) in a thread of
 this process's making; the two sides talk over a pair of named pipes, one line per batch: this
 side writes a batch of event words to an .npy file and its path to the request pipe, the
 testbench streams it through the core and answers with the path of the record words. An empty
