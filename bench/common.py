@@ -20,6 +20,8 @@ cv2.setNumThreads(1)
 import numba  # noqa: E402
 import numpy as np  # noqa: E402
 
+from evclust.documents import write_section  # noqa: E402, F401  (the benchmarks' section writer)
+
 
 def machine() -> list[str]:
     info = Path("/proc/cpuinfo").read_text() if Path("/proc/cpuinfo").exists() else ""
@@ -40,19 +42,3 @@ def machine() -> list[str]:
         f"- Python {platform.python_version()}, numpy {np.__version__}, numba {numba.__version__}, OpenCV {cv2.__version__}",
         f"- One core: NUMBA_NUM_THREADS=OMP_NUM_THREADS=OPENBLAS_NUM_THREADS=MKL_NUM_THREADS=EVCLUST_THREADS=1, cv2.setNumThreads(1); numba threads {numba.config.NUMBA_NUM_THREADS}, OpenCV threads {cv2.getNumThreads()}",
     ]
-
-
-def write_section(path: Path, section: str, start: str, end: str) -> None:
-    """Replace the part of `path` between the markers `start` and `end` (or append it)."""
-    if path.exists():
-        text = path.read_text()
-        if start in text and end in text:
-            head, rest = text.split(start, 1)
-            tail = rest.split(end, 1)[1].lstrip("\n")
-            text = head + section + ("\n" + tail if tail else "")
-        else:
-            text = text.rstrip("\n") + "\n\n" + section
-    else:
-        text = "# Benchmarks\n\nMeasured by `make bench`; each section is rewritten by the script that owns it.\n\n" + section
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(text)

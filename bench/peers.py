@@ -75,8 +75,9 @@ def run_v2e(folder: Path, fps: float) -> tuple[int, float]:
     import json
     import subprocess
 
-    done = subprocess.run([str(V2E_PYTHON), str(ROOT / "bench" / "peers_v2e.py"), str(folder), str(fps), str(V2E_SOURCE)],
-                          capture_output=True, text=True, check=True)  # fmt: skip
+    env = os.environ | {"PYTHONPATH": str(V2E_SOURCE)}  # v2e runs from its source checkout
+    done = subprocess.run([str(V2E_PYTHON), str(ROOT / "bench" / "peers_v2e.py"), str(folder), str(fps)],
+                          capture_output=True, text=True, check=True, env=env)  # fmt: skip
     result = json.loads(done.stdout.strip().splitlines()[-1])
     return result["events"], result["wall_s"]
 
@@ -117,12 +118,12 @@ def main() -> int:
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--write", metavar="MD")
     args = parser.parse_args()
-    sys.path.insert(0, str(PEERS / "esim_py"))
     try:
-        import esim_py  # noqa: F401
+        import esim_py  # noqa: F401  (on PYTHONPATH: make bench-peers builds it in build/peers/esim_py)
     except ImportError:
-        raise SystemExit(f"esim_py is not built in {PEERS / 'esim_py'}: run `make bench-peers`") from None
-    sys.path.insert(0, str(ROOT / "bench"))
+        raise SystemExit(
+            f"esim_py is not importable: `make bench-peers` builds it in {PEERS / 'esim_py'} and runs this with it on PYTHONPATH"
+        ) from None
     from simulator import VIDEO as PAN_DISKS, ensure_video  # its `common` pins every pool to one thread: undone below
 
     os.environ["EVCLUST_THREADS"] = str(os.cpu_count())
@@ -148,7 +149,7 @@ def main() -> int:
     ])  # fmt: skip
     print(section)
     if args.write:
-        from common import write_section
+        from evclust.documents import write_section
 
         write_section(Path(args.write), section, START, END)
     return 0

@@ -3,7 +3,7 @@
 (build/peers/v2e-venv: CPU torch). Prints {"wall_s", "events", "frames"} as JSON; the wall time
 covers decoding and emulating, not importing torch.
 
-    python bench/peers_v2e.py FRAMES_DIR FPS V2E_SOURCE
+    PYTHONPATH=V2E_SOURCE python bench/peers_v2e.py FRAMES_DIR FPS
 """
 
 import json
@@ -16,8 +16,7 @@ import numpy as np
 
 
 def main() -> int:
-    folder, fps, source = Path(sys.argv[1]), float(sys.argv[2]), sys.argv[3]
-    sys.path.insert(0, source)
+    folder, fps = Path(sys.argv[1]), float(sys.argv[2])  # v2e's source checkout on PYTHONPATH (bench/peers.py)
     import torch
     from v2ecore.emulator import EventEmulator
 

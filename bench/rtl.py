@@ -17,13 +17,12 @@ import sys
 import time
 from pathlib import Path
 
+from evclust.rtl.configurations import random_config
+from evclust.rtl.cosim import SIMULATORS, run
+from evclust.vectors import CASES
+from evclust.vectors.read import load_case
+
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "tb"))
-
-from cosim import SIMULATORS, random_config, run  # noqa: E402
-
-from evclust.vectors import CASES  # noqa: E402
-from evclust.vectors.read import load_case  # noqa: E402
 
 START, END = "<!-- bench:rtl:start -->", "<!-- bench:rtl:end -->"
 VECTORS = ROOT / "vectors"

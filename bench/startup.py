@@ -52,8 +52,7 @@ def main() -> int:
     ])  # fmt: skip
     print(section)
     if args.write:
-        sys.path.insert(0, str(ROOT / "bench"))
-        from common import write_section
+        from evclust.documents import write_section
 
         write_section(Path(args.write), section, START, END)
     return 0

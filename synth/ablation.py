@@ -174,8 +174,7 @@ def main():
     text = section(defaults, costs, objects, support_bits(), tracking, defaults[N_SMALL]["rtl"])
     print(text)
     if args.write:
-        sys.path.insert(0, str(ROOT / "bench"))
-        from common import write_section
+        from evclust.documents import write_section
 
         write_section(args.write, text, START, END)
 

@@ -147,8 +147,7 @@ def main():
     args.json.write_text(json.dumps(rows, indent=2) + "\n")
     print(table(rows))
     if args.write:
-        sys.path.insert(0, str(ROOT / "bench"))
-        from common import write_section
+        from evclust.documents import write_section
 
         if args.defaults:
             write_section(args.write, defaults_section(rows), DEFAULTS_START, DEFAULTS_END)

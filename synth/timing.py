@@ -21,8 +21,7 @@ from evclust.errors import EvclustError
 from evclust.rtl.synth import rtl_snapshot
 from evclust.rtl.timing import BUILD, PART, TARGET_MHZ, place_and_route
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from synth import defaults_header, params_header
+from synth import defaults_header, params_header  # synth/synth.py: a script's folder is on its path
 
 ROOT = Path(__file__).resolve().parents[1]
 START, END = "<!-- bench:timing:start -->", "<!-- bench:timing:end -->"
@@ -187,13 +186,11 @@ def main():
     args.json.write_text(json.dumps(rows, indent=2) + "\n")
     print(table(rows))
     if args.write:
-        sys.path.insert(0, str(ROOT / "bench"))
-        from common import write_section
+        from evclust.documents import write_section
 
         write_section(args.write, section(rows), START, END)
     if args.datasheet:
-        sys.path.insert(0, str(ROOT / "bench"))
-        from common import write_section
+        from evclust.documents import write_section
 
         write_section(args.datasheet, datasheet(rows), DATASHEET_START, DATASHEET_END)
 

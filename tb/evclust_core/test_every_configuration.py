@@ -11,13 +11,10 @@ EVCLUST_COVER_ROWS=3,7 runs rows 3 and 7.
 
 from __future__ import annotations
 
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from cosim import cosim_share, random_config, run, selected_simulators
 from switch_cover import (

@@ -16,12 +16,9 @@ and launches it through `cocotb_tools.runner`, as tb/evclust_core/test_evclust_c
 from __future__ import annotations
 
 import random
-import sys
-from pathlib import Path
 
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 try:
     import cocotb

@@ -12,13 +12,10 @@ preset (a fixed margin) at N = 4.
 from __future__ import annotations
 
 import random
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 try:
     import cocotb

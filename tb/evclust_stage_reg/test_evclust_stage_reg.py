@@ -11,12 +11,9 @@ without `advance`, ignores `rst` or lags a cycle fails.
 from __future__ import annotations
 
 import random
-import sys
-from pathlib import Path
 
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 try:
     import cocotb

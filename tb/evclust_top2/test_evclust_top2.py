@@ -12,12 +12,9 @@ equals the smallest).
 from __future__ import annotations
 
 import random
-import sys
-from pathlib import Path
 
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 try:
     import cocotb

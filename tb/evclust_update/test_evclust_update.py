@@ -18,13 +18,11 @@ captured case's (stage 2 reads only its register); an edge without `advance` mus
 from __future__ import annotations
 
 import random
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 try:
     import cocotb

@@ -15,6 +15,7 @@ import json
 from pathlib import Path
 
 from evclust.clusterer.layout import FLAG_BORDER, FLAG_MOVING_INT, FLAG_MOVING_MCM, FLAG_NEW
+from evclust.documents import write_section
 from evclust.fixed.registers import SATURATING_SIGNALS
 
 COVERAGE_DIR = Path("build") / "coverage"
@@ -116,15 +117,6 @@ def markdown(bins: dict[str, int], runs: int) -> list[str]:
 BEGIN, END = "<!-- coverage:begin -->", "<!-- coverage:end -->"
 
 
-def write_section(doc: Path, lines: list[str]) -> None:
-    text = doc.read_text()
-    if BEGIN not in text or END not in text:
-        raise SystemExit(f"{doc}: no {BEGIN} ... {END} section to replace")
-    head, rest = text.split(BEGIN, 1)
-    _, tail = rest.split(END, 1)
-    doc.write_text(head + BEGIN + "\n" + "\n".join(lines) + "\n" + END + tail)
-
-
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="python -m evclust.rtl.coverage", description=__doc__.splitlines()[0])
     parser.add_argument("--dir", type=Path, default=COVERAGE_DIR, help="the saved runs (default build/coverage)")
@@ -135,7 +127,7 @@ def main(argv=None) -> int:
         raise SystemExit(f"{args.dir}: no saved runs; run the co-simulation first (make cosim-full)")
     lines = markdown(bins, runs)
     if args.write:
-        write_section(args.write, lines)
+        write_section(args.write, "\n".join([BEGIN, *lines, END]), BEGIN, END, append=False)
     print("\n".join(lines))
     return 1 if holes(bins) or unexpected(bins) else 0
 
