@@ -34,6 +34,8 @@ BENCHES = {
     "evclust_update": ((), TB_DIR.parent / "evclust_update", "test_evclust_update"),
     "evclust_commit": ((), TB_DIR.parent / "evclust_commit", "test_evclust_commit"),
     "evclust_stage_reg": ((), TB_DIR.parent / "evclust_stage_reg", "test_evclust_stage_reg"),
+    "evclust_pipediv": ((), TB_DIR.parent / "evclust_pipediv", "test_evclust_pipediv"),
+    "evclust_udiv": ((), TB_DIR.parent / "evclust_udiv", "test_evclust_udiv"),
 }
 
 
