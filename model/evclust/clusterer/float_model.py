@@ -18,6 +18,7 @@ from evclust.clusterer.layout import (
     PD_T, PD_VMX, PD_VMY, PD_VOTE, PY, REPORTED, RX, RY, SINCE_FILTER, STEP, T_FILTER, T_LAST, VALID, VI_COUNT, VIX, VIY, VMX,
     VMY,
 )  # fmt: skip
+from evclust.clusterer.params import GAMMA_MODES
 from evclust.jit import njit
 
 # The parameter vector the compiled loop reads (built by `param_vector`).
@@ -39,7 +40,6 @@ LN2 = math.log(2.0)
 PRECISION_SIGNALS = ("centre", "half_size", "activity", "v_mcm", "mcm_norm", "v_int", "colour", "background", "gamma", "decay_table")
 Q_CENTRE, Q_HALF, Q_ACT, Q_VM, Q_NORM, Q_VI, Q_COLOUR, Q_BG, Q_GAMMA, Q_DECAY = range(len(PRECISION_SIGNALS))
 P_FRAC, P_LO, P_HI, P_NEAREST = range(4)  # precision columns: fraction bits (-1: exact), range, rounding
-GAMMA_MODES = ("global", "activity", "count")
 GAMMA_GLOBAL, GAMMA_ACTIVITY, GAMMA_COUNT = range(3)
 
 

@@ -32,6 +32,9 @@ class PaletteEntry(BaseModel):
     rgb: tuple[Byte, Byte, Byte]
 
 
+# γ's modes, in the order of their codes in both models and the RTL (GAMMA_MODE_* in the header).
+GAMMA_MODES = ("global", "activity", "count")
+
 MAX_WARMUP = 64  # the interval filter's running mean covers at most this many measurements
 
 DEFAULT_PALETTE = tuple(PaletteEntry(name=c.name, rgb=c.rgb) for c in NAMED_COLOURS)
@@ -70,7 +73,7 @@ class ClustererParams(BaseModel):
     # global: the paper's γ. activity: γ_i = A_i·ln2·T_frame/T_half, refreshed at filter steps.
     # count (beyond the paper): γ_i = the cluster's events in the last τ · T_frame/τ, which does not
     # follow the bursts inside a frame (activity with a short T_half does, and biases V_MCM).
-    gamma_mode: Literal["global", "activity", "count"] = "count"
+    gamma_mode: Literal[GAMMA_MODES] = "count"
     alpha_vel_int: Alpha = 0.583
     tau_us: Positive | None = None  # τ in µs; when not set, tau_frames frame periods (rounded to whole µs)
     tau_frames: Positive = 4.25

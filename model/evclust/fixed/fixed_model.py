@@ -19,7 +19,8 @@ from evclust.clusterer.layout import (
     T_LAST, VALID, VI_COUNT, VIX, VIY, VMX, VMY,
 )  # fmt: skip
 from evclust.fixed.arith import FLOOR, NEAREST, alpha_increment_nb, alpha_step_nb, decay_apply_nb, decay_nb, decay_steps_nb
-from evclust.fixed.formats import DECAY_FRAC_BITS, DECAY_TABLE_BITS, GAMMA_MODES, NOISE_GATE_FRAC_BITS, SCALE_FRAC_BITS
+from evclust.clusterer.params import GAMMA_MODES
+from evclust.fixed.formats import DECAY_FRAC_BITS, DECAY_TABLE_BITS, NOISE_GATE_FRAC_BITS, SCALE_FRAC_BITS
 from evclust.jit import njit
 
 TIME_MASK = (1 << 32) - 1

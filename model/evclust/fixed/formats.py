@@ -14,7 +14,7 @@ import math
 from typing import Literal
 
 from evclust.clusterer.objects import DT_MAX_US, object_time_us
-from evclust.clusterer.params import ClustererParams
+from evclust.clusterer.params import GAMMA_MODES, ClustererParams
 from evclust.errors import EvclustError
 
 Rounding = Literal["floor", "nearest", "trunc"]
@@ -487,7 +487,6 @@ OPTIONAL_CONSTANTS = (
 
 
 # The codes of clusterer.gamma_mode, in the model's constant vector and the RTL's header.
-GAMMA_MODES = ("global", "activity", "count")
 
 
 def table_options(p: ClustererParams, background: Format) -> tuple[tuple[str, int], ...]:
