@@ -36,6 +36,7 @@ BENCHES = {
     "evclust_stage_reg": ((), TB_DIR.parent / "evclust_stage_reg", "test_evclust_stage_reg"),
     "evclust_pipediv": ((), TB_DIR.parent / "evclust_pipediv", "test_evclust_pipediv"),
     "evclust_udiv": ((), TB_DIR.parent / "evclust_udiv", "test_evclust_udiv"),
+    "evclust_regs": ((), TB_DIR.parent / "evclust_regs", "test_evclust_regs"),
 }
 
 
