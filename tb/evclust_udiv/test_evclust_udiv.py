@@ -50,31 +50,31 @@ if cocotb is not None:
             den = rng.choice((1, (1 << den_w) - 1)) if edge else rng.randrange(1, 1 << den_w)
             return num, den
 
-        checked = 0
-        for division in range(DIVISIONS):
-            for _ in range(rng.randrange(3)):  # a pause: done and the last result hold
+        async def cycles(n: int) -> None:
+            for _ in range(n):
                 await RisingEdge(dut.clk)
                 await FallingEdge(dut.clk)
+
+        async def start() -> tuple[int, int]:
+            """A start with new operands; then other operands on the inputs, which a busy divider ignores."""
             num, den = draw()
             dut.numerator.value, dut.denominator.value, dut.start.value = num, den, 1
-            await RisingEdge(dut.clk)
-            await FallingEdge(dut.clk)
+            await cycles(1)
             dut.start.value = 0
-            dut.numerator.value, dut.denominator.value = rng.getrandbits(num_w), rng.randrange(1, 1 << den_w)  # ignored while busy
+            dut.numerator.value, dut.denominator.value = rng.getrandbits(num_w), rng.randrange(1, 1 << den_w)
+            return num, den
+
+        checked = 0
+        for division in range(DIVISIONS):
+            await cycles(rng.randrange(3))  # a pause: done and the last result hold
+            num, den = await start()
             if rng.random() < 0.1:  # a start part way through: the new division replaces it
-                for _ in range(rng.randrange(1, num_w)):
-                    await RisingEdge(dut.clk)
-                    await FallingEdge(dut.clk)
-                num, den = draw()
-                dut.numerator.value, dut.denominator.value, dut.start.value = num, den, 1
-                await RisingEdge(dut.clk)
-                await FallingEdge(dut.clk)
-                dut.start.value = 0
+                await cycles(rng.randrange(1, num_w))
+                num, den = await start()
             for cycle in range(num_w):
                 if int(dut.done.value) != 0:
                     return f"division {division}: done after {cycle} of {num_w} cycles", checked
-                await RisingEdge(dut.clk)
-                await FallingEdge(dut.clk)
+                await cycles(1)
             got = (int(dut.done.value), int(dut.quotient.value), int(dut.remainder_out.value))
             want = (1, num // den, num % den)
             checked += 1
