@@ -58,7 +58,7 @@ def table(rows) -> str:
         fmax = f"{r['fmax_mhz']:.1f}" if r["fmax_mhz"] is not None else "does not fit"
         path = f"{cp['cells']} ({cp['carry_cells']}), {cp['logic_ns']:.1f} + {cp['routing_ns']:.1f}" if cp else "none"
         lines.append(
-            f"| {r['configuration']}{' (constants built in)' if r.get('static') else ''} | {r['n_clusters']} | {fmax} | {('yes' if r['routed'] else 'placement estimate') if cp else 'not placed'} | {pct('lut4')} | {pct('ff')} "
+            f"| {r['configuration']}{' (constants built in)' if r.get('static') else ''} | {r['n_clusters']} | {fmax} | {('yes' if r['routed'] else 'placement estimate') if r['fmax_mhz'] is not None else 'not placed'} | {pct('lut4')} | {pct('ff')} "
             f"| {pct('mult18')} | {pct('lutram_w')} | {pct('bram')} | {r['carry_cells']:,} | {'yes' if r['fits'] else '**no**'} "
             f"| {path} "
             f"| {(r['synth_s'] + r['pnr_s']) / 60:.0f} min |")  # fmt: skip
@@ -139,7 +139,9 @@ def section(rows) -> str:
     for r in rows:
         cp = r["critical_path"]
         if not cp:
-            lines.append(f"- {r['configuration']}, N = {r['n_clusters']}: not placed: the design needs more cells than the part has.")
+            why = ("placed, not routed: nextpnr reports no path before routing" if r["fmax_mhz"] is not None
+                   else "not placed: the design needs more cells than the part has")  # fmt: skip
+            lines.append(f"- {r['configuration']}, N = {r['n_clusters']}: {why}.")
             continue
         # The project's own lines (not Yosys's techmap files), file name and line, in path order.
         where = list(

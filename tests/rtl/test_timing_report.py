@@ -131,3 +131,41 @@ def test_a_run_may_stop_after_placement():
             assert bad in str(exc)
         else:
             raise AssertionError(f"{bad!r} accepted")
+
+
+def test_a_placement_only_run_gives_nextpnrs_estimate_from_its_log(tmp_path):
+    # Without routing nextpnr's report leaves `fmax` empty; the log has the estimate.
+    placed = json.loads(json.dumps(REPORT)) | {"fmax": {}}
+    (tmp_path / "report.json").write_text(json.dumps(placed))
+    (tmp_path / "nextpnr.log").write_text(
+        "Info: Max frequency for clock 'clk': 4.10 MHz (FAIL at 100.00 MHz)\n...\nInfo: Max frequency for clock 'clk': 5.70 MHz (FAIL at 100.00 MHz)\n"
+    )
+    assert _figures(tmp_path)["fmax_mhz"] == 5.7  # the last estimate: after the placer's refinement
+    (tmp_path / "nextpnr.log").write_text("Info: Program finished normally.\n")
+    try:
+        _figures(tmp_path)
+    except Exception as exc:  # EvclustError: a one-line reason naming the log
+        assert "no Fmax" in str(exc) and "nextpnr.log" in str(exc)
+    else:
+        raise AssertionError("a report and a log without Fmax must not give a figure")
+
+
+def test_a_finished_run_whose_figures_were_not_written_is_read_not_rerun(tmp_path, monkeypatch):
+    import os
+
+    from evclust.rtl import timing
+
+    header, sources = "// header\n", {"evclust_core.v": "module m; endmodule\n"}
+    monkeypatch.setattr(timing, "BUILD", tmp_path)
+    monkeypatch.setattr(timing, "tool_identity", lambda: "yowasp (stub)")
+    monkeypatch.setattr(timing, "_run", lambda *a: (_ for _ in ()).throw(AssertionError("the tools ran again")))
+    out = tmp_path / "timing" / f"check-{timing.cache_key(header, sources, False, 'yowasp (stub)', False)}"
+    out.mkdir(parents=True)
+    for name, text, when in (("synth.ys", "", 1000), ("netlist.json", "{}", 1300), ("report.json", json.dumps(REPORT), 2000),
+                             ("nextpnr.log", "Info: Program finished normally.\n", 2000)):  # fmt: skip
+        (out / name).write_text(text)
+        os.utime(out / name, (when, when))
+    figures = timing.place_and_route(header, "check", route=False, snapshot=(sources, "abc1234"))
+    assert figures["fmax_mhz"] == 87.5 and figures["cached"]
+    assert (figures["synth_s"], figures["pnr_s"]) == (300, 700)  # from the files' times
+    assert json.loads((out / "figures.json").read_text())["rtl"] == "abc1234"
