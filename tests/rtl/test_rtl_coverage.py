@@ -5,6 +5,10 @@ from __future__ import annotations
 
 import json
 
+import pytest
+
+from evclust.errors import EvclustError
+
 from evclust.fixed.registers import SATURATING_SIGNALS
 from evclust.rtl import coverage
 
@@ -49,7 +53,12 @@ def test_the_report_rewrites_only_its_section(tmp_path):
     doc = tmp_path / "doc.md"
     doc.write_text(f"before\n{coverage.BEGIN}\nold\n{coverage.END}\nafter\n")
     bins = coverage.run_bins(_fsm(INIT_to_IDLE=1), {}, [])
-    coverage.write_section(doc, coverage.markdown(bins, 1))
+    coverage.write_table(doc, coverage.markdown(bins, 1))
     text = doc.read_text()
     assert text.startswith("before\n") and text.endswith("after\n") and "old" not in text
+    other = tmp_path / "other.md"
+    other.write_text("no coverage section here\n")
+    with pytest.raises(EvclustError, match="no <!-- coverage:begin --> ... <!-- coverage:end --> section"):
+        coverage.write_table(other, [])
+    assert other.read_text() == "no coverage section here\n"
     assert "| arc | INIT -> IDLE | 1 |" in text and "| action | drops | 0 **hole** |" in text

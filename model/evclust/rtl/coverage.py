@@ -117,6 +117,11 @@ def markdown(bins: dict[str, int], runs: int) -> list[str]:
 BEGIN, END = "<!-- coverage:begin -->", "<!-- coverage:end -->"
 
 
+def write_table(doc: Path, lines: list[str]) -> None:
+    """The coverage table into `doc`'s coverage section (a document without one is an error)."""
+    write_section(doc, "\n".join([BEGIN, *lines, END]), BEGIN, END, append=False)
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="python -m evclust.rtl.coverage", description=__doc__.splitlines()[0])
     parser.add_argument("--dir", type=Path, default=COVERAGE_DIR, help="the saved runs (default build/coverage)")
@@ -127,7 +132,7 @@ def main(argv=None) -> int:
         raise SystemExit(f"{args.dir}: no saved runs; run the co-simulation first (make cosim-full)")
     lines = markdown(bins, runs)
     if args.write:
-        write_section(args.write, "\n".join([BEGIN, *lines, END]), BEGIN, END, append=False)
+        write_table(args.write, lines)
     print("\n".join(lines))
     return 1 if holes(bins) or unexpected(bins) else 0
 
