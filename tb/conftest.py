@@ -18,5 +18,5 @@ def pytest_terminal_summary(terminalreporter):
         rows, how = selected_rows()
         terminalreporter.write_line(f"switch cover: {len(rows)} of {len(cover())} rows ({how})")
     if not full():
-        terminalreporter.write_line(f"rotating shares (vector cases, streams, resets, built-in constants, broken proofs) drawn from "
+        terminalreporter.write_line(f"rotating shares (vector cases, streams, resets, built-in constants, palette builds, broken proofs) drawn from "
                                     f"{rotation_key()[:12]}; make test-full runs them all")  # fmt: skip

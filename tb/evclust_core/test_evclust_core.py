@@ -38,7 +38,7 @@ def _case_header(name: str) -> str:
 # and ROTATING_CASES more drawn from the commit hash for that simulator (tb/cosim.py's rotating
 # subset: successive commits cover them all); `make test-full` replays every case under both.
 ANCHOR_CASES = ("traffic_clip", "pipelined_traffic", "pipelined_eviction_voids", "table_full")
-ROTATING_CASES = 4
+ROTATING_CASES = 3
 
 
 def replayed_cases() -> list[tuple[str, str]]:

@@ -166,7 +166,7 @@ if cocotb is not None:
 # ------------------------------------------------------------------------------------------
 # pytest: build, launch, check.
 
-from cosim import configuration_params, run, selected_simulators  # noqa: E402
+from cosim import configuration_params, cosim_share, run, selected_simulators  # noqa: E402
 
 # Builds whose palette widths differ: the traffic preset (8 entries), and the defaults (every
 # addition on, the mixing rule's formats) on a suite-sized sensor.
@@ -194,8 +194,16 @@ def palette_build(name: str) -> tuple[str, dict, dict]:
     return verilog_header(table), widths, {"widths": widths, "k": [int(v) for v in model.k]}
 
 
-@pytest.mark.parametrize("build, stages", [("traffic", 1), ("defaults", 1), ("defaults", 2)])
-@pytest.mark.parametrize("sim", selected_simulators())
+# Verilator runs the three builds; Icarus, several times slower on these sweeps, one of them in
+# `make test`, drawn from the commit hash (all three in `make test-full`).
+LEAF_CASES = [("traffic", 1), ("defaults", 1), ("defaults", 2)]
+
+
+@pytest.mark.rotating
+@pytest.mark.parametrize(
+    "sim, build, stages",
+    [(sim, *case) for sim in selected_simulators() for case in cosim_share(LEAF_CASES, 3 if sim == "verilator" else 1, "palette", sim)],
+)
 def test_the_palette_class_and_vote_match_the_models_functions(sim, build, stages):
     header, parameters, config = palette_build(build)
     result = run(sim, header, "palette_vectors", config | {"seed": 11, "stages": stages}, toplevel="evclust_palette",
