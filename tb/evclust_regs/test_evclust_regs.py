@@ -16,6 +16,11 @@ import random
 
 import pytest
 
+from evclust.fixed.registers import (
+    CONFIG_BASE, COUNTER_INC_BITS, COUNTERS, COUNTERS_BASE, CTRL_CLEAR, CTRL_CLEAR_COUNTERS, ID_VALUE, REG_BUILD, REG_CTRL, REG_ID,
+    REG_IRQ_ENABLE, REG_STATUS, REG_VERSION, STATUS_DROPPED, STATUS_SATURATED, VERSION, config_fields, config_words,
+)  # fmt: skip
+
 try:
     import cocotb
     from cocotb.clock import Clock
@@ -33,8 +38,6 @@ class RegisterMap:
     """What the register file holds, from the register map (not from the RTL)."""
 
     def __init__(self, table, runtime: bool):
-        from evclust.fixed.registers import COUNTERS, config_fields, config_words
-
         self.runtime = runtime
         self.n_counters = len(COUNTERS)
         self.reset_words = [0] * config_words(table)
@@ -50,18 +53,12 @@ class RegisterMap:
         self.irq_enable = self.saturated = self.dropped = 0
 
     def count(self, increments: list[int]) -> None:
-        from evclust.fixed.registers import COUNTERS
-
         self.counters = [(c + i) & MASK for c, i in zip(self.counters, increments)]
         self.saturated |= any(i for name, i in zip(COUNTERS, increments) if name.startswith("sat_"))
         self.dropped |= increments[COUNTERS.index("drops")] != 0
 
     def write(self, address: int, data: int, strobe: int) -> int:
         """The write's effect; the number of CLEAR pulses it gives."""
-        from evclust.fixed.registers import (
-            CONFIG_BASE, CTRL_CLEAR, CTRL_CLEAR_COUNTERS, REG_CTRL, REG_IRQ_ENABLE, REG_STATUS, STATUS_DROPPED, STATUS_SATURATED,
-        )  # fmt: skip
-
         word = (address - CONFIG_BASE) // 4
         if address >= CONFIG_BASE and word < len(self.config) and self.runtime:
             keep = sum(0xFF << (8 * b) for b in range(4) if not strobe >> b & 1)
@@ -81,10 +78,6 @@ class RegisterMap:
         return 0
 
     def read(self, address: int, idle: int) -> int:
-        from evclust.fixed.registers import (
-            COUNTERS_BASE, CONFIG_BASE, ID_VALUE, REG_BUILD, REG_ID, REG_IRQ_ENABLE, REG_STATUS, REG_VERSION, VERSION,
-        )  # fmt: skip
-
         fixed = {REG_ID: ID_VALUE, REG_VERSION: VERSION, REG_BUILD: self.build, REG_IRQ_ENABLE: self.irq_enable,
                  REG_STATUS: idle | self.saturated << 1 | self.dropped << 2}  # fmt: skip
         if address in fixed:
@@ -111,7 +104,6 @@ if cocotb is not None:
         from cocotbext.axi import AxiLiteBus, AxiLiteMaster
 
         from evclust.fixed.formats import build_formats
-        from evclust.fixed.registers import COUNTER_INC_BITS, COUNTERS_BASE, CONFIG_BASE, REG_CTRL, REG_IRQ_ENABLE, REG_STATUS
         from evclust.rtl.configurations import configuration_params
 
         table = build_formats(configuration_params("traffic", 16), 480, 270, 50000.0)
