@@ -27,6 +27,7 @@ import sys
 import tempfile
 
 import numba
+import numpy as np
 
 _warned = False
 
@@ -98,3 +99,15 @@ def vectorize(signatures, **options):
         return numba.vectorize(signatures, **options)(func)
 
     return decorate
+
+
+def named_record(dtype: np.dtype, values: dict) -> np.record:
+    """One record of `dtype` holding `values` (every field, no other): what a compiled loop reads
+    as named constants (`k.r_min`), passed by reference like an array and mutable from Python."""
+    missing, extra = set(dtype.names) - set(values), set(values) - set(dtype.names)
+    if missing or extra:
+        raise ValueError(f"record fields: missing {sorted(missing)}, unknown {sorted(extra)}")
+    row = np.rec.array(np.zeros(1, dtype))
+    for name in dtype.names:
+        row[name] = values[name]
+    return row[0]

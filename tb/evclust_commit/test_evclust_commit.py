@@ -51,7 +51,6 @@ def increment_bits(header: str, width: str | None) -> int:
 def cases(model, header: str, seed: int):
     """(S, H, row) cases: a slot as it is now and a live update of it."""
     from evclust.clusterer import layout
-    from evclust.fixed import fixed_model
 
     rng = random.Random(seed)
     t, k = model.table, model.k
@@ -59,7 +58,7 @@ def cases(model, header: str, seed: int):
     def pick(lo: int, hi: int) -> int:
         return rng.choice((lo, hi, rng.randrange(lo, hi + 1), rng.randrange(lo, hi + 1)))
 
-    tops = {"PX": t["centre"].raw_max, "PY": t["centre"].raw_max, "RX": int(k[fixed_model.C_R_MAX]), "RY": int(k[fixed_model.C_R_MAX]),
+    tops = {"PX": t["centre"].raw_max, "PY": t["centre"].raw_max, "RX": int(k.r_max), "RY": int(k.r_max),
             "MCM_NORM": 1 << t["mcm_norm"].frac_bits, "CY": t["colour"].raw_max, "CCB": t["colour"].raw_max, "CCR": t["colour"].raw_max}  # fmt: skip
     hist_top = (1 << t["hist"].word_bits) - 1
     for _ in range(CASES):
@@ -67,7 +66,7 @@ def cases(model, header: str, seed: int):
         H = np.zeros((model.params.n_clusters, len(model.params.palette)), dtype=np.int64)
         s = rng.randrange(S.shape[0])
         for column, top in tops.items():
-            S[s, getattr(layout, column)] = pick(int(k[fixed_model.C_R_MIN]) if column in ("RX", "RY") else 0, top)
+            S[s, getattr(layout, column)] = pick(int(k.r_min) if column in ("RX", "RY") else 0, top)
         S[s, layout.VMX] = pick(t["v_mcm"].raw_min, t["v_mcm"].raw_max)
         S[s, layout.VMY] = pick(t["v_mcm"].raw_min, t["v_mcm"].raw_max)
         S[s, layout.ACT] = pick(0, t["activity"].raw_max)
@@ -114,13 +113,12 @@ if cocotb is not None:
 
     async def _commit_vectors(dut, config):
         from evclust.clusterer import layout
-        from evclust.fixed import fixed_model
 
         model = leaf_model(config["build"])
         header = Path(config["header"]).read_text()
         hist_bits = model.table["hist"].word_bits
-        dut.r_min.value = int(model.k[fixed_model.C_R_MIN])
-        dut.r_max.value = int(model.k[fixed_model.C_R_MAX])
+        dut.r_min.value = int(model.k.r_min)
+        dut.r_max.value = int(model.k.r_max)
         checked = 0
         for S, H, row in cases(model, header, config["seed"]):
             s = int(row[layout.PD_SLOT])

@@ -48,24 +48,26 @@ class Palette:
 
         from evclust.clusterer.layout import BG_CB, BG_CR, BG_Y
         from evclust.fixed import fixed_model as fm
+        from evclust.fixed.constants import DTYPE
+        from evclust.jit import named_record
 
         w = config["widths"]
         self.size = w["P"]
-        self.k = np.array(config["k"], np.int64)
-        self.k[fm.C_LUMA_W] = rng.randrange(1 << w["LUMA_BITS"])
-        self.k[fm.C_MIX_TOL] = rng.choice((0, rng.randrange(1 << w["TOL_BITS"]), (1 << w["TOL_BITS"]) - 1))
+        self.k = named_record(DTYPE, config["k"])
+        self.k.luma_weight = rng.randrange(1 << w["LUMA_BITS"])
+        self.k.mixing_tolerance = rng.choice((0, rng.randrange(1 << w["TOL_BITS"]), (1 << w["TOL_BITS"]) - 1))
         self.palette = np.array([[rng.randrange(256) for _ in range(3)] for _ in range(self.size)], np.int64)
         if rng.random() < 0.3:  # equal entries: ties go to the lower index
             self.palette[rng.randrange(self.size)] = self.palette[rng.randrange(self.size)]
         self.mask = np.array([rng.random() < 0.25 for _ in range(self.size)], np.bool_)
         self.G = np.zeros(fm.N_GLOBALS, np.int64)
-        bg_max = (255 << self.k[fm.C_FB]) | ((1 << self.k[fm.C_FB]) - 1)
+        bg_max = (255 << self.k.background_frac) | ((1 << self.k.background_frac) - 1)
         for column in (BG_Y, BG_CB, BG_CR):
             self.G[column] = rng.randrange(bg_max + 1)
         if rng.random() < 0.2:  # the background on an entry: |w|^2 = 0, whose 1/|w|^2 is 0
             j = rng.randrange(self.size)
             for column, channel in ((BG_Y, 0), (BG_CB, 1), (BG_CR, 2)):
-                self.G[column] = int(self.palette[j, channel]) << self.k[fm.C_FB]
+                self.G[column] = int(self.palette[j, channel]) << self.k.background_frac
         self.inv_ww = np.zeros(self.size, np.int64)
         fm.refresh_mixing(self.G, self.palette, self.inv_ww, self.k)
         self.bg = tuple(int(self.G[c]) for c in (BG_Y, BG_CB, BG_CR))
@@ -73,13 +75,13 @@ class Palette:
     def expect(self, lum: int, cb: int, cr: int, mixing: int, vote_contrast: int) -> tuple[int, int]:
         from evclust.fixed import fixed_model as fm
 
-        fb = int(self.k[fm.C_FB])
+        fb = int(self.k.background_frac)
         if mixing:
             bg = tuple(v >> fb for v in self.bg)
             c = fm._mixing_palette(lum, cb, cr, bg, self.palette, self.inv_ww, self.mask, self.k)
         else:
             c = fm._nearest_palette(lum, cb, cr, self.palette, self.k)
-        self.k[fm.C_VOTE_CONTRAST] = vote_contrast
+        self.k.vote_contrast = vote_contrast
         return int(c), int(fm.palette_vote(lum, cb, cr, self.G, self.k))
 
     def events(self, rng: random.Random):
@@ -92,9 +94,8 @@ class Palette:
                 yield tuple(colour)
         for _ in range(RANDOM_EVENTS):
             yield tuple(rng.randrange(256) for _ in range(3))
-        from evclust.fixed.fixed_model import C_FB
 
-        bg = [v >> int(self.k[C_FB]) for v in self.bg]
+        bg = [v >> int(self.k.background_frac) for v in self.bg]
         for _ in range(RANDOM_EVENTS):  # on a segment background -> entry, nudged
             j, q = rng.randrange(self.size), rng.random()
             yield tuple(min(255, max(0, round(b + q * (int(p) - b)) + rng.randint(-2, 2))) for b, p in zip(bg, self.palette[j]))
@@ -128,10 +129,9 @@ if cocotb is not None:
             dut.inv_ww.value = sum(int(pal.inv_ww[j]) << (inv_bits * j) for j in range(pal.size))
             dut.background_mask.value = sum(int(pal.mask[j]) << j for j in range(pal.size))
             dut.bg_y.value, dut.bg_cb.value, dut.bg_cr.value = pal.bg
-            from evclust.fixed.fixed_model import C_LUMA_W, C_MIX_TOL
 
-            dut.luma_weight.value = int(pal.k[C_LUMA_W])
-            dut.mixing_tolerance.value = int(pal.k[C_MIX_TOL])
+            dut.luma_weight.value = int(pal.k.luma_weight)
+            dut.mixing_tolerance.value = int(pal.k.mixing_tolerance)
             for lum, cb, cr in pal.events(rng):
                 dut.lum.value, dut.cb.value, dut.cr.value = lum, cb, cr
                 for mixing, vote_contrast in SWITCHES:
@@ -153,8 +153,8 @@ if cocotb is not None:
                     classes.add((mixing, got[0]))
                     if got != want:
                         error = (f"event ({lum}, {cb}, {cr}), mixing={mixing}, vote_contrast={vote_contrast}, palette "
-                                 f"{pal.palette.tolist()}, background {pal.bg}, mask {pal.mask.tolist()}, w_Y {pal.k[C_LUMA_W]}, "
-                                 f"tolerance {pal.k[C_MIX_TOL]}: RTL (class, vote) {got}, model {want}")  # fmt: skip
+                                 f"{pal.palette.tolist()}, background {pal.bg}, mask {pal.mask.tolist()}, w_Y {pal.k.luma_weight}, "
+                                 f"tolerance {pal.k.mixing_tolerance}: RTL (class, vote) {got}, model {want}")  # fmt: skip
                         break
                 if error:
                     break
@@ -180,6 +180,7 @@ def _width(constants: dict, name: str) -> int:
 
 def palette_build(name: str) -> tuple[str, dict, dict]:
     """(header, module parameters, cocotb configuration) of a build."""
+    from evclust.fixed.constants import DTYPE
     from evclust.fixed.header import verilog_header
     from evclust.fixed.model import FixedClusterer
 
@@ -191,7 +192,7 @@ def palette_build(name: str) -> tuple[str, dict, dict]:
     widths = {"P": size, "CLASS_W": max(1, (size - 1).bit_length()), "BG_BITS": table["background"].word_bits,
               "INV_BITS": table["inv_ww"].word_bits, "VOTE_BITS": table["vote"].word_bits,
               "LUMA_BITS": _width(c, "luma_weight"), "TOL_BITS": _width(c, "mixing_tolerance")}  # fmt: skip
-    return verilog_header(table), widths, {"widths": widths, "k": [int(v) for v in model.k]}
+    return verilog_header(table), widths, {"widths": widths, "k": {name: int(model.k[name]) for name in DTYPE.names}}
 
 
 # Verilator runs the three builds; Icarus, several times slower on these sweeps, one of them in

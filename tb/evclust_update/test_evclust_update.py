@@ -33,11 +33,10 @@ except ImportError:  # collected by pytest without cocotb: the pytest half still
     cocotb = None
 
 CASES = 3000
-# The module's constant ports: (port, the model's constant slot name, register width in the header).
-CONSTANTS = (("beta_pos", "C_B_POS", "CFG_BETA_POS_W"), ("size_gain", "C_GAIN", "CFG_SIZE_GAIN_W"),
-             ("beta_size", "C_B_SIZE", "CFG_BETA_SIZE_W"), ("r_min", "C_R_MIN", "CFG_R_MIN_W"),
-             ("r_max", "C_R_MAX", "CFG_R_MAX_W"), ("beta_vel_mcm", "C_B_VM", "CFG_BETA_VEL_MCM_W"),
-             ("beta_lum", "C_B_LUM", "CFG_BETA_LUM_W"), ("beta_chro", "C_B_CHRO", "CFG_BETA_CHRO_W"))  # fmt: skip
+# The module's constant ports, named as the model's constants (k.<port>): (port, register width in the header).
+CONSTANTS = (("beta_pos", "CFG_BETA_POS_W"), ("size_gain", "CFG_SIZE_GAIN_W"), ("beta_size", "CFG_BETA_SIZE_W"),
+             ("r_min", "CFG_R_MIN_W"), ("r_max", "CFG_R_MAX_W"), ("beta_vel_mcm", "CFG_BETA_VEL_MCM_W"),
+             ("beta_lum", "CFG_BETA_LUM_W"), ("beta_chro", "CFG_BETA_CHRO_W"))  # fmt: skip
 # The slot fields the module reads: (port, layout column).
 FIELDS = (("px", "PX"), ("py", "PY"), ("rx", "RX"), ("ry", "RY"), ("gamma", "GAMMA"), ("vmx", "VMX"), ("vmy", "VMY"),
           ("norm", "MCM_NORM"), ("col_y", "CY"), ("col_cb", "CCB"), ("col_cr", "CCR"))  # fmt: skip
@@ -52,7 +51,6 @@ def cases(model, header: str, seed: int):
     """(k, S, slot, event) cases: the model's constant vector (the build's, or random registers),
     a random table and an event."""
     from evclust.clusterer import layout
-    from evclust.fixed import fixed_model
 
     rng = random.Random(seed)
     t = model.table
@@ -65,15 +63,15 @@ def cases(model, header: str, seed: int):
     for n in range(CASES):
         k = model.k.copy()
         if n % 2:
-            for _, slot, register in CONSTANTS:
-                k[getattr(fixed_model, slot)] = pick(0, (1 << header_width(header, register)) - 1)
-            k[fixed_model.C_R_MIN], k[fixed_model.C_R_MAX] = sorted((k[fixed_model.C_R_MIN], k[fixed_model.C_R_MAX]))
+            for name, register in CONSTANTS:
+                k[name] = pick(0, (1 << header_width(header, register)) - 1)
+            k.r_min, k.r_max = sorted((k.r_min, k.r_max))
         S = np.zeros((model.params.n_clusters, len(layout.SLOT_COLUMNS)), dtype=np.int64)
         s = rng.randrange(S.shape[0])
         S[s, layout.PX] = pick(0, (width - 1) << fp)
         S[s, layout.PY] = pick(0, (height - 1) << fp)
-        S[s, layout.RX] = pick(int(k[fixed_model.C_R_MIN]), int(k[fixed_model.C_R_MAX]))
-        S[s, layout.RY] = pick(int(k[fixed_model.C_R_MIN]), int(k[fixed_model.C_R_MAX]))
+        S[s, layout.RX] = pick(int(k.r_min), int(k.r_max))
+        S[s, layout.RY] = pick(int(k.r_min), int(k.r_max))
         S[s, layout.GAMMA] = pick(0, t["gamma"].raw_max)
         S[s, layout.VMX] = pick(t["v_mcm"].raw_min, t["v_mcm"].raw_max)
         S[s, layout.VMY] = pick(t["v_mcm"].raw_min, t["v_mcm"].raw_max)
@@ -101,7 +99,7 @@ def model_update(model, k, S, s: int, event) -> dict:
         out[increment] = d
         out[new] = int(S[s, getattr(layout, column)]) + d
     for new in ("rx_new", "ry_new"):  # the size as written: clamped (the delayed commit clamps the sum)
-        out[new] = min(max(out[new], int(k[fixed_model.C_R_MIN])), int(k[fixed_model.C_R_MAX]))
+        out[new] = min(max(out[new], int(k.r_min)), int(k.r_max))
     return out
 
 
@@ -113,7 +111,6 @@ if cocotb is not None:
 
     async def _update_vectors(dut, config):
         from evclust.clusterer import layout
-        from evclust.fixed import fixed_model
 
         model = leaf_model(config["build"])
         header = Path(config["header"]).read_text()
@@ -125,8 +122,8 @@ if cocotb is not None:
 
         def apply(k, S, s, event, constants=True):
             if constants:
-                for port, slot, _ in CONSTANTS:
-                    getattr(dut, port).value = int(k[getattr(fixed_model, slot)])
+                for port, _ in CONSTANTS:
+                    getattr(dut, port).value = int(k[port])
             for port, column in FIELDS:
                 getattr(dut, port).value = int(S[s, getattr(layout, column)]) & ((1 << len(getattr(dut, port))) - 1)
             for port, value in zip(("ev_x", "ev_y", "lum", "cb", "cr"), event):
@@ -189,14 +186,8 @@ def test_the_cases_saturate_and_clamp():
     header = verilog_header(model.table)
     outs = []
     for k, S, s, event in cases(model, header, 11):
-        outs.append((model_update(model, k, S, s, event), int(k[model_constant("C_R_MIN")]), int(k[model_constant("C_R_MAX")])))
+        outs.append((model_update(model, k, S, s, event), int(k.r_min), int(k.r_max)))
     assert sum(o["mcm_saturations"] > 0 for o, _, _ in outs) > CASES // 50
     assert any(o["rx_new"] == lo and o["d_rx"] < 0 for o, lo, _ in outs)
     assert any(o["rx_new"] == hi and o["d_rx"] > 0 for o, _, hi in outs)
     assert any(o["d_px"] < 0 for o, _, _ in outs) and any(o["d_px"] > 0 for o, _, _ in outs)
-
-
-def model_constant(name: str) -> int:
-    from evclust.fixed import fixed_model
-
-    return getattr(fixed_model, name)

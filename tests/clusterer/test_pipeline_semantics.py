@@ -14,7 +14,6 @@ from evclust.clusterer.layout import ACT, EV_COUNT, MERGED, PX, PY, VALID
 from evclust.clusterer.run import FloatClusterer
 from evclust.errors import EvclustError
 from evclust.events import EVENT_DTYPE
-from evclust.fixed import fixed_model
 from evclust.fixed.model import FixedClusterer
 from evclust.rtl.sources import params_header
 
@@ -64,7 +63,7 @@ def test_the_float_centre_follows_the_delayed_lms_recurrence(delay):
 @pytest.mark.parametrize("delay", [0, 2, 8])
 def test_the_fixed_centre_follows_the_delayed_lms_recurrence_bit_for_bit(delay):
     c, s = pull(delay, FixedClusterer)
-    fp, beta, bits = int(c.k[fixed_model.C_FP]), int(c.k[fixed_model.C_B_POS]), int(c.k[fixed_model.C_BB_POS])
+    fp, beta, bits = int(c.k.centre_frac), int(c.k.beta_pos), int(c.k.beta_pos_frac)
     # P += floor(((e << F_P) - P) * beta / 2^bits): Python's >> floors as the datapath does.
     expected = delayed_lms(delay, lambda e, p: (((e << fp) - p) * beta) >> bits, START << fp, TARGET)
     assert int(c.slots[s, PX]) == expected[-1]

@@ -18,19 +18,8 @@ from evclust.clusterer.layout import (
     PD_T, PD_VMX, PD_VMY, PD_VOTE, PY, REPORTED, RX, RY, SINCE_FILTER, STEP, T_FILTER, T_LAST, VALID, VI_COUNT, VIX, VIY, VMX,
     VMY,
 )  # fmt: skip
-from evclust.clusterer.params import GAMMA_MODES
 from evclust.jit import njit
 
-# The parameter vector the compiled loop reads (built by `param_vector`).
-(
-    K_SEEK, K_R_INIT, K_R_MIN, K_R_MAX, K_GAIN, B_POS, B_SIZE, K_T_HALF, K_A_MIN, K_A_VALID, K_EVERY,
-    B_VM, K_GAMMA, K_GAMMA_MODE, B_VI, K_TAU, K_T_FRAME, B_LUM, B_CHRO, B_BG, K_P, K_BG_FIXED,
-    K_LUMA_W, K_H_MAX, K_V_MIN, K_EXIT_M, K_V_EXIT, K_COS_EXIT, K_WIDTH, K_HEIGHT, K_COLOUR,
-    K_WARM_START, K_MCM_CORRECT, K_VOTE_CONTRAST, K_ASSIGN_MIXING, K_MIX_TOL,
-    K_SEEK_SCALE, K_MERGE, K_MERGE_SCALE, K_MERGE_V_TOL, K_MERGE_V_REL, K_NOISE_GATE,
-    K_SUPPORT, K_SUPPORT_BITS, K_SUPPORT_WINDOW, K_VI_CAP,
-) = range(46)  # fmt: skip
-N_PARAMS = 46
 LN2 = math.log(2.0)
 
 # Quantisation points: the stores of the signals the formats table gives a format to. With a
@@ -41,28 +30,6 @@ PRECISION_SIGNALS = ("centre", "half_size", "activity", "v_mcm", "mcm_norm", "v_
 Q_CENTRE, Q_HALF, Q_ACT, Q_VM, Q_NORM, Q_VI, Q_COLOUR, Q_BG, Q_GAMMA, Q_DECAY = range(len(PRECISION_SIGNALS))
 P_FRAC, P_LO, P_HI, P_NEAREST = range(4)  # precision columns: fraction bits (-1: exact), range, rounding
 GAMMA_GLOBAL, GAMMA_ACTIVITY, GAMMA_COUNT = range(3)
-
-
-def param_vector(p, width: int, height: int, t_frame_us: float, has_colour: bool) -> np.ndarray:
-    v = np.zeros(N_PARAMS)
-    v[K_SEEK], v[K_R_INIT], v[K_R_MIN], v[K_R_MAX], v[K_GAIN] = p.seek_margin, p.r_init, p.r_min, p.r_max, p.size_gain
-    v[B_POS], v[B_SIZE] = 1 - p.alpha_pos, 1 - p.alpha_size
-    v[K_T_HALF], v[K_A_MIN], v[K_A_VALID], v[K_EVERY] = p.t_half_us, p.a_min, p.a_valid, p.filter_every
-    v[B_VM], v[K_GAMMA], v[K_GAMMA_MODE] = 1 - p.alpha_vel_mcm, p.gamma, GAMMA_MODES.index(p.gamma_mode)
-    v[B_VI], v[K_TAU], v[K_T_FRAME] = 1 - p.alpha_vel_int, p.tau_us, t_frame_us
-    v[B_LUM], v[B_CHRO], v[B_BG], v[K_P] = 1 - p.alpha_lum, 1 - p.alpha_chro, 1 - p.alpha_bg, p.p_correction
-    v[K_BG_FIXED], v[K_LUMA_W], v[K_H_MAX] = p.background is not None, p.luma_weight, (1 << p.hist_bits) - 1
-    v[K_V_MIN], v[K_EXIT_M], v[K_V_EXIT] = p.v_min, p.exit_margin, p.v_exit
-    v[K_COS_EXIT] = math.cos(math.radians(p.theta_exit_deg))
-    v[K_WIDTH], v[K_HEIGHT], v[K_COLOUR] = width, height, has_colour
-    v[K_WARM_START], v[K_MCM_CORRECT] = p.velocity_warm_start, p.mcm_bias_correction
-    v[K_VOTE_CONTRAST] = p.palette_vote == "contrast"
-    v[K_ASSIGN_MIXING], v[K_MIX_TOL] = p.palette_assign == "mixing", p.mixing_tolerance
-    v[K_SEEK_SCALE], v[K_MERGE], v[K_MERGE_V_TOL], v[K_MERGE_V_REL] = p.seek_scale, p.merge, p.merge_v_tol, p.merge_v_rel
-    v[K_NOISE_GATE], v[K_MERGE_SCALE] = p.noise_gate, p.merge_scale
-    v[K_SUPPORT], v[K_SUPPORT_BITS], v[K_SUPPORT_WINDOW] = p.create_support, p.support_cell_bits, p.support_window_us
-    v[K_VI_CAP] = p.interval_warmup()
-    return v
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -92,9 +59,9 @@ def _gamma(activity, k):
     frame, A·ln2·T_frame/T_half (also the count mode's guess until its first full interval).
     Refreshed at filter steps only: per event, A's steps inside a burst of simultaneous events
     would correlate with where those events pull the centre and bias the estimate."""
-    if k[K_GAMMA_MODE] == GAMMA_GLOBAL:
-        return k[K_GAMMA]
-    return activity * LN2 * k[K_T_FRAME] / k[K_T_HALF]
+    if k.gamma_mode == GAMMA_GLOBAL:
+        return k.gamma
+    return activity * LN2 * k.t_frame_us / k.t_half_us
 
 
 @njit(cache=True, nogil=True)
@@ -132,7 +99,7 @@ def _mixing_palette(y, cb, cr, bg_y, bg_cb, bg_cr, palette, background_mask, lum
 @njit(cache=True, nogil=True, inline="always")
 def _margin(S, s, k):
     """The seek margin of a cluster: S, grown by seek_scale·max(Rx, Ry) (beyond the paper)."""
-    return k[K_SEEK] + k[K_SEEK_SCALE] * max(S[s, RX], S[s, RY])
+    return k.seek_margin + k.seek_scale * max(S[s, RX], S[s, RY])
 
 
 @njit(cache=True, nogil=True)
@@ -161,10 +128,10 @@ def _slot_for_new(S, G, t, k, precision):
             return s
     weakest, weakest_a = -1, np.inf
     for s in range(S.shape[0]):
-        a = _q(_decayed(S[s, ACT], t - S[s, T_LAST], k[K_T_HALF], precision), Q_ACT, precision)
+        a = _q(_decayed(S[s, ACT], t - S[s, T_LAST], k.t_half_us, precision), Q_ACT, precision)
         if a < weakest_a:
             weakest, weakest_a = s, a
-    if weakest_a < k[K_A_VALID]:
+    if weakest_a < k.a_valid:
         G[EVICTED] += 1
         return weakest
     return -1
@@ -178,7 +145,7 @@ def _create(S, H, G, s, t, x, y, lum, cb, cr, k, precision):
     G[NEXT_ID] += 1
     S[s, PX], S[s, PY] = x, y
     S[s, PPX], S[s, PPY] = x, y
-    S[s, RX], S[s, RY] = k[K_R_INIT], k[K_R_INIT]
+    S[s, RX], S[s, RY] = k.r_init, k.r_init
     S[s, ACT] = 1.0
     S[s, GAMMA] = _q(_gamma(1.0, k), Q_GAMMA, precision)
     S[s, T_LAST] = t
@@ -194,30 +161,32 @@ def _increments(S, G, s, t, x, y, lum, cb, cr, k, palette, background_mask, prec
     row[PD_LIVE], row[PD_SLOT], row[PD_T] = 1.0, s, t
     px, py = S[s, PX], S[s, PY]
     # Eq. (1) on the centre: P_new = P + β_P (e - P).
-    row[PD_PX] = k[B_POS] * (x - px)
-    row[PD_PY] = k[B_POS] * (y - py)
+    row[PD_PX] = k.beta_pos * (x - px)
+    row[PD_PY] = k.beta_pos * (y - py)
     # Size: R += β_R (g_R |e - P| - R), clamped when committed.
-    row[PD_RX] = k[B_SIZE] * (k[K_GAIN] * abs(x - px) - S[s, RX])
-    row[PD_RY] = k[B_SIZE] * (k[K_GAIN] * abs(y - py) - S[s, RY])
+    row[PD_RX] = k.beta_size * (k.size_gain * abs(x - px) - S[s, RX])
+    row[PD_RY] = k.beta_size * (k.size_gain * abs(y - py) - S[s, RY])
     # Eq. (5), MCM: V += β_vm (γ (P_new - P) - V).
     gamma = S[s, GAMMA]
     px_new, py_new = _q(px + row[PD_PX], Q_CENTRE, precision), _q(py + row[PD_PY], Q_CENTRE, precision)
-    row[PD_VMX] = k[B_VM] * (gamma * (px_new - px) - S[s, VMX])
-    row[PD_VMY] = k[B_VM] * (gamma * (py_new - py) - S[s, VMY])
+    row[PD_VMX] = k.beta_vel_mcm * (gamma * (px_new - px) - S[s, VMX])
+    row[PD_VMY] = k.beta_vel_mcm * (gamma * (py_new - py) - S[s, VMY])
     # The same filter on a constant 1 gives 1 - α^n: the weight V has gathered since V = 0.
-    row[PD_NORM] = k[B_VM] * (1.0 - S[s, MCM_NORM])
-    if k[K_COLOUR] != 0.0:
+    row[PD_NORM] = k.beta_vel_mcm * (1.0 - S[s, MCM_NORM])
+    if k.has_colour != 0.0:
         # Eq. (10): colour mean shift, luminance and chrominance with their own β.
-        row[PD_CY] = k[B_LUM] * (lum - S[s, CY])
-        row[PD_CCB] = k[B_CHRO] * (cb - S[s, CCB])
-        row[PD_CCR] = k[B_CHRO] * (cr - S[s, CCR])
+        row[PD_CY] = k.beta_lum * (lum - S[s, CY])
+        row[PD_CCB] = k.beta_chro * (cb - S[s, CCB])
+        row[PD_CCR] = k.beta_chro * (cr - S[s, CCR])
         # §7.2.2: the event's palette class and vote.
-        if k[K_ASSIGN_MIXING] != 0.0:
-            row[PD_CLASS] = _mixing_palette(lum, cb, cr, G[BG_Y], G[BG_CB], G[BG_CR], palette, background_mask, k[K_LUMA_W], k[K_MIX_TOL])
+        if k.mixing != 0.0:
+            row[PD_CLASS] = _mixing_palette(
+                lum, cb, cr, G[BG_Y], G[BG_CB], G[BG_CR], palette, background_mask, k.luma_weight, k.mixing_tolerance
+            )
         else:
-            row[PD_CLASS] = _nearest_palette(lum, cb, cr, palette, k[K_LUMA_W])
+            row[PD_CLASS] = _nearest_palette(lum, cb, cr, palette, k.luma_weight)
         row[PD_VOTE] = 1.0
-        if k[K_VOTE_CONTRAST] != 0.0:
+        if k.vote_contrast != 0.0:
             row[PD_VOTE] = int(abs(lum - G[BG_Y]) + abs(cb - G[BG_CB]) + abs(cr - G[BG_CR]) + 0.5)
 
 
@@ -228,21 +197,21 @@ def _commit(S, H, G, row, k, precision):
     paper's update exactly. Then the event's background-colour update (step 4)."""
     if row[PD_LIVE] != 0.0:
         s, t = int(row[PD_SLOT]), row[PD_T]
-        a = _q(_decayed(S[s, ACT], t - S[s, T_LAST], k[K_T_HALF], precision), Q_ACT, precision) + 1.0
+        a = _q(_decayed(S[s, ACT], t - S[s, T_LAST], k.t_half_us, precision), Q_ACT, precision) + 1.0
         S[s, ACT] = _q(a, Q_ACT, precision)
-        S[s, RX] = min(max(_q(S[s, RX] + row[PD_RX], Q_HALF, precision), k[K_R_MIN]), k[K_R_MAX])
-        S[s, RY] = min(max(_q(S[s, RY] + row[PD_RY], Q_HALF, precision), k[K_R_MIN]), k[K_R_MAX])
+        S[s, RX] = min(max(_q(S[s, RX] + row[PD_RX], Q_HALF, precision), k.r_min), k.r_max)
+        S[s, RY] = min(max(_q(S[s, RY] + row[PD_RY], Q_HALF, precision), k.r_min), k.r_max)
         S[s, VMX] = _q(S[s, VMX] + row[PD_VMX], Q_VM, precision)
         S[s, VMY] = _q(S[s, VMY] + row[PD_VMY], Q_VM, precision)
         S[s, MCM_NORM] = _q(min(S[s, MCM_NORM] + row[PD_NORM], 1.0), Q_NORM, precision)  # (a weight: at most 1)
         S[s, PX] = _q(S[s, PX] + row[PD_PX], Q_CENTRE, precision)
         S[s, PY] = _q(S[s, PY] + row[PD_PY], Q_CENTRE, precision)
-        if k[K_COLOUR] != 0.0:
+        if k.has_colour != 0.0:
             S[s, CY] = _q(S[s, CY] + row[PD_CY], Q_COLOUR, precision)
             S[s, CCB] = _q(S[s, CCB] + row[PD_CCB], Q_COLOUR, precision)
             S[s, CCR] = _q(S[s, CCR] + row[PD_CCR], Q_COLOUR, precision)
             # Count the event's class; halve all counters when one saturates.
-            c, h_max = int(row[PD_CLASS]), np.int64(k[K_H_MAX])
+            c, h_max = int(row[PD_CLASS]), np.int64(k.hist_max)
             H[s, c] = min(H[s, c] + np.int64(row[PD_VOTE]), h_max)
             if H[s, c] >= h_max:
                 for j in range(H.shape[1]):
@@ -275,14 +244,14 @@ def _cancel(line, s):
 
 @njit(cache=True, nogil=True, inline="always")
 def _near_border(px, py, k):
-    m = k[K_EXIT_M]
-    return px < m or px > k[K_WIDTH] - 1.0 - m or py < m or py > k[K_HEIGHT] - 1.0 - m
+    m = k.exit_margin
+    return px < m or px > k.width - 1.0 - m or py < m or py > k.height - 1.0 - m
 
 
 @njit(cache=True, nogil=True, inline="always")
 def _mcm_velocity(S, s, k):
     """V_MCM as reported: optionally divided by 1 - α^n, which removes the pull of V's zero start."""
-    if k[K_MCM_CORRECT] != 0.0 and S[s, MCM_NORM] > 0.0:
+    if k.mcm_correct != 0.0 and S[s, MCM_NORM] > 0.0:
         return S[s, VMX] / S[s, MCM_NORM], S[s, VMY] / S[s, MCM_NORM]
     return S[s, VMX], S[s, VMY]
 
@@ -293,16 +262,16 @@ def _exiting(S, s, k):
     px, py = S[s, PX], S[s, PY]
     vx, vy = _mcm_velocity(S, s, k)
     speed = math.hypot(vx, vy)
-    if speed < k[K_V_EXIT] or speed == 0.0:
+    if speed < k.v_exit or speed == 0.0:
         return False
-    m = k[K_EXIT_M]
-    limit = speed * k[K_COS_EXIT]
+    m = k.exit_margin
+    limit = speed * k.cos_exit
     # Outward normals: left (-1, 0), right (1, 0), top (0, -1), bottom (0, 1); y grows downwards.
     return (
         (px < m and -vx >= limit)
-        or (px > k[K_WIDTH] - 1.0 - m and vx >= limit)
+        or (px > k.width - 1.0 - m and vx >= limit)
         or (py < m and -vy >= limit)
-        or (py > k[K_HEIGHT] - 1.0 - m and vy >= limit)
+        or (py > k.height - 1.0 - m and vy >= limit)
     )
 
 
@@ -313,14 +282,14 @@ def _mergeable(S, s, j, k):
     their larger half-sizes overlap and both have measured velocities that agree."""
     dx, dy = abs(S[s, PX] - S[j, PX]), abs(S[s, PY] - S[j, PY])
     sx, sy = S[s, RX] + S[j, RX], S[s, RY] + S[j, RY]
-    grow = k[K_MERGE_SCALE] * (max(S[s, RX], S[s, RY]) + max(S[j, RX], S[j, RY]))
+    grow = k.merge_scale * (max(S[s, RX], S[s, RY]) + max(S[j, RX], S[j, RY]))
     if dx > sx + grow or dy > sy + grow:
         return False
     measured = S[s, VI_COUNT] >= 2.0 and S[j, VI_COUNT] >= 2.0
     if measured:
         dv = abs(S[s, VIX] - S[j, VIX]) + abs(S[s, VIY] - S[j, VIY])
         fast = max(abs(S[s, VIX]) + abs(S[s, VIY]), abs(S[j, VIX]) + abs(S[j, VIY]))
-        return dv <= k[K_MERGE_V_TOL] + k[K_MERGE_V_REL] * fast
+        return dv <= k.merge_v_tol + k.merge_v_rel * fast
     return dx <= sx and dy <= sy
 
 
@@ -339,8 +308,8 @@ def _merge(S, H, G, s, j, k, precision):
     lo_x, hi_x = min(S[s, PX] - S[s, RX], S[j, PX] - S[j, RX]), max(S[s, PX] + S[s, RX], S[j, PX] + S[j, RX])
     lo_y, hi_y = min(S[s, PY] - S[s, RY], S[j, PY] - S[j, RY]), max(S[s, PY] + S[s, RY], S[j, PY] + S[j, RY])
     # (kept inside the sensor: a young cluster's previous centre may not move out of the view)
-    ppx = min(max(S[survivor, PPX] + (px - S[survivor, PX]), 0.0), k[K_WIDTH] - 1.0)
-    ppy = min(max(S[survivor, PPY] + (py - S[survivor, PY]), 0.0), k[K_HEIGHT] - 1.0)
+    ppx = min(max(S[survivor, PPX] + (px - S[survivor, PX]), 0.0), k.width - 1.0)
+    ppy = min(max(S[survivor, PPY] + (py - S[survivor, PY]), 0.0), k.height - 1.0)
     act = _q(a_s + a_j, Q_ACT, precision)
     count = S[s, EV_COUNT] + S[j, EV_COUNT]
     if survivor == j:
@@ -349,8 +318,8 @@ def _merge(S, H, G, s, j, k, precision):
         H[s, :] = H[j, :]
         S[s, T_LAST] = t_last
     S[s, PX], S[s, PY], S[s, PPX], S[s, PPY] = px, py, ppx, ppy
-    S[s, RX] = min(_q((hi_x - lo_x) / 2, Q_HALF, precision), k[K_R_MAX])
-    S[s, RY] = min(_q((hi_y - lo_y) / 2, Q_HALF, precision), k[K_R_MAX])
+    S[s, RX] = min(_q((hi_x - lo_x) / 2, Q_HALF, precision), k.r_max)
+    S[s, RY] = min(_q((hi_y - lo_y) / 2, Q_HALF, precision), k.r_max)
     S[s, ACT], S[s, EV_COUNT] = act, count
     S[j, VALID] = 0.0
     G[MERGED] += 1
@@ -360,48 +329,48 @@ def _merge(S, H, G, s, j, k, precision):
 def _filter_step(S, H, G, t, k, palette, background_mask, out, n_out, precision):
     """Every N_f events: decay, free, interval velocity, noise and exit decisions, records."""
     # τ boundaries crossed since the last step: usually 0 or 1, more when events are sparse.
-    boundaries = math.floor((t - G[T_FIRST]) / k[K_TAU]) - math.floor((G[T_FILTER] - G[T_FIRST]) / k[K_TAU])
+    boundaries = math.floor((t - G[T_FIRST]) / k.tau_us) - math.floor((G[T_FILTER] - G[T_FIRST]) / k.tau_us)
     interval_due = boundaries > 0
-    per_frame = k[K_T_FRAME] / (max(boundaries, 1) * k[K_TAU])  # T_frame over the time measured
-    v_min = k[K_V_MIN]
-    G[BG_ACT] = _q(_decayed(G[BG_ACT], t - G[BG_T], k[K_T_HALF], precision), Q_ACT, precision)
+    per_frame = k.t_frame_us / (max(boundaries, 1) * k.tau_us)  # T_frame over the time measured
+    v_min = k.v_min
+    G[BG_ACT] = _q(_decayed(G[BG_ACT], t - G[BG_T], k.t_half_us, precision), Q_ACT, precision)
     G[BG_T] = t
     for s in range(S.shape[0]):
         if S[s, VALID] == 0.0:
             continue
-        S[s, ACT] = _q(_decayed(S[s, ACT], t - S[s, T_LAST], k[K_T_HALF], precision), Q_ACT, precision)
+        S[s, ACT] = _q(_decayed(S[s, ACT], t - S[s, T_LAST], k.t_half_us, precision), Q_ACT, precision)
         S[s, T_LAST] = t
-        if S[s, ACT] < k[K_A_MIN]:
+        if S[s, ACT] < k.a_min:
             S[s, VALID] = 0.0
             G[EXPIRED] += 1
             continue
-        if k[K_MERGE] != 0.0:  # absorb every later slot that is the same object, lowest first
+        if k.merge != 0.0:  # absorb every later slot that is the same object, lowest first
             j = s + 1
             while j < S.shape[0]:
                 if S[j, VALID] != 0.0 and _mergeable(S, s, j, k):
                     _merge(S, H, G, s, j, k, precision)
                     j = s  # the merged box may now reach a slot passed over
                 j += 1
-        if k[K_GAMMA_MODE] != GAMMA_COUNT or S[s, VI_COUNT] == 0.0:
+        if k.gamma_mode != GAMMA_COUNT or S[s, VI_COUNT] == 0.0:
             S[s, GAMMA] = _q(_gamma(S[s, ACT], k), Q_GAMMA, precision)
         if interval_due:
-            if k[K_GAMMA_MODE] == GAMMA_COUNT and S[s, VI_COUNT] >= 1.0:
+            if k.gamma_mode == GAMMA_COUNT and S[s, VI_COUNT] >= 1.0:
                 S[s, GAMMA] = _q(S[s, EV_COUNT] * per_frame, Q_GAMMA, precision)  # events per frame since the last boundary
             S[s, EV_COUNT] = 0.0
             # Eq. (4): V_RI += β_vi ((P - P_prev) · T_frame / τ - V_RI); P_prev = P.
             mx = _q((S[s, PX] - S[s, PPX]) * per_frame, Q_VI, precision)
             my = _q((S[s, PY] - S[s, PPY]) * per_frame, Q_VI, precision)
             n = S[s, VI_COUNT]  # full intervals measured before this one, plus one
-            if k[K_WARM_START] == 0.0 or n >= k[K_VI_CAP]:
-                S[s, VIX] = _q(S[s, VIX] + k[B_VI] * (mx - S[s, VIX]), Q_VI, precision)
-                S[s, VIY] = _q(S[s, VIY] + k[B_VI] * (my - S[s, VIY]), Q_VI, precision)
+            if k.warm_start == 0.0 or n >= k.interval_warmup:
+                S[s, VIX] = _q(S[s, VIX] + k.beta_vel_int * (mx - S[s, VIX]), Q_VI, precision)
+                S[s, VIY] = _q(S[s, VIY] + k.beta_vel_int * (my - S[s, VIY]), Q_VI, precision)
             elif n == 1.0:  # the first full interval: take it as it is
                 S[s, VIX], S[s, VIY] = mx, my
             elif n >= 2.0:  # the running mean of the first measurements, until 1/n falls to β
                 S[s, VIX] = _q(S[s, VIX] + (mx - S[s, VIX]) / n, Q_VI, precision)
                 S[s, VIY] = _q(S[s, VIY] + (my - S[s, VIY]) / n, Q_VI, precision)
             # (VI_COUNT 0: the cluster was born inside this interval; its displacement is partial.)
-            S[s, VI_COUNT] = min(n + 1.0, max(k[K_VI_CAP], 2.0))
+            S[s, VI_COUNT] = min(n + 1.0, max(k.interval_warmup, 2.0))
             S[s, PPX], S[s, PPY] = S[s, PX], S[s, PY]
         if _exiting(S, s, k):
             S[s, VALID] = 0.0
@@ -411,13 +380,13 @@ def _filter_step(S, H, G, t, k, palette, background_mask, out, n_out, precision)
         moving_mcm = math.hypot(S[s, VMX], S[s, VMY]) >= v_min
         vmx, vmy = _mcm_velocity(S, s, k)
         moving_int = math.hypot(S[s, VIX], S[s, VIY]) >= v_min
-        reported = S[s, ACT] >= k[K_A_VALID] and (moving_mcm or moving_int)
-        if reported and k[K_NOISE_GATE] > 0.0:
+        reported = S[s, ACT] >= k.a_valid and (moving_mcm or moving_int)
+        if reported and k.noise_gate > 0.0:
             # Beyond the paper: the background's events spread over the sensor would give the
             # box A_bg·(box area / sensor area); an object's cluster holds noise_gate times more.
             box = (2.0 * math.floor(S[s, RX]) + 1.0) * (2.0 * math.floor(S[s, RY]) + 1.0)  # its pixels
-            reported = S[s, ACT] * k[K_WIDTH] * k[K_HEIGHT] >= k[K_NOISE_GATE] * G[BG_ACT] * box
-        if S[s, ACT] >= k[K_A_VALID] and not reported:
+            reported = S[s, ACT] * k.width * k.height >= k.noise_gate * G[BG_ACT] * box
+        if S[s, ACT] >= k.a_valid and not reported:
             G[NOISE] += 1
         S[s, REPORTED] = 1.0 if reported else 0.0
         if not reported:
@@ -428,11 +397,11 @@ def _filter_step(S, H, G, t, k, palette, background_mask, out, n_out, precision)
         row[9], row[10], row[11], row[12] = vmx, vmy, S[s, VIX], S[s, VIY]
         cls = -1
         row[13], row[14], row[15] = 0.0, 0.0, 0.0  # no colour without TFS data
-        if k[K_COLOUR] != 0.0:
+        if k.has_colour != 0.0:
             # Eq. (11): C_obj = (C - BG) / p + BG, clamped to the byte range.
-            row[13] = min(max((S[s, CY] - G[BG_Y]) / k[K_P] + G[BG_Y], 0.0), 255.0)
-            row[14] = min(max((S[s, CCB] - G[BG_CB]) / k[K_P] + G[BG_CB], 0.0), 255.0)
-            row[15] = min(max((S[s, CCR] - G[BG_CR]) / k[K_P] + G[BG_CR], 0.0), 255.0)
+            row[13] = min(max((S[s, CY] - G[BG_Y]) / k.p_correction + G[BG_Y], 0.0), 255.0)
+            row[14] = min(max((S[s, CCB] - G[BG_CB]) / k.p_correction + G[BG_CB], 0.0), 255.0)
+            row[15] = min(max((S[s, CCR] - G[BG_CR]) / k.p_correction + G[BG_CR], 0.0), 255.0)
             best = 0
             for j in range(H.shape[1]):
                 if not background_mask[j] and H[s, j] > best:
@@ -475,11 +444,11 @@ def run_events(S, H, G, k, palette, background_mask, support, line, t_us, xs, ys
     of its latest event (-inf: none). `line` is the update delay line (D + 1 rows of
     layout.PENDING_COLUMNS): event n reads the table with the updates of events up to n - D - 1
     committed (creations at once), and every filter step first commits all."""
-    bits = int(k[K_SUPPORT_BITS])
+    bits = int(k.support_cell_bits)
     delay = line.shape[0] - 1
     n_out = 0
     first_step = G[STEP]
-    every = int(k[K_EVERY])
+    every = int(k.filter_every)
     for i in range(t_us.size):
         t = float(t_us[i])
         x, y = float(xs[i]), float(ys[i])
@@ -495,7 +464,7 @@ def run_events(S, H, G, k, palette, background_mask, support, line, t_us, xs, ys
         updated_reported = False
         cx, cy = (int(xs[i]) >> bits) + 1, (int(ys[i]) >> bits) + 1
         if s < 0:
-            if k[K_SUPPORT] != 0.0 and not _supported(support, cx, cy, t, k[K_SUPPORT_WINDOW]):
+            if k.create_support != 0.0 and not _supported(support, cx, cy, t, k.support_window_us):
                 G[UNSUPPORTED] += 1
             else:
                 s = _slot_for_new(S, G, t, k, precision)
@@ -507,17 +476,17 @@ def run_events(S, H, G, k, palette, background_mask, support, line, t_us, xs, ys
         else:
             _increments(S, G, s, t, x, y, lum, cb, cr, k, palette, background_mask, precision, row)
             updated_reported = S[s, REPORTED] != 0.0
-        if k[K_SUPPORT] != 0.0:
+        if k.create_support != 0.0:
             support[cy, cx] = t
         # Step 4: events that do not update a reported cluster track the background colour.
-        if not updated_reported and k[K_NOISE_GATE] > 0.0:  # the activity of the events no reported cluster takes
-            G[BG_ACT] = _q(_decayed(G[BG_ACT], t - G[BG_T], k[K_T_HALF], precision), Q_ACT, precision) + 1.0
+        if not updated_reported and k.noise_gate > 0.0:  # the activity of the events no reported cluster takes
+            G[BG_ACT] = _q(_decayed(G[BG_ACT], t - G[BG_T], k.t_half_us, precision), Q_ACT, precision) + 1.0
             G[BG_T] = t
-        if k[K_COLOUR] != 0.0 and k[K_BG_FIXED] == 0.0 and not updated_reported:
+        if k.has_colour != 0.0 and k.background_fixed == 0.0 and not updated_reported:
             row[PD_BG] = 1.0
-            row[PD_BG_Y] = k[B_BG] * (lum - G[BG_Y])
-            row[PD_BG_CB] = k[B_BG] * (cb - G[BG_CB])
-            row[PD_BG_CR] = k[B_BG] * (cr - G[BG_CR])
+            row[PD_BG_Y] = k.beta_bg * (lum - G[BG_Y])
+            row[PD_BG_CB] = k.beta_bg * (cb - G[BG_CB])
+            row[PD_BG_CR] = k.beta_bg * (cr - G[BG_CR])
         if delay == 0:
             _commit(S, H, G, row, k, precision)
         G[SINCE_FILTER] += 1

@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from evclust.clusterer import float_model
+from evclust.clusterer.constants import param_vector
 from evclust.clusterer.layout import (
     BG_CB, BG_CR, BG_Y, GLOBAL_COLUMNS, PENDING_COLUMNS, RECORD_COLUMNS, SLOT_COLUMNS, STEP, run_stats, support_shape,
 )  # fmt: skip
@@ -24,7 +25,7 @@ class FloatClusterer:
         its format: the float model then emulates chosen sources of the fixed model's error."""
         self.params = params = params.resolved(t_frame_us)
         self.precision = precision
-        self.k = float_model.param_vector(params, width, height, t_frame_us, has_colour)
+        self.k = param_vector(params, width, height, t_frame_us, has_colour)
         self.palette = params.palette_ycbcr()
         self.background_mask = params.background_mask()
         self.slots = np.zeros((params.n_clusters, len(SLOT_COLUMNS)))

@@ -19,8 +19,7 @@ from evclust.clusterer.layout import (
     T_LAST, VALID, VI_COUNT, VIX, VIY, VMX, VMY,
 )  # fmt: skip
 from evclust.fixed.arith import FLOOR, NEAREST, alpha_increment_nb, alpha_step_nb, decay_apply_nb, decay_nb, decay_steps_nb
-from evclust.clusterer.params import GAMMA_MODES
-from evclust.fixed.formats import DECAY_FRAC_BITS, DECAY_TABLE_BITS, NOISE_GATE_FRAC_BITS, SCALE_FRAC_BITS
+from evclust.fixed.formats import DECAY_FRAC_BITS, DECAY_TABLE_BITS
 from evclust.jit import njit
 
 TIME_MASK = (1 << 32) - 1
@@ -37,83 +36,6 @@ SIGNALS = (
     S_CENTRE, S_HALF, S_ACT, S_VM, S_NORM, S_VI, S_COLOUR, S_BG, S_GAMMA, S_EVCOUNT, S_HIST, S_STEP,
     S_SPEED, S_MCM_IN, S_SIZE_TARGET,
 ) = range(len(SIGNALS))  # fmt: skip
-
-# The constant vector the compiled loop reads (built by `constant_vector`).
-(
-    C_FP, C_FR, C_FA, C_FV, C_FW, C_FI, C_FC, C_FB, C_FG,
-    C_SEEK, C_R_INIT, C_R_MIN, C_R_MAX, C_GAIN, C_GAIN_F,
-    C_B_POS, C_BB_POS, C_B_SIZE, C_BB_SIZE, C_B_VM, C_BB_VM, C_B_VI, C_BB_VI,
-    C_B_LUM, C_BB_LUM, C_B_CHRO, C_BB_CHRO, C_B_BG, C_BB_BG,
-    C_INV_TH, C_INV_TH_F, C_A_MIN, C_A_VALID, C_EVERY,
-    C_GAMMA_MODE, C_GAMMA_GLOBAL, C_GPA, C_GPA_F, C_FPT, C_FPT_F, C_TAU_US,
-    C_INV_P, C_INV_P_F, C_BG_FIXED, C_LUMA_W, C_LUMA_W_F, C_H_MAX,
-    C_V_MIN_SQ, C_V_EXIT_SQ, C_SQ_F, C_COS_SQ, C_COS_SQ_F, C_EXIT_M,
-    C_WIDTH, C_HEIGHT, C_COLOUR, C_WARM, C_MCM_CORRECT, C_VOTE_CONTRAST, C_MIXING, C_MIX_TOL,
-    C_MAX_ACT, C_MAX_V, C_MIN_V, C_MAX_VI, C_MIN_VI, C_MAX_GAMMA,
-    C_MAX_EVCOUNT, C_V_FULL_BITS,
-    C_SEEK_SCALE, C_MERGE, C_MERGE_SCALE, C_MERGE_V_TOL, C_MERGE_V_REL, C_SCALE_F, C_NOISE_GATE, C_NOISE_GATE_F,
-    C_SUPPORT, C_SUPPORT_BITS, C_SUPPORT_WINDOW, C_R_MAX_RAW, C_VI_CAP,
-    C_MIN_STEP, C_MAX_STEP, C_FWD, C_FQ, C_P_MAX, C_COLOUR_MAX, C_BG_MAX,
-) = range(89)  # fmt: skip
-N_CONSTANTS = 89
-
-
-def constant_vector(table, params, has_colour: bool) -> np.ndarray:
-    """The formats table and the parameters as the int64 vector the loop reads."""
-    f, c = table.formats, table.constants
-    k = np.zeros(N_CONSTANTS, np.int64)
-    k[C_FP], k[C_FR], k[C_FA] = f["centre"].frac_bits, f["half_size"].frac_bits, f["activity"].frac_bits
-    k[C_FV], k[C_FW], k[C_FI] = f["v_mcm"].frac_bits, f["mcm_norm"].frac_bits, f["v_int"].frac_bits
-    k[C_FC], k[C_FB], k[C_FG] = f["colour"].frac_bits, f["background"].frac_bits, f["gamma"].frac_bits
-
-    def raw(name, default=0):
-        return c[name].raw if name in c else default
-
-    k[C_SEEK] = raw("seek_margin")  # centre fraction bits
-    k[C_R_INIT], k[C_R_MIN], k[C_R_MAX] = raw("r_init"), raw("r_min"), raw("r_max")
-    k[C_GAIN], k[C_GAIN_F] = raw("size_gain"), c["size_gain"].fmt.frac_bits
-    for code, bits, name in ((C_B_POS, C_BB_POS, "beta_pos"), (C_B_SIZE, C_BB_SIZE, "beta_size"),
-                             (C_B_VM, C_BB_VM, "beta_vel_mcm"), (C_B_VI, C_BB_VI, "beta_vel_int"),
-                             (C_B_LUM, C_BB_LUM, "beta_lum"), (C_B_CHRO, C_BB_CHRO, "beta_chro"),
-                             (C_B_BG, C_BB_BG, "beta_bg")):  # fmt: skip
-        k[code], k[bits] = c[name].raw, c[name].fmt.frac_bits
-    k[C_INV_TH], k[C_INV_TH_F] = raw("inv_t_half"), c["inv_t_half"].fmt.frac_bits
-    k[C_A_MIN], k[C_A_VALID], k[C_EVERY] = raw("a_min"), raw("a_valid"), params.filter_every
-    k[C_GAMMA_MODE] = GAMMA_MODES.index(params.gamma_mode)
-    k[C_GAMMA_GLOBAL] = raw("gamma_global")
-    k[C_GPA], k[C_GPA_F] = raw("gamma_per_activity"), c["gamma_per_activity"].fmt.frac_bits
-    k[C_FPT], k[C_FPT_F] = raw("frame_per_tau"), c["frame_per_tau"].fmt.frac_bits
-    k[C_TAU_US] = int(round(params.tau_us))
-    k[C_INV_P], k[C_INV_P_F] = raw("inv_p"), c["inv_p"].fmt.frac_bits
-    k[C_BG_FIXED] = params.background is not None
-    k[C_LUMA_W], k[C_LUMA_W_F] = raw("luma_weight"), (c["luma_weight"].fmt.frac_bits if "luma_weight" in c else 0)
-    k[C_H_MAX] = (1 << params.hist_bits) - 1
-    k[C_V_MIN_SQ], k[C_V_EXIT_SQ], k[C_SQ_F] = raw("v_min_sq"), raw("v_exit_sq"), f["speed_sq"].frac_bits
-    k[C_COS_SQ], k[C_COS_SQ_F] = raw("cos_sq_exit"), (c["cos_sq_exit"].fmt.frac_bits if "cos_sq_exit" in c else 0)
-    k[C_MIN_STEP], k[C_MAX_STEP] = f["centre_step"].raw_min, f["centre_step"].raw_max
-    k[C_FWD], k[C_FQ] = f["mcm_weight"].frac_bits, f["mixing_q"].frac_bits
-    k[C_EXIT_M] = raw("exit_margin")
-    k[C_WIDTH], k[C_HEIGHT], k[C_COLOUR] = table.width, table.height, has_colour
-    k[C_WARM], k[C_MCM_CORRECT] = params.velocity_warm_start, params.mcm_bias_correction
-    k[C_VOTE_CONTRAST], k[C_MIXING], k[C_MIX_TOL] = (
-        params.palette_vote == "contrast",
-        params.palette_assign == "mixing",
-        raw("mixing_tolerance"),
-    )
-    k[C_MAX_ACT] = f["activity"].raw_max
-    k[C_V_FULL_BITS] = f["v_int"].int_bits
-    k[C_MAX_V], k[C_MIN_V] = f["v_mcm"].raw_max, f["v_mcm"].raw_min
-    k[C_MAX_VI], k[C_MIN_VI] = f["v_int"].raw_max, f["v_int"].raw_min
-    k[C_MAX_GAMMA], k[C_MAX_EVCOUNT] = f["gamma"].raw_max, f["events_in_interval"].raw_max
-    k[C_SEEK_SCALE], k[C_MERGE], k[C_MERGE_SCALE] = raw("seek_scale"), params.merge, raw("merge_scale")
-    k[C_MERGE_V_TOL], k[C_MERGE_V_REL], k[C_SCALE_F] = raw("merge_v_tol"), raw("merge_v_rel"), SCALE_FRAC_BITS
-    k[C_NOISE_GATE], k[C_NOISE_GATE_F] = raw("noise_gate"), NOISE_GATE_FRAC_BITS
-    k[C_SUPPORT], k[C_SUPPORT_BITS], k[C_SUPPORT_WINDOW] = params.create_support, params.support_cell_bits, raw("support_window")
-    k[C_R_MAX_RAW] = raw("r_max")
-    k[C_VI_CAP] = params.interval_warmup()
-    # The tops of the formats a delayed commit saturates to (their bottoms are 0).
-    k[C_P_MAX], k[C_COLOUR_MAX], k[C_BG_MAX] = f["centre"].raw_max, f["colour"].raw_max, f["background"].raw_max
-    return k
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -158,14 +80,14 @@ def _align(raw, from_frac, to_frac):
 @njit(cache=True, nogil=True, inline="always")
 def _decayed(a, dt, k, table):
     """For comparisons only (eviction): the activity decayed to now, the slot left unchanged."""
-    return decay_nb(a, dt, k[C_INV_TH], k[C_INV_TH_F], table, DECAY_TABLE_BITS, DECAY_FRAC_BITS, FLOOR)
+    return decay_nb(a, dt, k.inv_t_half, k.inv_t_half_frac, table, DECAY_TABLE_BITS, DECAY_FRAC_BITS, FLOOR)
 
 
 @njit(cache=True, nogil=True, inline="always")
 def _decay_slot(S, s, t, k, table):
     """Decay the slot's activity to t, carrying the residual; t becomes its reference time."""
     m, S[s, DECAY_RESIDUAL] = decay_steps_nb(
-        (t - S[s, T_LAST]) & TIME_MASK, S[s, DECAY_RESIDUAL], k[C_INV_TH], k[C_INV_TH_F], DECAY_TABLE_BITS
+        (t - S[s, T_LAST]) & TIME_MASK, S[s, DECAY_RESIDUAL], k.inv_t_half, k.inv_t_half_frac, DECAY_TABLE_BITS
     )
     S[s, ACT] = decay_apply_nb(S[s, ACT], m, table, DECAY_TABLE_BITS, DECAY_FRAC_BITS, FLOOR)
     S[s, T_LAST] = t
@@ -174,22 +96,24 @@ def _decay_slot(S, s, t, k, table):
 @njit(cache=True, nogil=True, inline="always")
 def _decay_background(G, t, k, table):
     """The background's activity decayed to t, as a slot's (its residual carried)."""
-    m, G[BG_RESIDUAL] = decay_steps_nb((t - G[BG_T]) & TIME_MASK, G[BG_RESIDUAL], k[C_INV_TH], k[C_INV_TH_F], DECAY_TABLE_BITS)
+    m, G[BG_RESIDUAL] = decay_steps_nb((t - G[BG_T]) & TIME_MASK, G[BG_RESIDUAL], k.inv_t_half, k.inv_t_half_frac, DECAY_TABLE_BITS)
     G[BG_ACT] = decay_apply_nb(G[BG_ACT], m, table, DECAY_TABLE_BITS, DECAY_FRAC_BITS, FLOOR)
     G[BG_T] = t
 
 
 @njit(cache=True, nogil=True, inline="always")
 def _gamma_from_activity(a, k):
-    if k[C_GAMMA_MODE] == 0:
-        return k[C_GAMMA_GLOBAL]
-    return (a * k[C_GPA]) >> (k[C_FA] + k[C_GPA_F] - k[C_FG])  # A · ln2·T_frame/T_half, in γ's format
+    if k.gamma_mode == 0:
+        return k.gamma_global
+    return (a * k.gamma_per_activity) >> (
+        k.activity_frac + k.gamma_per_activity_frac - k.gamma_frac
+    )  # A · ln2·T_frame/T_half, in γ's format
 
 
 @njit(cache=True, nogil=True, inline="always")
 def _margin(S, s, k):
     """The seek margin in P's format: S + seek_scale·max(Rx, Ry), the product floored."""
-    return k[C_SEEK] + _align(k[C_SEEK_SCALE] * max(S[s, RX], S[s, RY]), k[C_SCALE_F] + k[C_FR], k[C_FP])
+    return k.seek_margin + _align(k.seek_scale * max(S[s, RX], S[s, RY]), k.scale_frac + k.half_size_frac, k.centre_frac)
 
 
 @njit(cache=True, nogil=True)
@@ -197,7 +121,7 @@ def _seek(S, x, y, k):
     """Step 1: the candidate nearest in L1; ties go to the lower slot. R is brought to P's
     fraction bits with one fixed shift (hoisted out of the loop)."""
     best, best_d = -1, np.int64(1) << 62
-    up = k[C_FP] - k[C_FR]  # the formats table gives the centre at least R's fraction bits
+    up = k.centre_frac - k.half_size_frac  # the formats table gives the centre at least R's fraction bits
     for s in range(S.shape[0]):
         if S[s, VALID] == 0:
             continue
@@ -215,9 +139,9 @@ def _seek(S, x, y, k):
 def _nearest_palette(ey, ecb, ecr, palette, k):
     """Integer L1 with the luminance weighted; distances in units of 2^-F_w."""
     best, best_d = 0, np.int64(1) << 62
-    fw = k[C_LUMA_W_F]
+    fw = k.luma_weight_frac
     for j in range(palette.shape[0]):
-        d = k[C_LUMA_W] * abs(ey - palette[j, 0]) + ((abs(ecb - palette[j, 1]) + abs(ecr - palette[j, 2])) << fw)
+        d = k.luma_weight * abs(ey - palette[j, 0]) + ((abs(ecb - palette[j, 1]) + abs(ecr - palette[j, 2])) << fw)
         if d < best_d:
             best, best_d = j, d
     return best
@@ -227,12 +151,12 @@ def _nearest_palette(ey, ecb, ecr, palette, k):
 def _mixing_palette(ey, ecb, ecr, bg, palette, inv_ww, background_mask, k):
     """The mixing rule (docs/FIXED_POINT.md): q in Q0.16 from a precomputed 1/|w|², then the
     L1 residual against the tolerance; distances in units of 2^-F_w."""
-    fw, fq = k[C_LUMA_W_F], k[C_FQ]
-    tol = k[C_MIX_TOL] << fw
+    fw, fq = k.luma_weight_frac, k.mixing_q_frac
+    tol = k.mixing_tolerance << fw
     uy, ucb, ucr = ey - bg[0], ecb - bg[1], ecr - bg[2]
     best, best_d = -1, np.int64(1) << 62
     for j in range(palette.shape[0]):
-        d_end = k[C_LUMA_W] * abs(ey - palette[j, 0]) + ((abs(ecb - palette[j, 1]) + abs(ecr - palette[j, 2])) << fw)
+        d_end = k.luma_weight * abs(ey - palette[j, 0]) + ((abs(ecb - palette[j, 1]) + abs(ecr - palette[j, 2])) << fw)
         if background_mask[j]:
             d_line = d_end
         else:
@@ -240,7 +164,7 @@ def _mixing_palette(ey, ecb, ecr, bg, palette, inv_ww, background_mask, k):
             dot = uy * wy + ucb * wcb + ucr * wcr
             q = 0 if dot <= 0 else min((dot * inv_ww[j]) >> fq, np.int64(1) << fq)  # mixing_q
             ry, rcb, rcr = (uy << fq) - q * wy, (ucb << fq) - q * wcb, (ucr << fq) - q * wcr
-            d_line = (k[C_LUMA_W] * abs(ry) + ((abs(rcb) + abs(rcr)) << fw)) >> fq
+            d_line = (k.luma_weight * abs(ry) + ((abs(rcb) + abs(rcr)) << fw)) >> fq
         if d_line <= tol and d_end < best_d:
             best, best_d = j, d_end
     return best if best >= 0 else _nearest_palette(ey, ecb, ecr, palette, k)
@@ -249,16 +173,16 @@ def _mixing_palette(ey, ecb, ecr, bg, palette, inv_ww, background_mask, k):
 @njit(cache=True, nogil=True)
 def palette_vote(lum, cb, cr, G, k):
     """The event's vote: 1, or with contrast votes |e - BG|₁ from the exact background, rounded half up."""
-    if k[C_VOTE_CONTRAST] == 0:
+    if k.vote_contrast == 0:
         return np.int64(1)
-    fb = k[C_FB]
+    fb = k.background_frac
     return (abs((lum << fb) - G[BG_Y]) + abs((cb << fb) - G[BG_CB]) + abs((cr << fb) - G[BG_CR]) + (np.int64(1) << (fb - 1))) >> fb
 
 
 @njit(cache=True, nogil=True)
 def refresh_mixing(G, palette, inv_ww, k):
     """1/|palette_j - BG|² in Q0.32 (integer colours): a division per entry, at filter steps only."""
-    fb = k[C_FB]
+    fb = k.background_frac
     for j in range(palette.shape[0]):
         wy = palette[j, 0] - (G[BG_Y] >> fb)
         wcb = palette[j, 1] - (G[BG_CB] >> fb)
@@ -273,13 +197,13 @@ def _create(S, H, G, s, t, ex, ey, lum, cb, cr, k):
     S[s, VALID] = 1
     S[s, ID] = G[NEXT_ID]
     G[NEXT_ID] = (G[NEXT_ID] + 1) & TIME_MASK  # 32-bit id, wraps by design
-    x, y = ex << k[C_FP], ey << k[C_FP]
+    x, y = ex << k.centre_frac, ey << k.centre_frac
     S[s, PX], S[s, PY], S[s, PPX], S[s, PPY] = x, y, x, y
-    S[s, RX], S[s, RY] = k[C_R_INIT], k[C_R_INIT]
-    S[s, ACT] = np.int64(1) << k[C_FA]
+    S[s, RX], S[s, RY] = k.r_init, k.r_init
+    S[s, ACT] = np.int64(1) << k.activity_frac
     S[s, GAMMA] = _gamma_from_activity(S[s, ACT], k)
     S[s, T_LAST] = t
-    S[s, CY], S[s, CCB], S[s, CCR] = lum << k[C_FC], cb << k[C_FC], cr << k[C_FC]
+    S[s, CY], S[s, CCB], S[s, CCR] = lum << k.colour_frac, cb << k.colour_frac, cr << k.colour_frac
     H[s, :] = 0
     G[CREATED] += 1
 
@@ -288,40 +212,40 @@ def _create(S, H, G, s, t, ex, ey, lum, cb, cr, k):
 def _increments(S, G, s, t, ex, ey, lum, cb, cr, k, palette, inv_ww, background_mask, log, ranges, row):
     """Step 3, read half: the slot's update as increments from the state the event reads (in a
     pipelined core, the table D events ago), into the delay-line row."""
-    fp, fr = k[C_FP], k[C_FR]
+    fp, fr = k.centre_frac, k.half_size_frac
     row[PD_LIVE], row[PD_SLOT], row[PD_T] = 1, s, t
     # 3b. Centre: P += β_P (e - P), the event in P's format with all its fraction bits as guard.
     px, py = S[s, PX], S[s, PY]
-    row[PD_PX] = alpha_increment_nb(px, ex, k[C_B_POS], k[C_BB_POS], fp, FLOOR)
-    row[PD_PY] = alpha_increment_nb(py, ey, k[C_B_POS], k[C_BB_POS], fp, FLOOR)
+    row[PD_PX] = alpha_increment_nb(px, ex, k.beta_pos, k.beta_pos_frac, fp, FLOOR)
+    row[PD_PY] = alpha_increment_nb(py, ey, k.beta_pos, k.beta_pos_frac, fp, FLOOR)
     # 3c. Size: R += β_R (g_R |e - P| - R); the clamp when committed.
-    gx = (abs((ex << fp) - px) * k[C_GAIN]) >> (k[C_GAIN_F] + fp - fr)
-    gy = (abs((ey << fp) - py) * k[C_GAIN]) >> (k[C_GAIN_F] + fp - fr)
+    gx = (abs((ex << fp) - px) * k.size_gain) >> (k.size_gain_frac + fp - fr)
+    gy = (abs((ey << fp) - py) * k.size_gain) >> (k.size_gain_frac + fp - fr)
     # No saturation: |e - P| < 2^coord and g_R < 2^bits(g_R), so the product fits size_target.
     gx = _seen(gx, S_SIZE_TARGET, ranges)
     gy = _seen(gy, S_SIZE_TARGET, ranges)
-    row[PD_RX] = alpha_increment_nb(S[s, RX], gx, k[C_B_SIZE], k[C_BB_SIZE], 0, FLOOR)
-    row[PD_RY] = alpha_increment_nb(S[s, RY], gy, k[C_B_SIZE], k[C_BB_SIZE], 0, FLOOR)
+    row[PD_RX] = alpha_increment_nb(S[s, RX], gx, k.beta_size, k.beta_size_frac, 0, FLOOR)
+    row[PD_RY] = alpha_increment_nb(S[s, RY], gy, k.beta_size, k.beta_size_frac, 0, FLOOR)
     # 3d. MCM: V += β_vm (γ (P_new - P) - V); the same filter on 1 gives the bias-correction weight.
-    step_x = _store(row[PD_PX], k[C_MIN_STEP], k[C_MAX_STEP], S_STEP, log, ranges)
-    step_y = _store(row[PD_PY], k[C_MIN_STEP], k[C_MAX_STEP], S_STEP, log, ranges)
-    ux = _store(_align(S[s, GAMMA] * step_x, k[C_FG] + fp, k[C_FV]), k[C_MIN_V], k[C_MAX_V], S_MCM_IN, log, ranges)
-    uy = _store(_align(S[s, GAMMA] * step_y, k[C_FG] + fp, k[C_FV]), k[C_MIN_V], k[C_MAX_V], S_MCM_IN, log, ranges)
+    step_x = _store(row[PD_PX], k.centre_step_min, k.centre_step_max, S_STEP, log, ranges)
+    step_y = _store(row[PD_PY], k.centre_step_min, k.centre_step_max, S_STEP, log, ranges)
+    ux = _store(_align(S[s, GAMMA] * step_x, k.gamma_frac + fp, k.v_mcm_frac), k.v_mcm_min, k.v_mcm_max, S_MCM_IN, log, ranges)
+    uy = _store(_align(S[s, GAMMA] * step_y, k.gamma_frac + fp, k.v_mcm_frac), k.v_mcm_min, k.v_mcm_max, S_MCM_IN, log, ranges)
     # Rounded to nearest: V's input is at V's own LSB, so a floor would drift one way.
-    row[PD_VMX] = alpha_increment_nb(S[s, VMX], ux, k[C_B_VM], k[C_BB_VM], 0, NEAREST)
-    row[PD_VMY] = alpha_increment_nb(S[s, VMY], uy, k[C_B_VM], k[C_BB_VM], 0, NEAREST)
+    row[PD_VMX] = alpha_increment_nb(S[s, VMX], ux, k.beta_vel_mcm, k.beta_vel_mcm_frac, 0, NEAREST)
+    row[PD_VMY] = alpha_increment_nb(S[s, VMY], uy, k.beta_vel_mcm, k.beta_vel_mcm_frac, 0, NEAREST)
     # w = 1 - α^n: the same filter on the integer 1, with all of w's fraction bits as guard.
-    row[PD_NORM] = alpha_increment_nb(S[s, MCM_NORM], 1, k[C_B_VM], k[C_BB_VM], k[C_FW], NEAREST)
-    if k[C_COLOUR] != 0:
+    row[PD_NORM] = alpha_increment_nb(S[s, MCM_NORM], 1, k.beta_vel_mcm, k.beta_vel_mcm_frac, k.mcm_norm_frac, NEAREST)
+    if k.has_colour != 0:
         # 3e. Colour: three α filters, the event's byte with all of C's fraction bits as guard.
-        fc = k[C_FC]
-        row[PD_CY] = alpha_increment_nb(S[s, CY], lum, k[C_B_LUM], k[C_BB_LUM], fc, FLOOR)
-        row[PD_CCB] = alpha_increment_nb(S[s, CCB], cb, k[C_B_CHRO], k[C_BB_CHRO], fc, FLOOR)
-        row[PD_CCR] = alpha_increment_nb(S[s, CCR], cr, k[C_B_CHRO], k[C_BB_CHRO], fc, FLOOR)
+        fc = k.colour_frac
+        row[PD_CY] = alpha_increment_nb(S[s, CY], lum, k.beta_lum, k.beta_lum_frac, fc, FLOOR)
+        row[PD_CCB] = alpha_increment_nb(S[s, CCB], cb, k.beta_chro, k.beta_chro_frac, fc, FLOOR)
+        row[PD_CCR] = alpha_increment_nb(S[s, CCR], cr, k.beta_chro, k.beta_chro_frac, fc, FLOOR)
         # 3f. Palette vote: the event's class and weight.
-        fb = k[C_FB]
+        fb = k.background_frac
         bg = (G[BG_Y] >> fb, G[BG_CB] >> fb, G[BG_CR] >> fb)
-        if k[C_MIXING] != 0:
+        if k.mixing != 0:
             row[PD_CLASS] = _mixing_palette(lum, cb, cr, bg, palette, inv_ww, background_mask, k)
         else:
             row[PD_CLASS] = _nearest_palette(lum, cb, cr, palette, k)
@@ -337,30 +261,30 @@ def _commit(S, H, G, row, k, table, log, ranges):
     if row[PD_LIVE] != 0:
         s, t = row[PD_SLOT], row[PD_T]
         _decay_slot(S, s, t, k, table)
-        S[s, ACT] = _store(S[s, ACT] + (np.int64(1) << k[C_FA]), 0, k[C_MAX_ACT], S_ACT, log, ranges)
-        S[s, RX] = _seen(min(max(S[s, RX] + row[PD_RX], k[C_R_MIN]), k[C_R_MAX]), S_HALF, ranges)
-        S[s, RY] = _seen(min(max(S[s, RY] + row[PD_RY], k[C_R_MIN]), k[C_R_MAX]), S_HALF, ranges)
-        S[s, VMX] = _store(S[s, VMX] + row[PD_VMX], k[C_MIN_V], k[C_MAX_V], S_VM, log, ranges)
-        S[s, VMY] = _store(S[s, VMY] + row[PD_VMY], k[C_MIN_V], k[C_MAX_V], S_VM, log, ranges)
-        S[s, MCM_NORM] = _store(S[s, MCM_NORM] + row[PD_NORM], 0, np.int64(1) << k[C_FW], S_NORM, log, ranges)  # w <= 1
-        S[s, PX] = _store(S[s, PX] + row[PD_PX], 0, k[C_P_MAX], S_CENTRE, log, ranges)
-        S[s, PY] = _store(S[s, PY] + row[PD_PY], 0, k[C_P_MAX], S_CENTRE, log, ranges)
-        if k[C_COLOUR] != 0:
-            S[s, CY] = _store(S[s, CY] + row[PD_CY], 0, k[C_COLOUR_MAX], S_COLOUR, log, ranges)
-            S[s, CCB] = _store(S[s, CCB] + row[PD_CCB], 0, k[C_COLOUR_MAX], S_COLOUR, log, ranges)
-            S[s, CCR] = _store(S[s, CCR] + row[PD_CCR], 0, k[C_COLOUR_MAX], S_COLOUR, log, ranges)
+        S[s, ACT] = _store(S[s, ACT] + (np.int64(1) << k.activity_frac), 0, k.activity_max, S_ACT, log, ranges)
+        S[s, RX] = _seen(min(max(S[s, RX] + row[PD_RX], k.r_min), k.r_max), S_HALF, ranges)
+        S[s, RY] = _seen(min(max(S[s, RY] + row[PD_RY], k.r_min), k.r_max), S_HALF, ranges)
+        S[s, VMX] = _store(S[s, VMX] + row[PD_VMX], k.v_mcm_min, k.v_mcm_max, S_VM, log, ranges)
+        S[s, VMY] = _store(S[s, VMY] + row[PD_VMY], k.v_mcm_min, k.v_mcm_max, S_VM, log, ranges)
+        S[s, MCM_NORM] = _store(S[s, MCM_NORM] + row[PD_NORM], 0, np.int64(1) << k.mcm_norm_frac, S_NORM, log, ranges)  # w <= 1
+        S[s, PX] = _store(S[s, PX] + row[PD_PX], 0, k.centre_max, S_CENTRE, log, ranges)
+        S[s, PY] = _store(S[s, PY] + row[PD_PY], 0, k.centre_max, S_CENTRE, log, ranges)
+        if k.has_colour != 0:
+            S[s, CY] = _store(S[s, CY] + row[PD_CY], 0, k.colour_max, S_COLOUR, log, ranges)
+            S[s, CCB] = _store(S[s, CCB] + row[PD_CCB], 0, k.colour_max, S_COLOUR, log, ranges)
+            S[s, CCR] = _store(S[s, CCR] + row[PD_CCR], 0, k.colour_max, S_COLOUR, log, ranges)
             # Saturating by design (SPEC §4): reaching the top halves every counter, so not an overflow.
             c = row[PD_CLASS]
-            H[s, c] = min(_seen(H[s, c] + row[PD_VOTE], S_HIST, ranges), k[C_H_MAX])
-            if H[s, c] >= k[C_H_MAX]:
+            H[s, c] = min(_seen(H[s, c] + row[PD_VOTE], S_HIST, ranges), k.hist_max)
+            if H[s, c] >= k.hist_max:
                 for j in range(H.shape[1]):
                     H[s, j] >>= 1
-        S[s, EV_COUNT] = _store(S[s, EV_COUNT] + 1, 0, k[C_MAX_EVCOUNT], S_EVCOUNT, log, ranges)
+        S[s, EV_COUNT] = _store(S[s, EV_COUNT] + 1, 0, k.events_in_interval_max, S_EVCOUNT, log, ranges)
         row[PD_LIVE] = 0
     if row[PD_BG] != 0:
-        G[BG_Y] = _store(G[BG_Y] + row[PD_BG_Y], 0, k[C_BG_MAX], S_BG, log, ranges)
-        G[BG_CB] = _store(G[BG_CB] + row[PD_BG_CB], 0, k[C_BG_MAX], S_BG, log, ranges)
-        G[BG_CR] = _store(G[BG_CR] + row[PD_BG_CR], 0, k[C_BG_MAX], S_BG, log, ranges)
+        G[BG_Y] = _store(G[BG_Y] + row[PD_BG_Y], 0, k.background_max, S_BG, log, ranges)
+        G[BG_CB] = _store(G[BG_CB] + row[PD_BG_CB], 0, k.background_max, S_BG, log, ranges)
+        G[BG_CR] = _store(G[BG_CR] + row[PD_BG_CR], 0, k.background_max, S_BG, log, ranges)
         row[PD_BG] = 0
 
 
@@ -390,7 +314,7 @@ def _slot_for_new(S, G, t, k, table):
         a = _decayed(S[s, ACT], (t - S[s, T_LAST]) & TIME_MASK, k, table)
         if a < weakest_a:
             weakest, weakest_a = s, a
-    if weakest_a < k[C_A_VALID]:
+    if weakest_a < k.a_valid:
         G[EVICTED] += 1
         return weakest
     return -1
@@ -398,9 +322,9 @@ def _slot_for_new(S, G, t, k, table):
 
 @njit(cache=True, nogil=True)
 def _near(px, py, k):
-    m = k[C_EXIT_M]
-    hi_x = ((k[C_WIDTH] - 1) << k[C_FP]) - m
-    hi_y = ((k[C_HEIGHT] - 1) << k[C_FP]) - m
+    m = k.exit_margin
+    hi_x = ((k.width - 1) << k.centre_frac) - m
+    hi_y = ((k.height - 1) << k.centre_frac) - m
     return px < m, px > hi_x, py < m, py > hi_y
 
 
@@ -408,18 +332,18 @@ def _near(px, py, k):
 def _speed_sq(vx, vy, frac, k):
     """|V|² in the speed_sq format from a velocity with `frac` fraction bits. Each component is
     first clamped to full scale (±2^V_FULL_BITS px/frame), so the squares fit an int64."""
-    full = (np.int64(1) << (k[C_V_FULL_BITS] + frac)) - 1
+    full = (np.int64(1) << (k.v_int_int_bits + frac)) - 1
     vx = min(max(vx, -full), full)
     vy = min(max(vy, -full), full)
-    return _align(vx * vx + vy * vy, 2 * frac, k[C_SQ_F])
+    return _align(vx * vx + vy * vy, 2 * frac, k.speed_sq_frac)
 
 
 @njit(cache=True, nogil=True, inline="always")
 def _corrected(colour, background, k):
     """Eq. (11): BG + (C - BG)·(1/p), in C's format, clamped to the byte range."""
-    bg = _align(background, k[C_FB], k[C_FC])
-    obj = bg + (((colour - bg) * k[C_INV_P]) >> k[C_INV_P_F])
-    return min(max(obj, 0), np.int64(255) << k[C_FC])
+    bg = _align(background, k.background_frac, k.colour_frac)
+    obj = bg + (((colour - bg) * k.inv_p) >> k.inv_p_frac)
+    return min(max(obj, 0), np.int64(255) << k.colour_frac)
 
 
 @njit(cache=True, nogil=True)
@@ -427,16 +351,16 @@ def _mergeable(S, s, j, k):
     """As the float model's: boxes that overlap (velocities not disagreeing), or boxes grown by
     merge_scale·max(R) that overlap with measured velocities that agree. In P's format; the
     grown reach and the relative velocity tolerance floored."""
-    up = k[C_FP] - k[C_FR]
+    up = k.centre_frac - k.half_size_frac
     dx, dy = abs(S[s, PX] - S[j, PX]), abs(S[s, PY] - S[j, PY])
     sx, sy = (S[s, RX] + S[j, RX]) << up, (S[s, RY] + S[j, RY]) << up
-    grow = _align(k[C_MERGE_SCALE] * (max(S[s, RX], S[s, RY]) + max(S[j, RX], S[j, RY])), k[C_SCALE_F] + k[C_FR], k[C_FP])
+    grow = _align(k.merge_scale * (max(S[s, RX], S[s, RY]) + max(S[j, RX], S[j, RY])), k.scale_frac + k.half_size_frac, k.centre_frac)
     if dx > sx + grow or dy > sy + grow:
         return False
     if S[s, VI_COUNT] >= 2 and S[j, VI_COUNT] >= 2:
         dv = abs(S[s, VIX] - S[j, VIX]) + abs(S[s, VIY] - S[j, VIY])
         fast = max(abs(S[s, VIX]) + abs(S[s, VIY]), abs(S[j, VIX]) + abs(S[j, VIY]))
-        return dv <= k[C_MERGE_V_TOL] + ((k[C_MERGE_V_REL] * fast) >> k[C_SCALE_F])
+        return dv <= k.merge_v_tol + ((k.merge_v_rel * fast) >> k.scale_frac)
     return dx <= sx and dy <= sy
 
 
@@ -445,7 +369,7 @@ def _merge(S, H, G, s, j, k, log, ranges):
     """Slot s absorbs slot j (the float model's _merge): the centre is the activity-weighted
     mean, floored (the sweep's one division); the box covers both boxes; activities and
     event counts add, saturated; the survivor's identity, velocities, colour and histogram."""
-    up = k[C_FP] - k[C_FR]
+    up = k.centre_frac - k.half_size_frac
     survivor = (
         j if (S[j, EVER_REPORTED] > S[s, EVER_REPORTED]) or (S[j, EVER_REPORTED] == S[s, EVER_REPORTED] and S[j, ACT] > S[s, ACT]) else s
     )
@@ -460,18 +384,18 @@ def _merge(S, H, G, s, j, k, log, ranges):
     lo_y = min(S[s, PY] - (S[s, RY] << up), S[j, PY] - (S[j, RY] << up))
     hi_y = max(S[s, PY] + (S[s, RY] << up), S[j, PY] + (S[j, RY] << up))
     # The previous centre moves with the centre, kept inside the sensor (as the float model).
-    ppx = min(max(S[survivor, PPX] + (px - S[survivor, PX]), 0), (k[C_WIDTH] - 1) << k[C_FP])
-    ppy = min(max(S[survivor, PPY] + (py - S[survivor, PY]), 0), (k[C_HEIGHT] - 1) << k[C_FP])
-    act = _store(a_s + a_j, 0, k[C_MAX_ACT], S_ACT, log, ranges)
-    count = _store(S[s, EV_COUNT] + S[j, EV_COUNT], 0, k[C_MAX_EVCOUNT], S_EVCOUNT, log, ranges)
+    ppx = min(max(S[survivor, PPX] + (px - S[survivor, PX]), 0), (k.width - 1) << k.centre_frac)
+    ppy = min(max(S[survivor, PPY] + (py - S[survivor, PY]), 0), (k.height - 1) << k.centre_frac)
+    act = _store(a_s + a_j, 0, k.activity_max, S_ACT, log, ranges)
+    count = _store(S[s, EV_COUNT] + S[j, EV_COUNT], 0, k.events_in_interval_max, S_EVCOUNT, log, ranges)
     if survivor == j:  # its state, with s's decay reference (s is decayed to now)
         t_last, residual = S[s, T_LAST], S[s, DECAY_RESIDUAL]
         S[s, :] = S[j, :]
         H[s, :] = H[j, :]
         S[s, T_LAST], S[s, DECAY_RESIDUAL] = t_last, residual
     S[s, PX], S[s, PY], S[s, PPX], S[s, PPY] = px, py, ppx, ppy
-    S[s, RX] = min((hi_x - lo_x) >> (up + 1), k[C_R_MAX_RAW])
-    S[s, RY] = min((hi_y - lo_y) >> (up + 1), k[C_R_MAX_RAW])
+    S[s, RX] = min((hi_x - lo_x) >> (up + 1), k.r_max)
+    S[s, RY] = min((hi_y - lo_y) >> (up + 1), k.r_max)
     S[s, ACT], S[s, EV_COUNT] = act, count
     S[j, VALID] = 0
     G[MERGED] += 1
@@ -480,78 +404,82 @@ def _merge(S, H, G, s, j, k, log, ranges):
 @njit(cache=True, nogil=True, inline="always")
 def _box_pixels(S, s, k):
     """The pixels of a cluster's box, (2·floor(Rx) + 1)·(2·floor(Ry) + 1)."""
-    return (2 * (S[s, RX] >> k[C_FR]) + 1) * (2 * (S[s, RY] >> k[C_FR]) + 1)
+    return (2 * (S[s, RX] >> k.half_size_frac) + 1) * (2 * (S[s, RY] >> k.half_size_frac) + 1)
 
 
 @njit(cache=True, nogil=True)
 def _filter_step(S, H, G, t, k, table, gains, palette, inv_ww, background_mask, out, n_out, log, ranges):
     # τ boundaries since the last step, from a phase counter (no division of the wrapping time).
     phase = G[TAU_PHASE] + ((t - G[T_FILTER]) & TIME_MASK)
-    boundaries = phase // k[C_TAU_US]
-    G[TAU_PHASE] = phase - boundaries * k[C_TAU_US]
-    per_frame = k[C_FPT] // max(boundaries, 1)  # T_frame/(n·τ), Q?.F_fpt
-    fp, fv, fw, fi, fc = k[C_FP], k[C_FV], k[C_FW], k[C_FI], k[C_FC]
+    boundaries = phase // k.tau_us
+    G[TAU_PHASE] = phase - boundaries * k.tau_us
+    per_frame = k.frame_per_tau // max(boundaries, 1)  # T_frame/(n·τ), Q?.F_fpt
+    fp, fv, fw, fi, fc = k.centre_frac, k.v_mcm_frac, k.mcm_norm_frac, k.v_int_frac, k.colour_frac
     _decay_background(G, t, k, table)
-    sensor = k[C_WIDTH] * k[C_HEIGHT]
+    sensor = k.width * k.height
     for s in range(S.shape[0]):
         if S[s, VALID] == 0:
             continue
         _decay_slot(S, s, t, k, table)
-        if S[s, ACT] < k[C_A_MIN]:
+        if S[s, ACT] < k.a_min:
             S[s, VALID] = 0
             G[EXPIRED] += 1
             continue
-        if k[C_MERGE] != 0:  # absorb every later slot that is the same object, lowest first
+        if k.merge != 0:  # absorb every later slot that is the same object, lowest first
             j = s + 1
             while j < S.shape[0]:
                 if S[j, VALID] != 0 and _mergeable(S, s, j, k):
                     _merge(S, H, G, s, j, k, log, ranges)
                     j = s
                 j += 1
-        if k[C_GAMMA_MODE] != 2 or S[s, VI_COUNT] == 0:
-            S[s, GAMMA] = _store(_gamma_from_activity(S[s, ACT], k), 0, k[C_MAX_GAMMA], S_GAMMA, log, ranges)
+        if k.gamma_mode != 2 or S[s, VI_COUNT] == 0:
+            S[s, GAMMA] = _store(_gamma_from_activity(S[s, ACT], k), 0, k.gamma_max, S_GAMMA, log, ranges)
         if boundaries > 0:
-            if k[C_GAMMA_MODE] == 2 and S[s, VI_COUNT] >= 1:
-                g = (S[s, EV_COUNT] * per_frame) >> (k[C_FPT_F] - k[C_FG])
-                S[s, GAMMA] = _store(g, 0, k[C_MAX_GAMMA], S_GAMMA, log, ranges)
+            if k.gamma_mode == 2 and S[s, VI_COUNT] >= 1:
+                g = (S[s, EV_COUNT] * per_frame) >> (k.frame_per_tau_frac - k.gamma_frac)
+                S[s, GAMMA] = _store(g, 0, k.gamma_max, S_GAMMA, log, ranges)
             S[s, EV_COUNT] = 0
-            mx = _store(_align((S[s, PX] - S[s, PPX]) * per_frame, fp + k[C_FPT_F], fi), k[C_MIN_VI], k[C_MAX_VI], S_VI, log, ranges)
-            my = _store(_align((S[s, PY] - S[s, PPY]) * per_frame, fp + k[C_FPT_F], fi), k[C_MIN_VI], k[C_MAX_VI], S_VI, log, ranges)
+            mx = _store(
+                _align((S[s, PX] - S[s, PPX]) * per_frame, fp + k.frame_per_tau_frac, fi), k.v_int_min, k.v_int_max, S_VI, log, ranges
+            )
+            my = _store(
+                _align((S[s, PY] - S[s, PPY]) * per_frame, fp + k.frame_per_tau_frac, fi), k.v_int_min, k.v_int_max, S_VI, log, ranges
+            )
             n = S[s, VI_COUNT]
-            if k[C_WARM] == 0 or n >= k[C_VI_CAP]:
-                S[s, VIX] = alpha_step_nb(S[s, VIX], mx, k[C_B_VI], k[C_BB_VI], 0, FLOOR)
-                S[s, VIY] = alpha_step_nb(S[s, VIY], my, k[C_B_VI], k[C_BB_VI], 0, FLOOR)
+            if k.warm_start == 0 or n >= k.interval_warmup:
+                S[s, VIX] = alpha_step_nb(S[s, VIX], mx, k.beta_vel_int, k.beta_vel_int_frac, 0, FLOOR)
+                S[s, VIY] = alpha_step_nb(S[s, VIY], my, k.beta_vel_int, k.beta_vel_int_frac, 0, FLOOR)
             elif n == 1:
                 S[s, VIX], S[s, VIY] = mx, my
             elif n >= 2:  # the warm-up's running mean: gain 1/n from the table
-                S[s, VIX] = alpha_step_nb(S[s, VIX], mx, gains[n], k[C_BB_VI], 0, FLOOR)
-                S[s, VIY] = alpha_step_nb(S[s, VIY], my, gains[n], k[C_BB_VI], 0, FLOOR)
-            S[s, VI_COUNT] = min(n + 1, max(k[C_VI_CAP], 2))
+                S[s, VIX] = alpha_step_nb(S[s, VIX], mx, gains[n], k.beta_vel_int_frac, 0, FLOOR)
+                S[s, VIY] = alpha_step_nb(S[s, VIY], my, gains[n], k.beta_vel_int_frac, 0, FLOOR)
+            S[s, VI_COUNT] = min(n + 1, max(k.interval_warmup, 2))
             S[s, PPX], S[s, PPY] = S[s, PX], S[s, PY]
         # The reported MCM velocity: V / w, the sweep's one division.
         vmx, vmy = S[s, VMX], S[s, VMY]
-        w_cut = S[s, MCM_NORM] >> (fw - k[C_FWD])  # w in mcm_weight's format: V·2^F fits an int64
-        if k[C_MCM_CORRECT] != 0 and w_cut > 0:
+        w_cut = S[s, MCM_NORM] >> (fw - k.mcm_weight_frac)  # w in mcm_weight's format: V·2^F fits an int64
+        if k.mcm_correct != 0 and w_cut > 0:
             # Saturated: early on (w small) V/w can leave V's format, which the record must hold.
-            vmx = _store((S[s, VMX] << k[C_FWD]) // w_cut, k[C_MIN_V], k[C_MAX_V], S_VM, log, ranges)
-            vmy = _store((S[s, VMY] << k[C_FWD]) // w_cut, k[C_MIN_V], k[C_MAX_V], S_VM, log, ranges)
+            vmx = _store((S[s, VMX] << k.mcm_weight_frac) // w_cut, k.v_mcm_min, k.v_mcm_max, S_VM, log, ranges)
+            vmy = _store((S[s, VMY] << k.mcm_weight_frac) // w_cut, k.v_mcm_min, k.v_mcm_max, S_VM, log, ranges)
         # Exit prediction on the squared speed (no square root).
         # No saturation: each component is clamped below 2^V_FULL_BITS, so the sum fits speed_sq.
         speed_sq = _seen(_speed_sq(vmx, vmy, fv, k), S_SPEED, ranges)
         left, right, top, bottom = _near(S[s, PX], S[s, PY], k)
-        if speed_sq >= k[C_V_EXIT_SQ] and speed_sq > 0:
-            limit = (speed_sq * k[C_COS_SQ]) >> k[C_COS_SQ_F]
+        if speed_sq >= k.v_exit_sq and speed_sq > 0:
+            limit = (speed_sq * k.cos_sq_exit) >> k.cos_sq_exit_frac
             if (left and vmx < 0 and _speed_sq(vmx, 0, fv, k) >= limit) or (right and vmx > 0 and _speed_sq(vmx, 0, fv, k) >= limit) \
                     or (top and vmy < 0 and _speed_sq(0, vmy, fv, k) >= limit) or (bottom and vmy > 0 and _speed_sq(0, vmy, fv, k) >= limit):  # fmt: skip
                 S[s, VALID] = 0
                 G[EXITED] += 1
                 continue
-        moving_mcm = _speed_sq(S[s, VMX], S[s, VMY], fv, k) >= k[C_V_MIN_SQ]
-        moving_int = _speed_sq(S[s, VIX], S[s, VIY], fi, k) >= k[C_V_MIN_SQ]
-        reported = S[s, ACT] >= k[C_A_VALID] and (moving_mcm or moving_int)
-        if reported and k[C_NOISE_GATE] != 0:  # A·W·H >= γ_n·A_bg·box, γ_n in Q.4
-            reported = (S[s, ACT] * sensor) << k[C_NOISE_GATE_F] >= k[C_NOISE_GATE] * G[BG_ACT] * _box_pixels(S, s, k)
-        if S[s, ACT] >= k[C_A_VALID] and not reported:
+        moving_mcm = _speed_sq(S[s, VMX], S[s, VMY], fv, k) >= k.v_min_sq
+        moving_int = _speed_sq(S[s, VIX], S[s, VIY], fi, k) >= k.v_min_sq
+        reported = S[s, ACT] >= k.a_valid and (moving_mcm or moving_int)
+        if reported and k.noise_gate != 0:  # A·W·H >= γ_n·A_bg·box, γ_n in Q.4
+            reported = (S[s, ACT] * sensor) << k.noise_gate_frac >= k.noise_gate * G[BG_ACT] * _box_pixels(S, s, k)
+        if S[s, ACT] >= k.a_valid and not reported:
             G[NOISE] += 1
         S[s, REPORTED] = 1 if reported else 0
         if not reported:
@@ -559,13 +487,13 @@ def _filter_step(S, H, G, t, k, table, gains, palette, inv_ww, background_mask, 
         row = out[n_out]
         row[0], row[1], row[2], row[3] = t, G[STEP], s, S[s, ID]
         row[4], row[5] = S[s, PX] / 2.0**fp, S[s, PY] / 2.0**fp
-        row[6], row[7] = S[s, RX] / 2.0 ** k[C_FR], S[s, RY] / 2.0 ** k[C_FR]
-        row[8] = S[s, ACT] / 2.0 ** k[C_FA]
+        row[6], row[7] = S[s, RX] / 2.0**k.half_size_frac, S[s, RY] / 2.0**k.half_size_frac
+        row[8] = S[s, ACT] / 2.0**k.activity_frac
         row[9], row[10] = vmx / 2.0**fv, vmy / 2.0**fv
         row[11], row[12] = S[s, VIX] / 2.0**fi, S[s, VIY] / 2.0**fi
         cls = -1
         row[13], row[14], row[15] = 0.0, 0.0, 0.0
-        if k[C_COLOUR] != 0:
+        if k.has_colour != 0:
             # Eq. (11): C_obj = BG + (C - BG)·(1/p), clamped to the byte range.
             row[13] = _corrected(S[s, CY], G[BG_Y], k) / 2.0**fc
             row[14] = _corrected(S[s, CCB], G[BG_CB], k) / 2.0**fc
@@ -587,7 +515,7 @@ def _filter_step(S, H, G, t, k, table, gains, palette, inv_ww, background_mask, 
         row[17] = flags
         S[s, EVER_REPORTED] = 1
         n_out += 1
-    if k[C_MIXING] != 0 and k[C_BG_FIXED] == 0:
+    if k.mixing != 0 and k.background_fixed == 0:
         refresh_mixing(G, palette, inv_ww, k)
     G[STEP] += 1
     G[T_FILTER] = t
@@ -620,8 +548,8 @@ def run_events(S, H, G, k, table, gains, palette, inv_ww, background_mask, suppo
     n_out = 0
     delay = line.shape[0] - 1
     first_step = G[STEP]
-    fb = k[C_FB]
-    bits = k[C_SUPPORT_BITS]
+    fb = k.background_frac
+    bits = k.support_cell_bits
     for i in range(t_us.size):
         t = np.int64(t_us[i]) & TIME_MASK  # the 32-bit timestamp counter
         ex, ey = np.int64(xs[i]), np.int64(ys[i])
@@ -634,11 +562,11 @@ def run_events(S, H, G, k, table, gains, palette, inv_ww, background_mask, suppo
         row = line[G[EVENTS] % (delay + 1)]  # it holds event n - D - 1: its turn to commit
         if delay > 0:
             _commit(S, H, G, row, k, table, log, ranges)
-        s = _seek(S, ex << k[C_FP], ey << k[C_FP], k)
+        s = _seek(S, ex << k.centre_frac, ey << k.centre_frac, k)
         updated_reported = False
         action = TRACE_UPDATE
         cx, cy = (ex >> bits) + 1, (ey >> bits) + 1
-        if s < 0 and k[C_SUPPORT] != 0 and not _supported(support, seen, cx, cy, t, k[C_SUPPORT_WINDOW]):
+        if s < 0 and k.create_support != 0 and not _supported(support, seen, cx, cy, t, k.support_window):
             G[UNSUPPORTED] += 1
             action = TRACE_UNSUPPORTED
         elif s < 0:
@@ -656,21 +584,21 @@ def run_events(S, H, G, k, table, gains, palette, inv_ww, background_mask, suppo
             updated_reported = S[s, REPORTED] != 0
         if trace is not None:
             trace[i] = (action << 16) | max(s, 0)
-        if k[C_SUPPORT] != 0:
+        if k.create_support != 0:
             support[cy, cx] = t
             seen[cy, cx] = True
-        if not updated_reported and k[C_NOISE_GATE] != 0:  # the background's activity: read by the noise gate only
+        if not updated_reported and k.noise_gate != 0:  # the background's activity: read by the noise gate only
             _decay_background(G, t, k, table)
-            G[BG_ACT] = _store(G[BG_ACT] + (np.int64(1) << k[C_FA]), 0, k[C_MAX_ACT], S_ACT, log, ranges)
-        if k[C_COLOUR] != 0 and k[C_BG_FIXED] == 0 and not updated_reported:
+            G[BG_ACT] = _store(G[BG_ACT] + (np.int64(1) << k.activity_frac), 0, k.activity_max, S_ACT, log, ranges)
+        if k.has_colour != 0 and k.background_fixed == 0 and not updated_reported:
             row[PD_BG] = 1
-            row[PD_BG_Y] = alpha_increment_nb(G[BG_Y], lum, k[C_B_BG], k[C_BB_BG], fb, FLOOR)
-            row[PD_BG_CB] = alpha_increment_nb(G[BG_CB], cb, k[C_B_BG], k[C_BB_BG], fb, FLOOR)
-            row[PD_BG_CR] = alpha_increment_nb(G[BG_CR], cr, k[C_B_BG], k[C_BB_BG], fb, FLOOR)
+            row[PD_BG_Y] = alpha_increment_nb(G[BG_Y], lum, k.beta_bg, k.beta_bg_frac, fb, FLOOR)
+            row[PD_BG_CB] = alpha_increment_nb(G[BG_CB], cb, k.beta_bg, k.beta_bg_frac, fb, FLOOR)
+            row[PD_BG_CR] = alpha_increment_nb(G[BG_CR], cr, k.beta_bg, k.beta_bg_frac, fb, FLOOR)
         if delay == 0:
             _commit(S, H, G, row, k, table, log, ranges)
         G[SINCE_FILTER] += 1
-        if G[SINCE_FILTER] >= k[C_EVERY]:
+        if G[SINCE_FILTER] >= k.filter_every:
             G[SINCE_FILTER] = 0
             steps[G[STEP] - first_step] = t_us[i]
             first = n_out

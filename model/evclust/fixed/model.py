@@ -7,6 +7,7 @@ import numpy as np
 from evclust.clusterer.layout import BG_CB, BG_CR, BG_Y, PENDING_COLUMNS, RECORD_COLUMNS, SLOT_COLUMNS, STEP, run_stats, support_shape
 from evclust.clusterer.params import ClustererParams
 from evclust.fixed import fixed_model
+from evclust.fixed.constants import constant_vector
 from evclust.fixed.formats import FormatTable, build_formats, decay_table
 from evclust.fixed.registers import runtime_table
 
@@ -39,7 +40,7 @@ class FixedClusterer:
             self.table = runtime_table(build, params, t_frame_us)
         else:
             self.table = build_formats(params, width, height, t_frame_us, **format_options)
-        self.k = fixed_model.constant_vector(self.table, params, has_colour)
+        self.k = constant_vector(self.table, params, has_colour)
         self.decay = np.asarray(decay_table(self.table), dtype=np.int64)
         self.gains = np.asarray(self.table.warmup_gains, dtype=np.int64)
         self.palette = np.array(

@@ -22,7 +22,7 @@ from evclust.report.budget import (
     OBJECT_OUTPUTS, OUTPUTS, SIGNAL_GROUP, SOURCES, best_velocity_nrmse, budget, error_vs_frac_bits, noise_sum_ratio, scene_scores,
     wordlength_search,
 )  # fmt: skip
-from evclust.report.hardware import CONFIGS, evaluate_configs, rtl_runtime, start_synthesis
+from evclust.report.hardware import CONFIGS, QUICK_CONFIGS, evaluate_configs, rtl_runtime, start_synthesis
 from evclust.report.results import PAPER, _num, _pct
 from evclust.report.tradeoffs import TAU_FRAMES, effect_costs, velocity_tradeoff
 from evclust.scenes import load_scene
@@ -329,7 +329,7 @@ def hardware_section(results, img: Path, scene_names: list[str], quick: bool) ->
     ]
     synthesised = [r for r in results if isinstance(r.area, dict)]
     if quick or not synthesised:
-        lines += ["Area: not synthesised in this run (`--quick` skips Yosys; `make report` runs it).", ""]
+        lines += ["Area: not synthesised in this run (`--quick` skips Yosys and the guard-bit rows; `make report` runs both).", ""]
     else:
         figures.area_against_accuracy(
             [r.config.label for r in synthesised], [r.area for r in synthesised],
@@ -392,7 +392,7 @@ def write_report(out: Path, quick: bool = False, progress: bool = True) -> Path:
     out = Path(out)
     img = out / "img"
     img.mkdir(parents=True, exist_ok=True)
-    steps = len(SCENES) * (len(SOURCES) + 4 + 45) + len(SIGNAL_GROUP) + 1 + 20 + 10 + len(CONFIGS) + 2
+    steps = len(SCENES) * (len(SOURCES) + 4 + 45) + len(SIGNAL_GROUP) + 1 + 20 + 10 + len(QUICK_CONFIGS if quick else CONFIGS) + 2
     bar = tqdm(total=steps, desc="report", unit="run", disable=None if progress else True)
     scenes = {name: _scene(name, quick) for name in SCENES}
     first_meta, first_events, first_params, _, _ = scenes[SCENES[0]]
@@ -426,7 +426,7 @@ def write_report(out: Path, quick: bool = False, progress: bool = True) -> Path:
     rtl = rtl_runtime(first_meta, first_events, first_params, RTL_EVENTS[quick])
     bar.update(1)
     runtime_lines = runtime_section(scenes, rtl, img, yosys_running)
-    configs = evaluate_configs(scenes, CYCLE_EVENTS[quick], progress=lambda: bar.update(1))
+    configs = evaluate_configs(scenes, CYCLE_EVENTS[quick], QUICK_CONFIGS if quick else CONFIGS, progress=lambda: bar.update(1))
     if synthesis:
         synthesis.add_worker()  # nothing else left to run: both cores to Yosys
         areas = synthesis.wait()
