@@ -12,7 +12,8 @@ modulo 2^32, STATUS's sticky flags (write 1 to clear) and `irq` (the RDL's `intr
 their `enable`s), and 0 outside the map. Driven by cocotbext-axi's AXI4-Lite master, under
 Icarus and Verilator.
 
-Rounds of: random counter increments for a while (then none, so that reads are exact), then
+First every register word and its neighbours read once out of reset (the RDL's reset values);
+then rounds of: random counter increments for a while (then none, so that reads are exact), then
 random bus operations (every kind above, reads of every register word and of addresses around
 the map), each read compared with the model, `irq` and the CLEAR pulses checked throughout.
 """
@@ -203,6 +204,12 @@ if cocotb is not None:
         config_words = model.config_words()
         status, irq_enable, ctrl = model.address("STATUS"), model.address("IRQ_ENABLE"), model.address("CTRL")
         checked, expected_pulses = 0, 0
+        # Out of reset, before any write: every word reads its RDL reset value.
+        for address in addresses:
+            got, want = await bus.read_dword(address), model.read(address, int(dut.idle.value))
+            checked += 1
+            if got != want:
+                return f"after reset: read 0x{address:03x}: RTL {got:#010x}, register map {want:#010x}", checked
         for round_ in range(ROUNDS):
             await FallingEdge(dut.clk)  # each increment set between edges, taken by the next rising one
             for _ in range(rng.randrange(1, 40)):  # the core counting: up to 3 per counter per cycle
