@@ -6,7 +6,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 BUILD  := build
 
-.PHONY: formal setup demo demo-video results-video bench-peers test test-full cosim cosim-full coverage lint synth timing bench results report params vectors generalize clean
+.PHONY: formal setup demo demo-video results-video bench-peers test test-full cosim cosim-full coverage lint synth timing bench results report params registers-html vectors generalize clean
 
 setup: $(STAMP)
 
@@ -101,9 +101,16 @@ bench: $(STAMP)
 	$(PY) bench/event_io.py --write docs/BENCHMARKS.md
 	$(PY) bench/startup.py --write docs/BENCHMARKS.md
 
-# The RTL parameter header, generated from the formats table (tests fail when it is stale).
+# The RTL parameter header and the register map's files (SystemRDL, and from it with PeakRDL the C
+# header, docs/REGISTERS.md and IP-XACT), generated from the formats table (tests fail when stale).
 params: $(STAMP)
-	$(VENV)/bin/evclust formats --verilog rtl/evclust_params.vh --c-header rtl/evclust_regs.h --registers docs/REGISTERS.md > /dev/null
+	$(VENV)/bin/evclust formats --verilog rtl/evclust_params.vh --rdl rtl/evclust_regs.rdl --c-header rtl/evclust_regs.h \
+		--registers docs/REGISTERS.md --ipxact rtl/evclust_regs.xml > /dev/null
+
+# The register map as HTML pages (PeakRDL-html, from the same RDL as `make params`' files), into
+# build/registers/ only: open build/registers/index.html.
+registers-html: $(STAMP)
+	$(VENV)/bin/evclust formats --html $(BUILD)/registers > /dev/null
 
 # Golden vectors for the RTL, from the fixed model (tests fail when they are stale).
 vectors: $(STAMP)

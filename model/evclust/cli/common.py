@@ -22,7 +22,7 @@ FILE_ARGUMENTS = {
     "score": (("tracks", "truth"), ("json",)),
     "reference": (("video", "params"), ("output",)),
     "tune": (("scene", "params"), ("output",)),
-    "formats": (("params", "write_for"), ("verilog", "c_header", "registers")),
+    "formats": (("params", "write_for"), ("verilog", "rdl", "c_header", "registers", "ipxact")),
     "show": (("events",), ("output",)),
     "render": (("events", "tracks"), ("output",)),
     "plot": (("tracks", "truth", "events"), ("output",)),

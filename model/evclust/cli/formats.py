@@ -1,4 +1,5 @@
-"""evclust formats [--params P.toml] [--width W --height H] [--verilog rtl/evclust_params.vh] [--c-header H] [--registers MD]"""
+"""evclust formats [--params P.toml] [--width W --height H] [--verilog rtl/evclust_params.vh] [--rdl RDL] [--c-header H]
+[--registers MD] [--ipxact XML] [--html DIR]"""
 
 from __future__ import annotations
 
@@ -25,8 +26,11 @@ def add_parser(sub) -> None:
     p.add_argument("--height", type=int, default=REFERENCE[2], help="sensor height, px")
     p.add_argument("--t-frame-us", type=float, default=None, help="frame period, µs (default: the parameters', else 50000)")
     p.add_argument("--verilog", metavar="VH", help="write the Verilog parameter header here")
-    p.add_argument("--c-header", metavar="H", help="write the register map as a C header here (a driver's)")
-    p.add_argument("--registers", metavar="MD", help="write the register map as a Markdown document here")
+    p.add_argument("--rdl", metavar="RDL", help="write the register map in SystemRDL here")
+    p.add_argument("--c-header", metavar="H", help="write the register map as a C header here (a driver's; PeakRDL-cheader)")
+    p.add_argument("--registers", metavar="MD", help="write the register map as a Markdown document here (PeakRDL-markdown)")
+    p.add_argument("--ipxact", metavar="XML", help="write the register map as IP-XACT here (PeakRDL-ipxact)")
+    p.add_argument("--html", metavar="DIR", help="write the register map as HTML pages into this folder (PeakRDL-html)")
     p.add_argument(
         "--write-for",
         metavar="P",
@@ -61,11 +65,20 @@ def run(args) -> int:
     print(render_table(table))
     from evclust.fixed import registers
 
-    for path, text in ((args.verilog, verilog_header), (args.c_header, registers.c_header), (args.registers, registers.markdown)):
+    outputs = {"rdl": args.rdl, "c_header": args.c_header, "markdown": args.registers, "ipxact": args.ipxact}
+    texts = {"verilog": verilog_header(table)} if args.verilog else {}
+    if any(outputs.values()) or args.html:
+        from evclust.fixed import rdl
+
+        texts |= rdl.generated(table)
+    for kind, path in {"verilog": args.verilog, **outputs}.items():
         if path:
             with atomic_output(path) as tmp:
-                tmp.write_text(text(table))
+                tmp.write_text(texts[kind])
             print(f"{path}: written")
+    if args.html:
+        rdl.write_html(table, args.html)
+        print(f"{args.html}/index.html: written")
     if args.write_for:
         other, _ = load_params(args.write_for)
         runtime = registers.runtime_table(table, other, other.t_frame_us or t_frame)

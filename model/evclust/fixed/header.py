@@ -9,7 +9,8 @@ from evclust.fixed import registers
 from evclust.fixed.formats import DECAY_FRAC_BITS, DECAY_TABLE_BITS, OPTIONAL_CONSTANTS, SWEEP_DIV_STEP, FormatTable, decay_table
 from evclust.fixed.layouts import TRACE_FIELDS, event_fields, object_fields, record_fields
 
-_ASCII = str.maketrans({"µ": "u", "²": "^2", "₁": "_1", "α": "alpha", "β": "beta", "γ": "gamma", "θ": "theta", "τ": "tau", "Δ": "d", "·": "*",
+# Non-ASCII characters of the formats' and registers' docs, spelt out for the generated Verilog and SystemRDL.
+ASCII = str.maketrans({"µ": "u", "²": "^2", "₁": "_1", "α": "alpha", "β": "beta", "γ": "gamma", "θ": "theta", "τ": "tau", "Δ": "d", "·": "*",
                         "×": "x", "−": "-", "≥": ">=", "≤": "<="})  # fmt: skip
 
 
@@ -20,7 +21,7 @@ def _packed(name: str, values, width: int) -> str:
 
 def verilog_header(table: FormatTable) -> str:
     """`rtl/evclust_params.vh`: widths, quantised constants and table sizes as localparams (ASCII)."""
-    return _verilog_lines(table).translate(_ASCII)
+    return _verilog_lines(table).translate(ASCII)
 
 
 # The RTL's limits beyond the model's: the trace names a slot in 8 bits, and the tau-boundary
