@@ -238,7 +238,8 @@ def float_fingerprint(files: Files | None = None) -> str:
         env = dict(os.environ, PYTHONPATH=str(Path(tmp) / "model"), NUMBA_CACHE_DIR=str(Path(tmp) / "numba"))
         run = subprocess.run([sys.executable, "-c", probe], cwd=tmp, env=env, capture_output=True, text=True)
         if run.returncode != 0:
-            last = (run.stderr.strip().splitlines() or ["no output"])[-1]
+            errors = [line for line in run.stderr.splitlines() if re.match(r"[\w.]+(Error|Exception)\b", line)]
+            last = (errors or run.stderr.strip().splitlines() or ["no output"])[-1]
             raise EvclustError(f"the float probe does not run on {files.commit}'s model: {last}")
         return run.stdout.strip().splitlines()[-1]
 
@@ -337,14 +338,29 @@ def stamp_document(doc: Document, values: dict[str, str] | None = None, root: Pa
     path.write_text(head + stamped(doc, doc.start + section, stamp_line(doc, values)) + doc.end + tail)
 
 
-def vouch(doc: Document, commit: str) -> dict[str, str]:
-    """The document's inputs' fingerprints if each is the same at `commit` (where the document was
-    made) as now; otherwise a one-line refusal naming the inputs that changed."""
+def _content(doc: Document, text: str) -> str | None:
+    """The document (or its section) without its stamp: what its generator wrote."""
+    if doc.start is not None:
+        if doc.start not in text or doc.end not in text:
+            return None
+        text = doc.start + text.split(doc.start, 1)[1].split(doc.end, 1)[0]
+    return "\n".join(line for line in text.split("\n") if not STAMP_RE.fullmatch(line))
+
+
+def vouch(doc: Document, commit: str, root: Path = REPO) -> dict[str, str]:
+    """The document's inputs' fingerprints if it is as it was at `commit` (where it was made) and
+    each input's fingerprint is the same at `commit` as now; otherwise a one-line refusal."""
+    then_text = Files(commit, root).read(doc.path).decode()
+    if _content(doc, then_text) is None or _content(doc, then_text) != _content(doc, (root / doc.path).read_text()):
+        raise EvclustError(f"{doc.name}: {doc.path} is not as it was at {commit}: it was not made there, or was edited since")
     now = fingerprints(doc.inputs)
-    then = fingerprints(doc.inputs, commit)
-    changed = [name for name in doc.inputs if now[name] != then[name]]
-    if changed:
-        raise EvclustError(f"{doc.name}: {', '.join(changed)} changed since {commit}; regenerate it with {doc.target}")
+    for name in sorted(doc.inputs, key=lambda n: n == "float"):  # the float probe last: it costs most
+        try:
+            then = fingerprints((name,), commit)[name]
+        except EvclustError as exc:
+            raise EvclustError(f"{doc.name}: {exc}; regenerate it with {doc.target}") from None
+        if then != now[name]:
+            raise EvclustError(f"{doc.name}: {name} changed since {commit}; regenerate it with {doc.target}")
     return now
 
 
