@@ -13,7 +13,8 @@ the behaviour keeps the stamps (as the golden vectors' staleness check compares 
   float    the float model's and the simulator's behaviour: a small scene simulated without and
            with every sensor effect, each run through the float model with the configurations the
            documents use (the defaults, each preset, the defaults at update_delay 1 and 2), object
-           layer included; plus the built-in scenes as parsed. Its records hashed.
+           layer included; plus the built-in scenes as parsed. Its events and its records (as
+           float32, so that another machine's last-place rounding does not count) hashed.
 
     python -m evclust.stamps                       # the current fingerprints and every document's state
     python -m evclust.stamps --stamp NAME --made-at COMMIT
@@ -192,6 +193,14 @@ legs = [{ frames = 18, velocity = [0.0, -4.5] }]
 """
 
 
+def _rounded(rows) -> bytes:
+    """Records as float32: a last-place difference of a float64 (another CPU's libm or SIMD path)
+    does not change them, a change of the model's behaviour does."""
+    import numpy as np
+
+    return np.ascontiguousarray(rows, dtype=np.float32).tobytes()
+
+
 def probe_records() -> list[tuple[str, bytes]]:
     """The float probe's outputs, each labelled. Only long-standing interfaces of the models are
     used, so that `--made-at` can run this on an earlier commit's model."""
@@ -215,10 +224,10 @@ def probe_records() -> list[tuple[str, bytes]]:
         for name, params in configs:
             model = FloatClusterer(params, src.width, src.height, src.t_frame_us)
             rows = model.feed(events)
-            out.append((f"{label} {name} clusters", np.ascontiguousarray(rows).tobytes()))
+            out.append((f"{label} {name} clusters", _rounded(rows)))
             if params.objects:
                 objects = FloatObjects(model.params, src.width, src.height, src.t_frame_us)
-                out.append((f"{label} {name} objects", np.ascontiguousarray(objects.feed(rows, model.steps)).tobytes()))
+                out.append((f"{label} {name} objects", _rounded(objects.feed(rows, model.steps))))
     return out
 
 
