@@ -92,7 +92,9 @@ def main() -> int:
     text = "\n".join(lines) + "\n"
     print(text)
     if args.write:
-        common.write_section(Path(args.write), text, START, END)
+        from evclust.stamps import stamp_for
+
+        common.write_section(Path(args.write), text, START, END, stamp=stamp_for("BENCHMARKS:clusterer"))
     return 0
 
 

@@ -150,8 +150,9 @@ def main() -> int:
     print(section)
     if args.write:
         from evclust.documents import write_section
+        from evclust.stamps import stamp_for
 
-        write_section(Path(args.write), section, START, END)
+        write_section(Path(args.write), section, START, END, stamp=stamp_for("BENCHMARKS:peers"))
     return 0
 
 

@@ -136,7 +136,9 @@ def main() -> int:
     text = "\n".join(lines)
     print(text)
     if args.write:
-        common.write_section(Path(args.write), text, START, END)
+        from evclust.stamps import stamp_for
+
+        common.write_section(Path(args.write), text, START, END, stamp=stamp_for("BENCHMARKS:rtl"))
     (ROOT / "build" / "bench_rtl.json").write_text(json.dumps({"cases": cases, "speed": speed}, indent=1))
     return 0
 

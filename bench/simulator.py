@@ -474,7 +474,9 @@ def main(argv: list[str] | None = None) -> int:
     text = report(cases, costs, video_note, args.repeat, effects, missing)
     print(text, end="")
     if args.write:
-        common.write_section(Path(args.write), text, START, END)
+        from evclust.stamps import stamp_for
+
+        common.write_section(Path(args.write), text, START, END, stamp=stamp_for("BENCHMARKS:simulator"))
         print(f"bench: wrote {args.write}", file=sys.stderr)
     return 0
 

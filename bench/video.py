@@ -145,7 +145,9 @@ def main() -> int:
     ])  # fmt: skip
     print(section)
     if args.write:
-        common.write_section(Path(args.write), section, START, END)
+        from evclust.stamps import stamp_for
+
+        common.write_section(Path(args.write), section, START, END, stamp=stamp_for("RESULTS:video"))
     return 0
 
 

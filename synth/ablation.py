@@ -175,8 +175,9 @@ def main():
     print(text)
     if args.write:
         from evclust.documents import write_section
+        from evclust.stamps import stamp_for
 
-        write_section(args.write, text, START, END)
+        write_section(args.write, text, START, END, stamp=stamp_for("TUNING:ablation"))
 
 
 if __name__ == "__main__":

@@ -148,11 +148,12 @@ def main():
     print(table(rows))
     if args.write:
         from evclust.documents import write_section
+        from evclust.stamps import stamp_for
 
         if args.defaults:
-            write_section(args.write, defaults_section(rows), DEFAULTS_START, DEFAULTS_END)
+            write_section(args.write, defaults_section(rows), DEFAULTS_START, DEFAULTS_END, stamp=stamp_for("BENCHMARKS:synth-defaults"))
         else:
-            write_section(args.write, section(rows), START, END)
+            write_section(args.write, section(rows), START, END, stamp=stamp_for("BENCHMARKS:synth"))
 
 
 if __name__ == "__main__":

@@ -189,12 +189,14 @@ def main():
     print(table(rows))
     if args.write:
         from evclust.documents import write_section
+        from evclust.stamps import stamp_for
 
-        write_section(args.write, section(rows), START, END)
+        write_section(args.write, section(rows), START, END, stamp=stamp_for("BENCHMARKS:timing"))
     if args.datasheet:
         from evclust.documents import write_section
+        from evclust.stamps import stamp_for
 
-        write_section(args.datasheet, datasheet(rows), DATASHEET_START, DATASHEET_END)
+        write_section(args.datasheet, datasheet(rows), DATASHEET_START, DATASHEET_END, stamp=stamp_for("RTL:datasheet"))
 
 
 if __name__ == "__main__":

@@ -54,4 +54,4 @@ def test_the_tests_mirror_the_packages():
     folders = {p.name for p in (ROOT / "tests").iterdir() if p.is_dir() and not p.name.startswith((".", "__"))}
     assert folders <= packages, f"test folders that name no package: {sorted(folders - packages)}"
     top = sorted(p.name for p in (ROOT / "tests").glob("test_*.py"))
-    assert top == ["test_readonly_install.py", "test_style.py"], top
+    assert top == ["test_documents.py", "test_readonly_install.py", "test_style.py"], top

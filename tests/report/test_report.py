@@ -68,6 +68,7 @@ def test_every_source_is_in_the_budget(traffic_budget):
 def test_the_quick_report_writes_its_markdown_and_figures(tmp_path):
     path = write_report(tmp_path, quick=True, progress=False)
     text = path.read_text()
+    assert text.startswith("<!-- inputs: formats=")  # its input stamp (evclust.stamps)
     for heading in ("## Fixed-point error budget", "## Error against fraction bits", "## Ranges and saturation", "## Task results: float and fixed",
                     "### Float, fixed and RTL", "### Word lengths and N: accuracy against area and cycles", "### Shift-only β against multiplier β"):  # fmt: skip
         assert heading in text

@@ -56,6 +56,7 @@ def test_the_report_rewrites_only_its_section(tmp_path):
     coverage.write_table(doc, coverage.markdown(bins, 1))
     text = doc.read_text()
     assert text.startswith("before\n") and text.endswith("after\n") and "old" not in text
+    assert f"{coverage.BEGIN}\n<!-- inputs: formats=" in text  # its input stamp (evclust.stamps)
     other = tmp_path / "other.md"
     other.write_text("no coverage section here\n")
     with pytest.raises(EvclustError, match="no <!-- coverage:begin --> ... <!-- coverage:end --> section"):

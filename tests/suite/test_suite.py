@@ -20,6 +20,7 @@ def test_generalize_writes_the_page_for_a_few_scenes(tmp_path, capsys):
                  "--workers", "2", "-o", str(out), "-q"])  # fmt: skip
     assert code == 0
     text = out.read_text()
+    assert text.startswith("<!-- inputs: formats=")  # its input stamp (evclust.stamps)
 
     # Three configurations, float and fixed of the defaults beside the paper's: what each reports
     # (the defaults' objects, the paper's clusters), then every one's cluster records.

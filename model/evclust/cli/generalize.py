@@ -76,7 +76,8 @@ def run(args) -> int:
         runs = run_configurations(client, Path(args.suite_dir), seeds, configurations, progress=not args.quiet)
     write_report(runs, Path(args.suite_dir), out, args.split, seeds, command, machine, picture,
                  categories_of=("default",) if args.ablation else None,
-                 title="Ablation: what each addition beyond the paper buys" if args.ablation else "Generalization")  # fmt: skip
+                 title="Ablation: what each addition beyond the paper buys" if args.ablation else "Generalization",
+                 document="ABLATION" if args.ablation else "GENERALIZATION")  # fmt: skip
     if args.json:
         write_figures(runs, Path(args.json))
     print(f"{out}: {len(seeds)} scenes of the {args.split} split, {len(runs)} configurations")

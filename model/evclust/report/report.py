@@ -28,6 +28,7 @@ from evclust.report.tradeoffs import TAU_FRAMES, effect_costs, velocity_tradeoff
 from evclust.scenes import load_scene
 from evclust.scenes.truth import truth_array
 from evclust.simulator import simulate_scene
+from evclust.stamps import stamp_for
 
 SCENES = ("traffic", "pedestrian")
 QUICK_EVENTS = {"traffic": 150_000, "pedestrian": 60_000}  # the first events of each scene in --quick
@@ -500,5 +501,5 @@ def write_report(out: Path, quick: bool = False, progress: bool = True) -> Path:
     ]
     path = out / "REPORT.md"
     with atomic_output(path) as tmp:
-        tmp.write_text("\n".join(text) + "\n")
+        tmp.write_text("\n".join([stamp_for("REPORT"), *text]) + "\n")
     return path

@@ -18,6 +18,7 @@ from evclust.tracks import VELOCITY_METHODS
 from evclust.scenes import load_scene
 from evclust.scenes.truth import truth_array
 from evclust.simulator import simulate_scene
+from evclust.stamps import stamp_for
 
 # The paper's Tables 5 and 7 (Lesage et al., Sensors 2023).
 PAPER = {
@@ -404,7 +405,7 @@ def write_results(
     if video:
         lines += ["", video]
     with atomic_output(path) as tmp:
-        tmp.write_text("\n".join(lines).lstrip() + "\n")
+        tmp.write_text(stamp_for("RESULTS") + "\n" + "\n".join(lines).lstrip() + "\n")
     return results
 
 

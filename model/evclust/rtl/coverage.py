@@ -17,6 +17,7 @@ from pathlib import Path
 from evclust.clusterer.layout import FLAG_BORDER, FLAG_MOVING_INT, FLAG_MOVING_MCM, FLAG_NEW
 from evclust.documents import write_section
 from evclust.fixed.registers import SATURATING_SIGNALS
+from evclust.stamps import stamp_for
 
 COVERAGE_DIR = Path("build") / "coverage"
 STATES = ("INIT", "IDLE", "EXEC", "SCAN", "EVICT", "SWEEP", "MERGE", "PHASE")  # ST_* codes 0..7
@@ -119,7 +120,7 @@ BEGIN, END = "<!-- coverage:begin -->", "<!-- coverage:end -->"
 
 def write_table(doc: Path, lines: list[str]) -> None:
     """The coverage table into `doc`'s coverage section (a document without one is an error)."""
-    write_section(doc, "\n".join([BEGIN, *lines, END]), BEGIN, END, append=False)
+    write_section(doc, "\n".join([BEGIN, *lines, END]), BEGIN, END, append=False, stamp=stamp_for("VERIFICATION:coverage"))
 
 
 def main(argv=None) -> int:

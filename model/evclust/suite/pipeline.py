@@ -107,4 +107,4 @@ def write_page(by_split: dict, out: Path, command: str, machine: str, scenes: di
         lines += [f"## {split} split ({scenes[split]} scenes; {what})", "", *section(split, changes, held_out), ""]
     lines += commands_section(("make generalize          # this page, with docs/GENERALIZATION.md",
                                "evclust generalize --pipeline -o docs/PIPELINE.md"))  # fmt: skip
-    return save_page(out, lines)
+    return save_page(out, lines, "PIPELINE")

@@ -23,6 +23,7 @@ from evclust.suite.evaluate import evaluate_scene
 from evclust.suite.figures import failure_grid
 from evclust.suite.prepare import SceneFiles, prepare_scene
 from evclust.suite.run import map_scenes
+from evclust.stamps import stamp_for
 
 # The targets on the test split (default configuration, float model, what it reports).
 TARGETS = (
@@ -240,8 +241,9 @@ def write_figures(runs: list[SuiteRun], path: Path) -> None:
 
 
 def write_report(runs: list[SuiteRun], folder: Path, out: Path, split: str, seeds, command: str, machine: str,
-                 picture: Path | None, categories_of=None, title: str = "Generalization") -> str:  # fmt: skip
-    """The page. `categories_of`: the configurations whose category tables are given (default: all)."""
+                 picture: Path | None, categories_of=None, title: str = "Generalization", document: str = "GENERALIZATION") -> str:  # fmt: skip
+    """The page. `categories_of`: the configurations whose category tables are given (default: all);
+    `document`: which of evclust.stamps.DOCUMENTS it is (its input stamp)."""
     default = next(r for r in runs if r.configuration.name == "default" and r.configuration.model == "float")
     files_of = lambda name: SceneFiles(name, folder)
     panels = failure_grid(default.results, files_of, default.configuration.params, picture) if picture else []
@@ -323,7 +325,7 @@ def write_report(runs: list[SuiteRun], folder: Path, out: Path, split: str, seed
             )
         ),
     ]
-    return save_page(out, lines)
+    return save_page(out, lines, document)
 
 
 def commands_section(commands) -> list[str]:
@@ -331,8 +333,9 @@ def commands_section(commands) -> list[str]:
     return ["## Commands", "", "```sh", *commands, "```", ""]
 
 
-def save_page(out: Path, lines: list[str]) -> str:
-    text = "\n".join(lines)
+def save_page(out: Path, lines: list[str], document: str) -> str:
+    """The page, its input stamp (evclust.stamps: `document`'s inputs) on its first line."""
+    text = "\n".join([stamp_for(document), *lines])
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(text)
     return text

@@ -1,0 +1,403 @@
+"""Input stamps of the generated documents: each document (or section of one) records, in one HTML
+comment line, fingerprints of the inputs it was made from, and tests/test_documents.py fails when
+an input changed since, naming the document, the input and the make target that regenerates it.
+
+The inputs are fingerprinted by what they do, not by their source text, so a refactor that keeps
+the behaviour keeps the stamps (as the golden vectors' staleness check compares outputs):
+
+  formats  sha256 of the generated header rtl/evclust_params.vh (a test keeps it current with the
+           formats table)
+  rtl      sha256 over the RTL's sources (rtl/*.v, rtl/*.vh but the generated header), by name
+  fixed    sha256 over the golden vectors' manifests' sha256 entries (vectors/*/manifest.json; the
+           vectors' staleness test keeps them equal to what the fixed model writes now)
+  float    the float model's and the simulator's behaviour: a small scene simulated without and
+           with every sensor effect, each run through the float model with the configurations the
+           documents use (the defaults, each preset, the defaults at update_delay 1 and 2), object
+           layer included; plus the built-in scenes as parsed. Its events and its records (as
+           float32, so that another machine's last-place rounding does not count) hashed.
+
+    python -m evclust.stamps                       # the current fingerprints and every document's state
+    python -m evclust.stamps --stamp NAME --made-at COMMIT
+        stamps a document made at COMMIT without regenerating it, only where each of its inputs'
+        fingerprints at COMMIT equals today's (the float probe runs on COMMIT's model in a
+        subprocess); otherwise it refuses and names the input that changed.
+
+This module runs the float model, so it sits above evclust.clusterer and evclust.simulator; the
+RTL's coverage table (evclust.rtl.coverage) writes its stamp, so it sits below evclust.rtl. It
+reads the RTL and the vectors as files and imports neither evclust.rtl nor evclust.vectors.
+"""
+
+from __future__ import annotations
+
+import argparse
+import functools
+import hashlib
+import json
+import os
+import re
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+from typing import NamedTuple
+
+from evclust.errors import EvclustError
+
+REPO = Path(__file__).resolve().parents[2]
+HEADER = "rtl/evclust_params.vh"
+INPUTS = ("formats", "rtl", "fixed", "float")
+DIGITS = 12  # hex digits of each fingerprint in a stamp
+STAMP_RE = re.compile(r"<!-- inputs: ((?:[a-z]+=[0-9a-f]+ ?)+) -->")
+
+
+class Document(NamedTuple):
+    """A generated document, or the section of one between two markers (start is None: the
+    whole file, its stamp on the first line)."""
+
+    name: str
+    path: str
+    start: str | None
+    end: str | None
+    inputs: tuple[str, ...]
+    target: str  # what regenerates it
+
+
+def _bench(name: str, inputs: tuple[str, ...], target: str) -> Document:
+    return Document(f"BENCHMARKS:{name}", "docs/BENCHMARKS.md", f"<!-- bench:{name}:start -->", f"<!-- bench:{name}:end -->",
+                    inputs, target)  # fmt: skip
+
+
+# Every generated document and what it is made from: the one table the test and the generators read.
+# Not here: BENCHMARKS' runtime-config section (written by hand, a record of a before/after
+# comparison), its event_io and startup sections (they time the event-file code and the command
+# line's start-up, none of these inputs), docs/REGISTERS.md and rtl/evclust_params.vh (checked
+# byte for byte by their own tests), the README's tables (copied by hand from the documents here).
+# fmt: off
+DOCUMENTS = (
+    Document("REPORT", "docs/report/REPORT.md", None, None, ("formats", "rtl", "fixed", "float"), "make report"),
+    Document("RESULTS", "docs/RESULTS.md", None, None, ("formats", "fixed", "float"), "make results"),
+    Document("RESULTS:video", "docs/RESULTS.md", "<!-- results:video:start -->", "<!-- results:video:end -->", ("float",),
+             "make results-video"),
+    Document("GENERALIZATION", "docs/GENERALIZATION.md", None, None, ("formats", "fixed", "float"), "make generalize"),
+    Document("PIPELINE", "docs/PIPELINE.md", None, None, ("float",), "make generalize"),
+    Document("ABLATION", "docs/ABLATION.md", None, None, ("float",),
+             "evclust generalize --split tuning --ablation -o docs/ABLATION.md"),
+    _bench("simulator", ("float",), "make bench (bench/simulator.py)"),
+    _bench("clusterer", ("formats", "fixed", "float"), "make bench (bench/clusterer.py)"),
+    _bench("rtl", ("formats", "rtl", "fixed"), "make bench (bench/rtl.py)"),
+    _bench("synth", ("formats", "rtl"), "make synth"),
+    _bench("synth-defaults", ("formats", "rtl"), "synth/synth.py --defaults --write docs/BENCHMARKS.md"),
+    _bench("timing", ("formats", "rtl"), "make timing"),
+    _bench("peers", ("float",), "make bench-peers"),
+    Document("RTL:datasheet", "docs/RTL.md", "<!-- datasheet:timing:start -->", "<!-- datasheet:timing:end -->", ("formats", "rtl"),
+             "make timing"),
+    Document("VERIFICATION:coverage", "docs/VERIFICATION.md", "<!-- coverage:begin -->", "<!-- coverage:end -->",
+             ("formats", "rtl", "fixed"), "make coverage"),
+    Document("TUNING:ablation", "docs/TUNING.md", "<!-- ablation:start -->", "<!-- ablation:end -->", ("formats", "rtl", "float"),
+             "synth/ablation.py --write docs/TUNING.md"),
+)
+# fmt: on
+BY_NAME = {d.name: d for d in DOCUMENTS}
+
+
+# -- the fingerprints ------------------------------------------------------------------------------
+
+
+def _sha(chunks) -> str:
+    h = hashlib.sha256()
+    for chunk in chunks:
+        h.update(chunk if isinstance(chunk, bytes) else chunk.encode())
+        h.update(b"\0")
+    return h.hexdigest()
+
+
+class Files:
+    """The repository's files, now (the working tree) or at a commit (git show)."""
+
+    def __init__(self, commit: str | None = None, root: Path = REPO):
+        self.commit, self.root = commit, root
+
+    def _git(self, *args: str) -> str:
+        return subprocess.run(["git", *args], cwd=self.root, capture_output=True, text=True, check=True).stdout
+
+    def names(self, folder: str, suffixes: tuple[str, ...]) -> list[str]:
+        if self.commit is None:
+            found = [str(p.relative_to(self.root)) for p in (self.root / folder).rglob("*") if p.is_file()]
+        else:
+            found = self._git("ls-tree", "-r", "--name-only", self.commit, "--", folder).split()
+        return sorted(n for n in found if n.endswith(suffixes))
+
+    def read(self, name: str) -> bytes:
+        if self.commit is None:
+            return (self.root / name).read_bytes()
+        return subprocess.run(["git", "show", f"{self.commit}:{name}"], cwd=self.root, capture_output=True, check=True).stdout
+
+
+def formats_fingerprint(files: Files) -> str:
+    return hashlib.sha256(files.read(HEADER)).hexdigest()
+
+
+def rtl_fingerprint(files: Files) -> str:
+    names = [n for n in files.names("rtl", (".v", ".vh")) if n != HEADER and n.count("/") == 1]
+    return _sha(part for n in names for part in (n, files.read(n)))
+
+
+def fixed_fingerprint(files: Files) -> str:
+    chunks = []
+    for name in (n for n in files.names("vectors", ("/manifest.json",)) if n.count("/") == 2):
+        manifest = json.loads(files.read(name))
+        chunks += [name.split("/")[1], *(f"{k}={v}" for k, v in sorted(manifest["sha256"].items()))]
+    return _sha(chunks)
+
+
+# The probe's scene: small, coloured objects that enter, cross, turn and leave over a textured
+# background, sampled between frames; simulated once as the ideal sensor and once with every effect.
+PROBE_SCENE = """
+name = "stamp_probe"
+width = 96
+height = 64
+fps = 25
+frames = 24
+substeps = 2
+seed = 5
+[background]
+kind = "texture"
+colour = [90, 100, 110]
+contrast = 6
+scale = 3
+[[objects]]
+id = 1
+label = "red"
+size = [14, 10]
+colour = [200, 30, 30]
+patches = [{ offset = [3, 0], size = [5, 6], colour = [40, 40, 60] }]
+start = [-6.0, 20.0]
+legs = [{ frames = 24, velocity = [5.0, 0.5] }]
+[[objects]]
+id = 2
+label = "blue"
+shape = "ellipse"
+size = [12, 12]
+colour = [30, 60, 210]
+start = [80.0, 50.0]
+start_frame = 3
+legs = [{ frames = 10, velocity = [-3.0, -1.0] }, { frames = 11, velocity = [-1.0, -3.0] }]
+[[objects]]
+id = 3
+label = "white"
+size = [8, 20]
+colour = [235, 235, 230]
+start = [40.0, 70.0]
+start_frame = 6
+legs = [{ frames = 18, velocity = [0.0, -4.5] }]
+"""
+
+
+def _rounded(rows) -> bytes:
+    """Records as float32: a last-place difference of a float64 (another CPU's libm or SIMD path)
+    does not change them, a change of the model's behaviour does."""
+    import numpy as np
+
+    return np.ascontiguousarray(rows, dtype=np.float32).tobytes()
+
+
+def probe_records() -> list[tuple[str, bytes]]:
+    """The float probe's outputs, each labelled. Only long-standing interfaces of the models are
+    used, so that `--made-at` can run this on an earlier commit's model."""
+    import numpy as np
+
+    from evclust.clusterer import ClustererParams, FloatClusterer, load_params, preset_names
+    from evclust.clusterer.objects import FloatObjects
+    from evclust.scenes import builtin_scenes, load_scene, scene_from_toml
+    from evclust.simulator import EFFECTS, simulate_scene
+
+    out = [(f"scene {name}", load_scene(name).spec.model_dump_json().encode()) for name in builtin_scenes()]
+    configs = [("defaults", ClustererParams())] + [(name, load_params(name)[0]) for name in preset_names()]
+    configs += [(f"defaults D={d}", ClustererParams(update_delay=d)) for d in (1, 2)]
+    ideal = scene_from_toml(PROBE_SCENE, "stamp probe")
+    effects = scene_from_toml(PROBE_SCENE + "".join(f"[effects.{name}]\n" for name in EFFECTS), "stamp probe, every effect")
+    for label, scene in (("ideal", ideal), ("effects", effects)):
+        sim = simulate_scene(scene)
+        events = np.ascontiguousarray(sim.events)
+        out.append((f"events {label}", events.tobytes()))
+        src = scene.source
+        for name, params in configs:
+            model = FloatClusterer(params, src.width, src.height, src.t_frame_us)
+            rows = model.feed(events)
+            out.append((f"{label} {name} clusters", _rounded(rows)))
+            if params.objects:
+                objects = FloatObjects(model.params, src.width, src.height, src.t_frame_us)
+                out.append((f"{label} {name} objects", _rounded(objects.feed(rows, model.steps))))
+    return out
+
+
+def float_fingerprint(files: Files | None = None) -> str:
+    """The probe's hash, run here, or (files at a commit) on that commit's model in a subprocess."""
+    if files is None or files.commit is None:
+        return _sha(part for label, data in probe_records() for part in (label, data))
+    with tempfile.TemporaryDirectory(prefix="evclust-stamp-") as tmp:
+        archive = subprocess.run(["git", "archive", files.commit, "model"], cwd=files.root, capture_output=True, check=True).stdout
+        subprocess.run(["tar", "-x", "-C", tmp], input=archive, check=True)
+        probe = (
+            "import importlib.util, sys\n"
+            f"spec = importlib.util.spec_from_file_location('evclust_stamp_probe', {str(Path(__file__))!r})\n"
+            "m = importlib.util.module_from_spec(spec); spec.loader.exec_module(m)\n"
+            "print(m.float_fingerprint())\n"
+        )
+        env = dict(os.environ, PYTHONPATH=str(Path(tmp) / "model"), NUMBA_CACHE_DIR=str(Path(tmp) / "numba"))
+        run = subprocess.run([sys.executable, "-c", probe], cwd=tmp, env=env, capture_output=True, text=True)
+        if run.returncode != 0:
+            errors = [line for line in run.stderr.splitlines() if re.match(r"[\w.]+(Error|Exception)\b", line)]
+            last = (errors or run.stderr.strip().splitlines() or ["no output"])[-1]
+            raise EvclustError(f"the float probe does not run on {files.commit}'s model: {last}")
+        return run.stdout.strip().splitlines()[-1]
+
+
+FINGERPRINTS = {"formats": formats_fingerprint, "rtl": rtl_fingerprint, "fixed": fixed_fingerprint, "float": float_fingerprint}
+
+
+def fingerprints(inputs=INPUTS, commit: str | None = None) -> dict[str, str]:
+    """The inputs' fingerprints (12 hex digits each), now or at a commit."""
+    if commit is None:
+        return {name: _current(name) for name in inputs}
+    files = Files(commit)
+    return {name: FINGERPRINTS[name](files)[:DIGITS] for name in inputs}
+
+
+@functools.cache
+def _current(name: str) -> str:
+    """An input's fingerprint now, once per process (a generator stamps once, at its end)."""
+    return FINGERPRINTS[name](Files())[:DIGITS]
+
+
+def stamp_for(name: str) -> str:
+    """The stamp line a generator writes into the document `name` of DOCUMENTS."""
+    return stamp_line(BY_NAME[name])
+
+
+# -- stamps in documents ---------------------------------------------------------------------------
+
+
+def stamp_line(doc: Document, values: dict[str, str] | None = None) -> str:
+    """The document's stamp: its inputs' fingerprints (now, unless given)."""
+    values = values if values is not None else fingerprints(doc.inputs)
+    return "<!-- inputs: " + " ".join(f"{name}={values[name][:DIGITS]}" for name in doc.inputs) + " -->"
+
+
+def stamped(doc: Document, text: str, line: str | None = None) -> str:
+    """`text` (the whole document, or its section from start marker to end marker) with its stamp
+    line added or replaced: the first line of a whole document, the line after a section's start."""
+    line = line or stamp_line(doc)
+    if doc.start is None:
+        lines = text.split("\n")
+        if lines and STAMP_RE.fullmatch(lines[0]):
+            lines = lines[1:]
+        return "\n".join([line, *lines])
+    if not text.startswith(doc.start):
+        raise EvclustError(f"{doc.name}: the section does not begin with {doc.start}")
+    body = text[len(doc.start) :].lstrip("\n")
+    first, _, rest = body.partition("\n")
+    if STAMP_RE.fullmatch(first):
+        body = rest
+    return f"{doc.start}\n{line}\n{body}"
+
+
+def read_stamp(doc: Document, text: str) -> dict[str, str] | None:
+    """The fingerprints a document records (None: no stamp where it belongs, or no section)."""
+    if doc.start is None:
+        first = text.split("\n", 1)[0]
+    else:
+        if doc.start not in text or doc.end not in text:
+            return None
+        first = text.split(doc.start, 1)[1].lstrip("\n").split("\n", 1)[0]
+    match = STAMP_RE.fullmatch(first)
+    return dict(pair.split("=") for pair in match.group(1).split()) if match else None
+
+
+def check(documents=DOCUMENTS, current: dict[str, str] | None = None, root: Path = REPO) -> list[str]:
+    """One line per document whose stamp is missing or records an input that has changed since."""
+    current = current if current is not None else fingerprints()
+    problems = []
+    for doc in documents:
+        path = root / doc.path
+        if not path.is_file():
+            problems.append(f"{doc.path} ({doc.name}): missing; regenerate it with {doc.target}")
+            continue
+        stamp = read_stamp(doc, path.read_text())
+        if stamp is None:
+            problems.append(f"{doc.path} ({doc.name}): no input stamp; regenerate it with {doc.target}")
+            continue
+        changed = [name for name in doc.inputs if stamp.get(name) != current[name]]
+        if changed:
+            problems.append(f"{doc.path} ({doc.name}): made from other {', '.join(changed)} than now; regenerate it with {doc.target}")
+    return problems
+
+
+def stamp_document(doc: Document, values: dict[str, str] | None = None, root: Path = REPO) -> None:
+    """Add or refresh a document's stamp in place, nothing else."""
+    path = root / doc.path
+    text = path.read_text()
+    if doc.start is None:
+        path.write_text(stamped(doc, text, stamp_line(doc, values)))
+        return
+    if doc.start not in text or doc.end not in text:
+        raise EvclustError(f"{path}: no {doc.start} ... {doc.end} section to stamp")
+    head, rest = text.split(doc.start, 1)
+    section, tail = rest.split(doc.end, 1)
+    path.write_text(head + stamped(doc, doc.start + section, stamp_line(doc, values)) + doc.end + tail)
+
+
+def _content(doc: Document, text: str) -> str | None:
+    """The document (or its section) without its stamp: what its generator wrote."""
+    if doc.start is not None:
+        if doc.start not in text or doc.end not in text:
+            return None
+        text = doc.start + text.split(doc.start, 1)[1].split(doc.end, 1)[0]
+    return "\n".join(line for line in text.split("\n") if not STAMP_RE.fullmatch(line))
+
+
+def vouch(doc: Document, commit: str, root: Path = REPO) -> dict[str, str]:
+    """The document's inputs' fingerprints if it is as it was at `commit` (where it was made) and
+    each input's fingerprint is the same at `commit` as now; otherwise a one-line refusal."""
+    then_text = Files(commit, root).read(doc.path).decode()
+    if _content(doc, then_text) is None or _content(doc, then_text) != _content(doc, (root / doc.path).read_text()):
+        raise EvclustError(f"{doc.name}: {doc.path} is not as it was at {commit}: it was not made there, or was edited since")
+    now = fingerprints(doc.inputs)
+    for name in sorted(doc.inputs, key=lambda n: n == "float"):  # the float probe last: it costs most
+        try:
+            then = fingerprints((name,), commit)[name]
+        except EvclustError as exc:
+            raise EvclustError(f"{doc.name}: {exc}; regenerate it with {doc.target}") from None
+        if then != now[name]:
+            raise EvclustError(f"{doc.name}: {name} changed since {commit}; regenerate it with {doc.target}")
+    return now
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m evclust.stamps", description=__doc__.split("\n\n")[0])
+    ap.add_argument("--stamp", metavar="NAME", choices=sorted(BY_NAME), help="stamp this document without regenerating it")
+    ap.add_argument("--made-at", metavar="COMMIT", help="the commit at which the document was generated (required with --stamp)")
+    args = ap.parse_args(argv)
+    try:
+        if args.stamp:
+            if not args.made_at:
+                ap.error("--stamp needs --made-at COMMIT: the commit whose inputs the document was made from")
+            doc = BY_NAME[args.stamp]
+            commit = subprocess.run(["git", "rev-parse", "--short=12", args.made_at], cwd=REPO, capture_output=True, text=True,
+                                    check=True).stdout.strip()  # fmt: skip
+            values = vouch(doc, commit)
+            stamp_document(doc, values)
+            print(f"{doc.path} ({doc.name}): stamped; its inputs ({', '.join(doc.inputs)}) are the same now as at {commit}")
+            return 0
+        current = fingerprints()
+        print(" ".join(f"{k}={v}" for k, v in current.items()))
+        for line in check(current=current) or ["every document is current"]:
+            print(line)
+        return 0
+    except (EvclustError, subprocess.CalledProcessError) as exc:
+        print(f"evclust.stamps: {exc}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
