@@ -10,16 +10,17 @@ the behaviour keeps the stamps (as the golden vectors' staleness check compares 
   rtl      sha256 over the RTL's sources (rtl/*.v, rtl/*.vh but the generated header), by name
   fixed    sha256 over the golden vectors' manifests' sha256 entries (vectors/*/manifest.json; the
            vectors' staleness test keeps them equal to what the fixed model writes now)
-  float    the float model's and the simulator's behaviour: a small scene simulated without and
-           with every sensor effect, each run through the float model with the configurations the
-           documents use (the defaults, each preset, the defaults at update_delay 1 and 2), object
-           layer included; plus the built-in scenes as parsed. Its events and its records (as
-           float32, so that another machine's last-place rounding does not count) hashed.
+  simulator  the simulator's behaviour: a small scene simulated without and with every sensor
+           effect, its events hashed, and the built-in scenes as parsed
+  float    the float model's behaviour (on the simulator's): the simulator's probe, each run through
+           the float model with the configurations the documents use (the defaults, each preset,
+           the defaults at update_delay 1 and 2), object layer included; its records (as float32,
+           so that another machine's last-place rounding does not count) hashed with the events.
 
     python -m evclust.stamps                       # the current fingerprints and every document's state
     python -m evclust.stamps --stamp NAME --made-at COMMIT
         stamps a document made at COMMIT without regenerating it, only where each of its inputs'
-        fingerprints at COMMIT equals today's (the float probe runs on COMMIT's model in a
+        fingerprints at COMMIT equals today's (the probes run on COMMIT's model in a
         subprocess); otherwise it refuses and names the input that changed.
 
 This module runs the float model, so it sits above evclust.clusterer and evclust.simulator; the
@@ -45,7 +46,7 @@ from evclust.errors import EvclustError
 
 REPO = Path(__file__).resolve().parents[2]
 HEADER = "rtl/evclust_params.vh"
-INPUTS = ("formats", "rtl", "fixed", "float")
+INPUTS = ("formats", "rtl", "fixed", "simulator", "float")
 DIGITS = 12  # hex digits of each fingerprint in a stamp
 STAMP_RE = re.compile(r"<!-- inputs: ((?:[a-z]+=[0-9a-f]+ ?)+) -->")
 
@@ -82,13 +83,13 @@ DOCUMENTS = (
     Document("PIPELINE", "docs/PIPELINE.md", None, None, ("float",), "make generalize"),
     Document("ABLATION", "docs/ABLATION.md", None, None, ("float",),
              "evclust generalize --split tuning --ablation -o docs/ABLATION.md"),
-    _bench("simulator", ("float",), "make bench (bench/simulator.py)"),
+    _bench("simulator", ("simulator",), "make bench (bench/simulator.py)"),
     _bench("clusterer", ("formats", "fixed", "float"), "make bench (bench/clusterer.py)"),
     _bench("rtl", ("formats", "rtl", "fixed"), "make bench (bench/rtl.py)"),
     _bench("synth", ("formats", "rtl"), "make synth"),
     _bench("synth-defaults", ("formats", "rtl"), "synth/synth.py --defaults --write docs/BENCHMARKS.md"),
     _bench("timing", ("formats", "rtl"), "make timing"),
-    _bench("peers", ("float",), "make bench-peers"),
+    _bench("peers", ("simulator",), "make bench-peers"),
     Document("RTL:datasheet", "docs/RTL.md", "<!-- datasheet:timing:start -->", "<!-- datasheet:timing:end -->", ("formats", "rtl"),
              "make timing"),
     Document("VERIFICATION:coverage", "docs/VERIFICATION.md", "<!-- coverage:begin -->", "<!-- coverage:end -->",
@@ -201,29 +202,49 @@ def _rounded(rows) -> bytes:
     return np.ascontiguousarray(rows, dtype=np.float32).tobytes()
 
 
+def _probe_scenes():
+    from evclust.scenes import scene_from_toml
+    from evclust.simulator import EFFECTS
+
+    ideal = scene_from_toml(PROBE_SCENE, "stamp probe")
+    effects = scene_from_toml(PROBE_SCENE + "".join(f"[effects.{name}]\n" for name in EFFECTS), "stamp probe, every effect")
+    return (("ideal", ideal), ("effects", effects))
+
+
+def probe_events() -> list[tuple[str, bytes]]:
+    """The simulator probe's outputs, each labelled: the built-in scenes as parsed, the probe
+    scene's events. Only long-standing interfaces are used, so that `--made-at` can run this on
+    an earlier commit's simulator."""
+    import numpy as np
+
+    from evclust.scenes import builtin_scenes, load_scene
+    from evclust.simulator import simulate_scene
+
+    out = [(f"scene {name}", load_scene(name).spec.model_dump_json().encode()) for name in builtin_scenes()]
+    for label, scene in _probe_scenes():
+        out.append((f"events {label}", np.ascontiguousarray(simulate_scene(scene).events).tobytes()))
+    return out
+
+
 def probe_records() -> list[tuple[str, bytes]]:
-    """The float probe's outputs, each labelled. Only long-standing interfaces of the models are
-    used, so that `--made-at` can run this on an earlier commit's model."""
+    """The float probe's outputs, each labelled: the simulator probe's, each scene's events
+    followed by the float model's records on them."""
     import numpy as np
 
     from evclust.clusterer import ClustererParams, FloatClusterer, load_params, preset_names
     from evclust.clusterer.objects import FloatObjects
-    from evclust.scenes import builtin_scenes, load_scene, scene_from_toml
-    from evclust.simulator import EFFECTS, simulate_scene
 
-    out = [(f"scene {name}", load_scene(name).spec.model_dump_json().encode()) for name in builtin_scenes()]
+    simulated = probe_events()
+    out = [(label, data) for label, data in simulated if not label.startswith("events ")]
+    events = {label.split(" ", 1)[1]: data for label, data in simulated if label.startswith("events ")}
     configs = [("defaults", ClustererParams())] + [(name, load_params(name)[0]) for name in preset_names()]
     configs += [(f"defaults D={d}", ClustererParams(update_delay=d)) for d in (1, 2)]
-    ideal = scene_from_toml(PROBE_SCENE, "stamp probe")
-    effects = scene_from_toml(PROBE_SCENE + "".join(f"[effects.{name}]\n" for name in EFFECTS), "stamp probe, every effect")
-    for label, scene in (("ideal", ideal), ("effects", effects)):
-        sim = simulate_scene(scene)
-        events = np.ascontiguousarray(sim.events)
-        out.append((f"events {label}", events.tobytes()))
+    for label, scene in _probe_scenes():
+        out.append((f"events {label}", events[label]))
         src = scene.source
         for name, params in configs:
             model = FloatClusterer(params, src.width, src.height, src.t_frame_us)
-            rows = model.feed(events)
+            rows = model.feed(np.frombuffer(events[label], dtype=_event_dtype()))
             out.append((f"{label} {name} clusters", _rounded(rows)))
             if params.objects:
                 objects = FloatObjects(model.params, src.width, src.height, src.t_frame_us)
@@ -231,10 +252,32 @@ def probe_records() -> list[tuple[str, bytes]]:
     return out
 
 
-def float_fingerprint(files: Files | None = None) -> str:
-    """The probe's hash, run here, or (files at a commit) on that commit's model in a subprocess."""
+def _event_dtype():
+    from evclust.events import EVENT_DTYPE
+
+    return EVENT_DTYPE
+
+
+def _hash(parts) -> str:
+    return _sha(part for label, data in parts for part in (label, data))
+
+
+def simulator_fingerprint(files: Files | None = None) -> str:
+    """The simulator probe's hash, run here, or (files at a commit) on that commit's simulator."""
     if files is None or files.commit is None:
-        return _sha(part for label, data in probe_records() for part in (label, data))
+        return _hash(probe_events())
+    return _at_commit(files, "simulator_fingerprint", "simulator")
+
+
+def float_fingerprint(files: Files | None = None) -> str:
+    """The float probe's hash, run here, or (files at a commit) on that commit's model."""
+    if files is None or files.commit is None:
+        return _hash(probe_records())
+    return _at_commit(files, "float_fingerprint", "float")
+
+
+def _at_commit(files: Files, function: str, what: str) -> str:
+    """A probe run in a subprocess on the commit's model (git archive), this module's code."""
     with tempfile.TemporaryDirectory(prefix="evclust-stamp-") as tmp:
         archive = subprocess.run(["git", "archive", files.commit, "model"], cwd=files.root, capture_output=True, check=True).stdout
         subprocess.run(["tar", "-x", "-C", tmp], input=archive, check=True)
@@ -242,18 +285,24 @@ def float_fingerprint(files: Files | None = None) -> str:
             "import importlib.util, sys\n"
             f"spec = importlib.util.spec_from_file_location('evclust_stamp_probe', {str(Path(__file__))!r})\n"
             "m = importlib.util.module_from_spec(spec); spec.loader.exec_module(m)\n"
-            "print(m.float_fingerprint())\n"
+            f"print(m.{function}())\n"
         )
         env = dict(os.environ, PYTHONPATH=str(Path(tmp) / "model"), NUMBA_CACHE_DIR=str(Path(tmp) / "numba"))
         run = subprocess.run([sys.executable, "-c", probe], cwd=tmp, env=env, capture_output=True, text=True)
         if run.returncode != 0:
             errors = [line for line in run.stderr.splitlines() if re.match(r"[\w.]+(Error|Exception)\b", line)]
             last = (errors or run.stderr.strip().splitlines() or ["no output"])[-1]
-            raise EvclustError(f"the float probe does not run on {files.commit}'s model: {last}")
+            raise EvclustError(f"the {what} probe does not run on {files.commit}'s model: {last}")
         return run.stdout.strip().splitlines()[-1]
 
 
-FINGERPRINTS = {"formats": formats_fingerprint, "rtl": rtl_fingerprint, "fixed": fixed_fingerprint, "float": float_fingerprint}
+FINGERPRINTS = {
+    "formats": formats_fingerprint,
+    "rtl": rtl_fingerprint,
+    "fixed": fixed_fingerprint,
+    "simulator": simulator_fingerprint,
+    "float": float_fingerprint,
+}
 
 
 def fingerprints(inputs=INPUTS, commit: str | None = None) -> dict[str, str]:
@@ -363,7 +412,7 @@ def vouch(doc: Document, commit: str, root: Path = REPO) -> dict[str, str]:
     if _content(doc, then_text) is None or _content(doc, then_text) != _content(doc, (root / doc.path).read_text()):
         raise EvclustError(f"{doc.name}: {doc.path} is not as it was at {commit}: it was not made there, or was edited since")
     now = fingerprints(doc.inputs)
-    for name in sorted(doc.inputs, key=lambda n: n == "float"):  # the float probe last: it costs most
+    for name in sorted(doc.inputs, key=lambda n: n in ("simulator", "float")):  # the probes last: they cost most
         try:
             then = fingerprints((name,), commit)[name]
         except EvclustError as exc:
