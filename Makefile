@@ -99,6 +99,7 @@ bench: $(STAMP)
 	$(PY) bench/clusterer.py --write docs/BENCHMARKS.md
 	$(PY) bench/rtl.py --write docs/BENCHMARKS.md
 	$(PY) bench/event_io.py --write docs/BENCHMARKS.md
+	$(PY) -m evclust.readme --write README.md
 	$(PY) bench/startup.py --write docs/BENCHMARKS.md
 
 # The RTL parameter header and the register map's files (SystemRDL, and from it with PeakRDL the C
@@ -119,11 +120,13 @@ vectors: $(STAMP)
 # Task accuracy on the built-in scenes: docs/RESULTS.md and its figures.
 results: $(STAMP)
 	$(PY) -m evclust.report --write docs/RESULTS.md
+	$(PY) -m evclust.readme --write README.md
 
 # The precision and accuracy report: docs/report/REPORT.md and its figures. It co-simulates the
 # RTL and synthesises six configurations with Yosys (the synth extra): 16 min 52 s here.
 report: $(SYNTH_STAMP)
 	$(VENV)/bin/evclust report -o docs/report
+	$(PY) -m evclust.readme --write README.md
 
 # The generalization suite's test split (held out from all tuning) through the default and the
 # paper's configurations, float and fixed: docs/GENERALIZATION.md and its picture. Scenes and
@@ -132,6 +135,7 @@ report: $(SYNTH_STAMP)
 generalize: $(STAMP)
 	$(VENV)/bin/evclust generalize --split test -o docs/GENERALIZATION.md
 	$(VENV)/bin/evclust generalize --pipeline -o docs/PIPELINE.md
+	$(PY) -m evclust.readme --write README.md
 
 # A real video end to end (outside CI): OpenCV's vtest.avi (768x576, 795 frames of people walking,
 # from Debian's opencv-doc package; fetched, not committed) simulated and tracked in one pass (no

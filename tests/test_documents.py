@@ -52,3 +52,46 @@ def test_restamping_keeps_the_document_and_changes_only_its_stamp(tmp_path):
     stamps.stamp_document(part, {"rtl": "2" * 12}, tmp_path)
     want = "# Top\n\n<!-- s:start -->\n<!-- inputs: rtl=222222222222 -->\n## S\n\nrows\n<!-- s:end -->\n\nafter\n"
     assert (tmp_path / "s.md").read_text() == want
+
+
+def test_the_readmes_tables_are_their_sources_tables_now():
+    from evclust import readme
+
+    assert readme.stale(stamps.REPO / "README.md") == []
+
+
+def test_a_readme_table_is_its_sources_rows_and_columns_and_follows_it(tmp_path):
+    from evclust import readme
+    from evclust.errors import EvclustError
+
+    source = stamps.Document("SRC", "src.md", None, None, ("rtl",), "make src")
+    text = "# Src\n\n## Figures\n\n| name | a | b / c |\n|---|---:|---:|\n| x | 1 | 2 / 3 |\n| y | 4 | 5 / 6 |\n\n## Other\n\n| q |\n|---|\n| z |\n"
+    (tmp_path / "src.md").write_text(stamps.stamped(source, text, stamps.stamp_line(source, {"rtl": "a" * 12})))
+    table = readme.Table("t", "src.md", "SRC", "## Figures", (readme.Column("name"), readme.Column("b / c", "c", 1)), ("y",))
+    want = "| name | c |\n|---|---:|\n| y | 6 |"
+    assert readme.extract(table, text) == want
+    assert readme.extract(table._replace(columns=None, rows=None), text).split("\n")[-1] == "| y | 4 | 5 / 6 |"
+    with pytest.raises(EvclustError, match="no column 'd'"):
+        readme.extract(table._replace(columns=(readme.Column("d"),)), text)
+    with pytest.raises(EvclustError, match="no row 'w'"):
+        readme.extract(table._replace(rows=("w",)), text)
+
+    # The README's section carries the source's stamp; it goes stale when the source changes.
+    (tmp_path / "README.md").write_text("# R\n\n<!-- readme:t:start -->\n<!-- readme:t:end -->\n")
+    old_tables, old_names = readme.TABLES, dict(stamps.BY_NAME)
+    readme.TABLES = (table,)
+    stamps.BY_NAME["SRC"] = source
+    try:
+        readme.write(tmp_path / "README.md", tmp_path)
+        assert (tmp_path / "README.md").read_text() == (
+            "# R\n\n<!-- readme:t:start -->\n<!-- inputs: rtl=aaaaaaaaaaaa -->\n" + want + "\n<!-- readme:t:end -->\n"
+        )
+        assert readme.stale(tmp_path / "README.md", tmp_path) == []
+        (tmp_path / "src.md").write_text((tmp_path / "src.md").read_text().replace("| 5 / 6 |", "| 5 / 7 |"))
+        assert readme.stale(tmp_path / "README.md", tmp_path) == [
+            f"{tmp_path / 'README.md'}: the t table is not what src.md says now: run `python -m evclust.readme --write README.md`"
+        ]
+    finally:
+        readme.TABLES = old_tables
+        stamps.BY_NAME.clear()
+        stamps.BY_NAME.update(old_names)

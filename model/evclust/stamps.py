@@ -72,7 +72,8 @@ def _bench(name: str, inputs: tuple[str, ...], target: str) -> Document:
 # Not here: BENCHMARKS' runtime-config section (written by hand, a record of a before/after
 # comparison), its event_io and startup sections (they time the event-file code and the command
 # line's start-up, none of these inputs), docs/REGISTERS.md and rtl/evclust_params.vh (checked
-# byte for byte by their own tests), the README's tables (copied by hand from the documents here).
+# byte for byte by their own tests), the README's tables (copied from the documents here with their
+# stamps by evclust.readme, and checked against them).
 # fmt: off
 DOCUMENTS = (
     Document("REPORT", "docs/report/REPORT.md", None, None, ("formats", "rtl", "fixed", "float"), "make report"),
