@@ -79,7 +79,7 @@ def build(sim: str, header: str, toplevel: str = TOPLEVEL, parameters: dict | No
     try:
         from cocotb_tools.runner import get_runner
     except ImportError:
-        raise EvclustError("cocotb is not installed: pip install -e '.[test]'") from None
+        raise EvclustError("cocotb is not installed: install the test extra (pip install '.[test]')") from None
     use_simulator(sim)
     # Verilator: random initial values (--x-initial unique, seeded per run by the plusarg below),
     # so a register read before it is reset or written shows up as a mismatch.
