@@ -8,17 +8,20 @@ venv's site-packages names this interpreter's site-packages folder. A path line 
 process the .pth files in that folder, so the editable install's (which points at the checkout)
 stays off: the test checks that `evclust` is imported from the venv.
 
-Cost: building the wheel takes about 2 s (pip's isolated build fetches setuptools). The venv is
+Cost: building the wheel takes about 2 s (with this interpreter's setuptools if it is 77 or later,
+else pip's isolated build, which fetches it from PyPI). The venv is
 kept while the wheel's files are the same (numba's cache lives in it), and the co-simulation's
 build in build/wheel-test/cache/evclust/ (the installed package's default, $XDG_CACHE_HOME/evclust)
 while the RTL and its header are the same, so a warm run is the models' and the simulator's run
-time; a fresh clone adds numba's compilation and one Verilator build (about a minute each on 2 busy
-cores; ccache's runtime objects come from the checkout's build/ccache).
+time (about 17 s). A new wheel adds numba's compilation in the fresh venv (about 30 s), and a fresh
+clone one Verilator build too (about 50 s without ccache; the Verilator runtime's objects come
+from the checkout's build/ccache when the other co-simulations have put them there).
 """
 
 from __future__ import annotations
 
 import hashlib
+import importlib.metadata
 import os
 import shutil
 import subprocess
@@ -53,14 +56,25 @@ def _purelib(python: Path | str) -> Path:
     return Path(subprocess.run([str(python), "-c", code], capture_output=True, text=True, check=True, env=_env()).stdout.strip())
 
 
+def _setuptools_major() -> int:
+    try:
+        return int(importlib.metadata.version("setuptools").split(".")[0])
+    except importlib.metadata.PackageNotFoundError:
+        return 0
+
+
 @pytest.fixture(scope="module")
 def wheel(tmp_path_factory) -> Path:
     """The wheel, built from a copy of the checkout."""
     tmp = tmp_path_factory.mktemp("wheel")
     shutil.copytree(REPO, tmp / "src", ignore=_ignore)
-    build = subprocess.run([sys.executable, "-m", "pip", "wheel", "--no-deps", "-q", "-w", str(tmp / "dist"), str(tmp / "src")],
-                           capture_output=True, text=True, timeout=600)  # fmt: skip
-    assert build.returncode == 0, f"pip wheel failed (its isolated build fetches setuptools from PyPI):\n{build.stderr}"
+    # This interpreter's setuptools if it is recent enough (offline), else pip's isolated build (fetches it from PyPI).
+    local = ["--no-build-isolation"] if _setuptools_major() >= 77 else []
+    build = subprocess.run([sys.executable, "-m", "pip", "wheel", "--no-deps", "-q", *local, "-w", str(tmp / "dist"), str(tmp / "src")],
+                           capture_output=True, text=True, timeout=600, env=_env())  # fmt: skip
+    assert build.returncode == 0, (
+        f"pip wheel failed{'' if local else ' (its isolated build fetches setuptools from PyPI)'}:\n{build.stderr}"
+    )
     (path,) = (tmp / "dist").glob("evclust-*.whl")
     return path
 

@@ -92,7 +92,12 @@ def build(sim: str, header: str, toplevel: str = TOPLEVEL, parameters: dict | No
     build_dir = BUILD / "cosim" / sim / digest.hexdigest()[:16]
     src = build_dir / "src"
     runner = get_runner(sim)
-    build_dir.parent.mkdir(parents=True, exist_ok=True)
+    try:
+        build_dir.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise EvclustError(
+            f"{build_dir.parent}: cannot make the RTL's build folder ({exc.strerror}); set EVCLUST_BUILD_DIR to a writable folder"
+        ) from None
     # One build at a time per directory: pytest-xdist workers share the cache.
     with FileLock(build_dir.with_suffix(".lock")), _make_flags(sim):
         if not (src / "evclust_params.vh").exists():
