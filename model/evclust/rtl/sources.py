@@ -5,10 +5,10 @@ Two places hold the RTL, looked for in this order:
   rtl/ and tb/evclust_core/evclust_tb.v there, keeping their layout);
 - the repository that holds this package (an editable install, `pip install -e .`), whose rtl/ is
   read directly, so an edit there is seen without reinstalling.
-The builds (co-simulation, streams, synthesis) go to the repository's build/ in a checkout. An
-installed wheel's package folder may be read-only, so they go to $EVCLUST_BUILD_DIR if set, else
-the user's cache folder ($XDG_CACHE_HOME/evclust, by default ~/.cache/evclust), else ./build when
-that cannot be made.
+The builds (co-simulation, streams, synthesis) go to $EVCLUST_BUILD_DIR if set, else to the
+repository's build/ in a checkout. An installed wheel's package folder may be read-only, so its
+builds go to the user's cache folder ($XDG_CACHE_HOME/evclust, by default ~/.cache/evclust), or
+to ./build when that cannot be made.
 """
 
 from __future__ import annotations
