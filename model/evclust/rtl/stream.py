@@ -13,7 +13,7 @@ import numpy as np
 from evclust.clusterer import ClustererParams
 from evclust.errors import atomic_output
 from evclust.rtl.cosim import run
-from evclust.rtl.sources import BUILD, params_header, require_repository
+from evclust.rtl.sources import BUILD, params_header, require_rtl
 
 
 @dataclasses.dataclass(frozen=True)
@@ -49,7 +49,7 @@ def run_stream(
     """Run `events` through the RTL built for these parameters (and `formats`, the options of
     `build_formats`) under `sim`, checking every record and trace word against the fixed model.
     A mismatch raises AssertionError naming the first differing field."""
-    require_repository()
+    require_rtl()
     header = params_header(params, width, height, t_frame_us, **formats)
     data = np.ascontiguousarray(events)
     digest = hashlib.sha256(data.tobytes()).hexdigest()[:16]
