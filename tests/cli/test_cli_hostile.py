@@ -159,8 +159,24 @@ def test_simulate_writes_both_outputs_or_neither(files, tmp_path, capsys):
     )
 
 
-def test_sigterm_mid_run_leaves_no_temporary_or_partial_file(files, tmp_path):
-    """A long simulation killed with SIGTERM: exit 143, one line, nothing left in the folder."""
+def _ignore_sigint():
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+# SIGINT as Ctrl-C sends it, and as a job started in the background by a non-interactive shell
+# receives it: that job starts with SIGINT ignored, which Python keeps unless told otherwise.
+@pytest.mark.parametrize(
+    ("sig", "exit_code", "line", "preexec"),
+    [
+        (signal.SIGTERM, 128 + signal.SIGTERM, "evclust: terminated", None),
+        (signal.SIGINT, 130, "evclust: interrupted", None),
+        (signal.SIGINT, 130, "evclust: interrupted", _ignore_sigint),
+    ],
+    ids=["sigterm", "sigint", "sigint-in-background"],
+)
+def test_a_signal_mid_run_stops_it_at_once_and_leaves_no_temporary_or_partial_file(files, tmp_path, sig, exit_code, line, preexec):
+    """A long simulation stopped by SIGTERM or SIGINT: its exit code, one line, within seconds,
+    nothing left in the folder."""
     folder = work_folder(files, tmp_path)
     long_scene = (
         SCENE.replace("frames = 6", "frames = 4000")
@@ -171,15 +187,17 @@ def test_sigterm_mid_run_leaves_no_temporary_or_partial_file(files, tmp_path):
     (folder / "long.toml").write_text(long_scene)
     before = snapshot(folder)
     proc = subprocess.Popen([sys.executable, "-c", "import sys; from evclust.cli import main; sys.exit(main())", "simulate", str(folder / "long.toml"), "-o", str(folder / "long.npz"), "-q"],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)  # fmt: skip
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, preexec_fn=preexec)  # fmt: skip
     deadline = time.monotonic() + 120
     while not any(p.name.startswith(".long.npz") for p in folder.iterdir()):  # the writer has started
         assert proc.poll() is None and time.monotonic() < deadline, proc.communicate()
         time.sleep(0.05)
-    proc.send_signal(signal.SIGTERM)
+    proc.send_signal(sig)
+    sent = time.monotonic()
     out, err = proc.communicate(timeout=60)
-    assert proc.returncode == 128 + signal.SIGTERM, err
-    assert err.strip().splitlines() == ["evclust: terminated"]
+    assert proc.returncode == exit_code, err
+    assert time.monotonic() - sent < 10  # the whole 4,000 frames take minutes
+    assert err.strip().splitlines() == [line]
     assert snapshot(folder) == before
 
 

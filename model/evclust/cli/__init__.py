@@ -56,7 +56,11 @@ def main(argv: list[str] | None = None) -> int:
     except SystemExit as exc:  # --help, --version, or a usage error already reported in one line
         return exc.code if isinstance(exc.code, int) else 2
     main_thread = threading.current_thread() is threading.main_thread()  # signal handlers live there only
-    previous = signal.signal(signal.SIGTERM, _terminate) if main_thread else None
+    # SIGINT raises KeyboardInterrupt even where the process started with it ignored (a job put in
+    # the background by a non-interactive shell, which Python would otherwise leave deaf to it).
+    previous = (
+        (signal.signal(signal.SIGTERM, _terminate), signal.signal(signal.SIGINT, signal.default_int_handler)) if main_thread else None
+    )
     try:
         refuse_overwriting(args)
         return args.run(args) or 0
@@ -74,4 +78,5 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     finally:
         if main_thread:
-            signal.signal(signal.SIGTERM, previous)
+            signal.signal(signal.SIGTERM, previous[0])
+            signal.signal(signal.SIGINT, previous[1])
