@@ -325,8 +325,9 @@ def _npz_meta(meta) -> callable:
     return write
 
 
-def _h5_from_good(attrs: dict | None = None, reshape: str | None = None) -> callable:
-    """An HDF5 event file from the good events, with attributes replaced or one field reshaped."""
+def _h5_from_good(attrs: dict | None = None, reshape: str | None = None, group: str | None = None) -> callable:
+    """An HDF5 event file from the good events, with attributes replaced, one field reshaped or
+    one field a group instead of a dataset."""
 
     def write(path: Path, files: Path) -> None:
         import h5py
@@ -342,6 +343,9 @@ def _h5_from_good(attrs: dict | None = None, reshape: str | None = None) -> call
                 data = f["events"][reshape][...]
                 del f["events"][reshape]
                 f["events"][reshape] = data.reshape(1, -1) if data.size else data.reshape(1, 0)
+            if group:
+                del f["events"][group]
+                f["events"].create_group(group).create_dataset("values", data=[1, 2, 3])
 
     return write
 
@@ -365,6 +369,8 @@ MALFORMED.update(
         "h5 sensor 60000 x 60000": ({"bad.h5": _h5_from_good({"width": 60000, "height": 60000})}, TRACK_H5),
         "h5 field t two-dimensional": ({"bad.h5": _h5_from_good(reshape="t")}, TRACK_H5),
         "h5 field x two-dimensional": ({"bad.h5": _h5_from_good(reshape="x")}, TRACK_H5),
+        "h5 field t a group": ({"bad.h5": _h5_from_good(group="t")}, TRACK_H5),
+        "h5 field y a group": ({"bad.h5": _h5_from_good(group="y")}, TRACK_H5),
     }
 )
 

@@ -162,6 +162,11 @@ def _hdf5_header(path: Path) -> tuple[dict, int]:
                 raise EvclustError(f"{path}: no 'events' group")
             group = f["events"]
             _check_fields(path, group.keys())
+            not_data = [name for name in group.keys() if not isinstance(group[name], h5py.Dataset)]
+            if not_data:
+                raise EvclustError(
+                    f"{path}: events/{not_data[0]} is a {type(group[not_data[0]]).__name__.lower()}, not a dataset of values"
+                )
             count = group["t"].shape[0] if group["t"].ndim == 1 else -1
             meta = {k: (v.item() if getattr(v, "size", 0) == 1 else v) for k, v in f.attrs.items()}  # arrays stay, for check() to refuse
             meta["has_colour"] = COLOUR_FIELDS[0] in group
