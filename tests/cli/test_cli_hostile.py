@@ -159,6 +159,19 @@ def test_simulate_writes_both_outputs_or_neither(files, tmp_path, capsys):
     )
 
 
+@pytest.mark.parametrize("argv", [["--window", "1e300"], ["--t1", "1e15"], ["--window", "1e19", "--t1", "1e19"]], ids=" ".join)
+def test_a_picture_at_times_past_every_event_is_drawn_not_an_overflow(files, tmp_path, argv, capsys):
+    """Times beyond the uint64 event clock are looked up clamped (they raised OverflowError): the
+    picture is written, the size of any other."""
+    import cv2
+
+    out, reference = tmp_path / "out.png", tmp_path / "reference.png"
+    assert main(["render", str(files / "ev.npz"), str(files / "tracks.csv"), "-o", str(reference), "-q"]) == 0
+    assert main(["render", str(files / "ev.npz"), str(files / "tracks.csv"), "-o", str(out), "-q", *argv]) == 0
+    assert capsys.readouterr().err == ""
+    assert cv2.imread(str(out)).shape == cv2.imread(str(reference)).shape
+
+
 def _ignore_sigint():
     signal.signal(signal.SIGINT, signal.SIG_IGN)
 
@@ -517,6 +530,8 @@ MALFORMED.update(
         "show --span -1": ({}, ["show", "{d}/ev.npz", "-o", "{d}/out.png", "--span", "-1"]),
         "render --arrow-frames -1": ({}, ["render", "{d}/ev.npz", "{d}/tracks.csv", "-o", "{d}/out.png", "--arrow-frames", "-1", "-q"]),
         "render --arrow-frames NaN": ({}, ["render", "{d}/ev.npz", "{d}/tracks.csv", "-o", "{d}/out.png", "--arrow-frames", "nan", "-q"]),
+        # 3e10 frames, 224 GiB of frame times alone: refused before anything is allocated.
+        "render a video to --t1 1e15": ({}, ["render", "{d}/ev.npz", "{d}/tracks.csv", "-o", "{d}/out.mp4", "--t1", "1e15", "-q"]),
         "render --t1 negative": ({}, ["render", "{d}/ev.npz", "{d}/tracks.csv", "-o", "{d}/out.png", "--t1", "-5", "-q"]),
         "render a missing tracks file": ({}, ["render", "{d}/ev.npz", "{d}/none.csv", "-o", "{d}/out.png", "-q"]),
         "formats --width 0": ({}, ["formats", "--width", "0"]),

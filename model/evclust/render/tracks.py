@@ -21,6 +21,7 @@ import cv2
 import numpy as np
 from tqdm import tqdm
 
+from evclust import limits
 from evclust.colour import ycbcr_to_rgb
 from evclust.errors import EvclustError, atomic_output
 from evclust.events.format import EventMeta
@@ -29,6 +30,15 @@ from evclust.tracks.record import RECORD_DTYPES, ObjectFlags, TrackMeta
 DEFAULT_FRAME_US = 33333.0
 PNG_SUFFIXES = (".png",)
 VIDEO_SUFFIXES = (".mp4",)
+# Event and record times are uint64 µs; a time from the command line (a window of 1e300 µs, a
+# picture at 1e15 µs) is looked up clamped to [0, 2^63], past every real one.
+LAST_TIME = 1 << 63
+
+
+def _time_key(t_us: float) -> np.uint64:
+    """`floor(t_us)` as an event time, clamped to what the uint64 times can hold."""
+    return np.uint64(min(max(0, math.floor(t_us)), LAST_TIME))
+
 
 # BGR, as OpenCV draws.
 BACKGROUND = (24, 24, 24)
@@ -74,11 +84,11 @@ def latest_records(tracks: np.ndarray, t_lo_us: float, t_hi_us: float, per_frame
     if tracks.size == 0:
         return tracks
     t = tracks["t_us"]
-    i = int(np.searchsorted(t, np.uint64(max(0, math.floor(t_hi_us))), side="right")) - 1
+    i = int(np.searchsorted(t, _time_key(t_hi_us), side="right")) - 1
     if i < 0 or float(t[i]) <= t_lo_us:
         return tracks[:0]
     if per_frame:
-        lo = int(np.searchsorted(t, np.uint64(max(0, math.floor(t_lo_us) + 1)), side="left"))
+        lo = int(np.searchsorted(t, _time_key(t_lo_us + 1), side="left"))
         window = tracks[lo : i + 1]
         _, last_from_end = np.unique(window["id"][::-1], return_index=True)
         return window[np.sort(window.size - 1 - last_from_end)]
@@ -94,7 +104,7 @@ def busiest_time(ev: np.ndarray, window_us: float) -> float:
     t0, t1 = int(ev["t"][0]), int(ev["t"][-1])
     bins = max(1, math.ceil((t1 - t0 + 1) / window_us))
     edges = t0 + window_us * np.arange(bins + 1)
-    counts = np.diff(np.searchsorted(ev["t"], edges.astype(np.uint64), side="left"))
+    counts = np.diff(np.searchsorted(ev["t"], np.minimum(edges, float(LAST_TIME)).astype(np.uint64), side="left"))
     counts[-1] += int(ev.size - counts.sum())  # events at or beyond the last edge
     return float(edges[int(np.argmax(counts)) + 1])
 
@@ -227,9 +237,7 @@ class FrameDrawer:
 
     def window_slice(self, t_us: float) -> slice:
         """Events with t_us - window < t <= t_us."""
-        lo_t = max(0, math.floor(t_us - self.window) + 1)
-        hi_t = max(0, math.floor(t_us) + 1)
-        lo, hi = np.searchsorted(self.ev["t"], np.array([lo_t, hi_t], np.uint64), side="left")
+        lo, hi = np.searchsorted(self.ev["t"], np.array([_time_key(t_us - self.window + 1), _time_key(t_us + 1)]), side="left")
         return slice(int(lo), int(hi))
 
     def draw(self, t_us: float, events: slice | None = None) -> np.ndarray:
@@ -313,6 +321,7 @@ def frame_times(ev: np.ndarray, tracks: np.ndarray, period: float, t0_us: float 
     if t1 < t0:
         raise EvclustError(f"t1={t1:g} us is before t0={t0:g} us")
     n = int(math.floor((t1 - t0) / period + 1e-9)) + 1
+    limits.check("FRAMES", n, f"t0={t0:g} us to t1={t1:g} us every {period:g} us: video frames")
     return t0 + period * np.arange(n)
 
 
