@@ -29,6 +29,18 @@ def read_text(path: str | os.PathLike) -> str:
         raise EvclustError(f"{path}: not UTF-8 text (byte {exc.start}); save it as UTF-8") from None
 
 
+def _temp_prefix(path: Path, suffix: str) -> str:
+    """The temporary file's name before mkstemp's 8 random characters: `.<name>.`, the name cut
+    short where the whole would pass the file system's longest name (so a legal output name of
+    244 characters stays legal)."""
+    try:
+        longest = os.pathconf(path.parent, "PC_NAME_MAX")
+    except (OSError, ValueError):
+        longest = 255
+    room = longest - len(suffix) - 8 - 2  # the random part, the two dots
+    return f".{path.name[: max(1, room)]}."
+
+
 @contextlib.contextmanager
 def atomic_output(path: str | os.PathLike, suffix: str | None = None):
     """Yield a temporary path beside `path`; move it into place only if the block succeeds.
@@ -47,7 +59,8 @@ def atomic_output(path: str | os.PathLike, suffix: str | None = None):
             raise EvclustError(f"{path}: {exc.strerror or exc}") from None  # /dev/full: name the file
         return
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix or path.suffix, dir=path.parent)
+    suffix = suffix or path.suffix
+    fd, tmp = tempfile.mkstemp(prefix=_temp_prefix(path, suffix), suffix=suffix, dir=path.parent)
     os.close(fd)
     tmp = Path(tmp)
     umask = os.umask(0)
@@ -68,7 +81,7 @@ def atomic_folder(path: str | os.PathLike):
 
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{path.name}.", dir=path.parent))
+    tmp = Path(tempfile.mkdtemp(prefix=_temp_prefix(path, ""), dir=path.parent))
     try:
         yield tmp
         old = None

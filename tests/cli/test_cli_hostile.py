@@ -172,6 +172,15 @@ def test_a_picture_at_times_past_every_event_is_drawn_not_an_overflow(files, tmp
     assert cv2.imread(str(out)).shape == cv2.imread(str(reference)).shape
 
 
+@pytest.mark.parametrize("length", [244, 255])
+def test_an_output_name_as_long_as_the_file_system_allows_is_written(files, tmp_path, length):
+    """The temporary file beside it is named within the same limit (it was `.<name>.<random>.csv`,
+    past 255 characters, so a legal name was refused)."""
+    out = tmp_path / ("t" * (length - 4) + ".csv")
+    assert main(["track", str(files / "ev.npz"), "-o", str(out), "-q"]) == 0
+    assert [p.name for p in tmp_path.iterdir()] == [out.name] and out.stat().st_size > 0
+
+
 def _ignore_sigint():
     signal.signal(signal.SIGINT, signal.SIG_IGN)
 
