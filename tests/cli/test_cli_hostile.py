@@ -405,6 +405,8 @@ MALFORMED.update(
         "scene wider than 65535": ({"bad.toml": _scene_with(**{"width = 40": "width = 70000"})}, SIM),
         "scene of 10^12 frames": ({"bad.toml": _scene_with(**{"frames = 6": "frames = 1000000000000"})}, SIM),
         "object of 10^8 px": ({"bad.toml": _scene_with(**{"size = [8, 8]": "size = [10000, 10000]"})}, SIM),
+        # The truth file holds a label in 32 characters: a longer one is the scene's fault, not score's.
+        "object label of 33 characters": ({"bad.toml": SCENE.replace('label = "red"', f'label = "{"r" * 33}"').encode()}, SIM),
         "sensor threshold 1e-300": ({"bad.toml": (SCENE + "[sensor]\nthreshold_on = 1e-300\n").encode()}, SIM),
         "sensor threshold 0": ({"bad.toml": (SCENE + "[sensor]\nthreshold_off = 0\n").encode()}, SIM),
     }

@@ -69,9 +69,13 @@ class LegSpec(Strict):
     velocity: Vec2  # px/frame
 
 
+# The longest object label: the ground-truth files hold it in a 32-character column (truth.py).
+LABEL_CHARS = 32
+
+
 class ObjectSpec(Strict):
     id: Annotated[int, Field(ge=0)]
-    label: str
+    label: Annotated[str, Field(max_length=LABEL_CHARS)]
     shape: Literal["rectangle", "ellipse"] = "rectangle"
     size: Size2
     colour: Colour

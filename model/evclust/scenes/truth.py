@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from evclust.errors import EvclustError, atomic_output
+from evclust.scenes.schema import LABEL_CHARS
 from evclust.scenes.synthetic import TRUTH_COLUMNS, TRUTH_OPTIONAL
 
 
@@ -23,7 +24,6 @@ def write_truth(path: str | Path, rows: list[dict]) -> None:
 # ---------------------------------------------------------------------------------------------
 # Reading (docs/METRICS.md "Ground truth"): a numpy structured array, one element per CSV row.
 
-LABEL_CHARS = 32
 TRUTH_DTYPE = np.dtype(
     [
         ("frame", np.int64),  # frame index k; the row describes the object at t_k = k · t_frame
