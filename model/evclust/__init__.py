@@ -3,4 +3,12 @@
 Data flows one way: scene -> simulator -> events -> clusterer -> tracks -> metrics -> report.
 """
 
+import os
+
 __version__ = "0.1.0"
+
+# OpenCV's and FFmpeg's own messages (a damaged block of a video, a missing moov atom) would reach
+# stderr beside evclust's one-line error; a user who wants them sets these before the run. They
+# are read when OpenCV loads, so they are set here, before any module imports cv2.
+os.environ.setdefault("OPENCV_LOG_LEVEL", "OFF")
+os.environ.setdefault("OPENCV_FFMPEG_LOGLEVEL", "-8")  # AV_LOG_QUIET

@@ -181,6 +181,38 @@ def test_an_output_name_as_long_as_the_file_system_allows_is_written(files, tmp_
     assert [p.name for p in tmp_path.iterdir()] == [out.name] and out.stat().st_size > 0
 
 
+def _damaged_videos(folder: Path) -> dict[str, bool]:
+    """Video files OpenCV or FFmpeg complain about on their own stderr: name -> whether evclust
+    still reads frames from it."""
+    import cv2
+    import numpy as np
+
+    writer = cv2.VideoWriter(str(folder / "whole.avi"), cv2.VideoWriter_fourcc(*"XVID"), 10, (64, 48))
+    rng = np.random.default_rng(1)
+    for _ in range(30):
+        writer.write(rng.integers(0, 255, (48, 64, 3), dtype=np.uint8))
+    writer.release()
+    whole = (folder / "whole.avi").read_bytes()
+    (folder / "cut.avi").write_bytes(whole[: len(whole) * 2 // 3])  # damaged blocks near the end
+    (folder / "header.avi").write_bytes(b"RIFF\0\0\0\0AVI LIST" + bytes(range(256)) * 4)  # an AVI that is not one
+    (folder / "empty.mp4").write_bytes(b"")  # no moov atom
+    return {"cut.avi": True, "header.avi": False, "empty.mp4": False}
+
+
+def test_a_damaged_video_gives_one_line_or_none_not_the_decoders_own(tmp_path):
+    """OpenCV's and FFmpeg's messages (damaged blocks, a missing moov atom, an odd AVI list) were
+    printed beside evclust's one line; now only evclust speaks, in a fresh process as a user runs it."""
+    env = {k: v for k, v in os.environ.items() if not k.startswith("OPENCV_")}
+    for name, readable in _damaged_videos(tmp_path).items():
+        run = subprocess.run([sys.executable, "-c", "import sys; from evclust.cli import main; sys.exit(main())", "track", name, "-o", "out.csv",
+                              "--per-frame", "-q"], cwd=tmp_path, env=env, capture_output=True, text=True, timeout=300)  # fmt: skip
+        lines = run.stderr.strip().splitlines()
+        if readable:
+            assert run.returncode == 0 and lines == [], (name, run.stderr)
+        else:
+            assert run.returncode == 2 and len(lines) == 1 and lines[0].startswith(f"evclust: error: {name}: "), (name, run.stderr)
+
+
 def _ignore_sigint():
     signal.signal(signal.SIGINT, signal.SIG_IGN)
 

@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import collections
+import contextlib
 import os
+import sys
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
@@ -34,6 +36,21 @@ def _decoded_ahead(load, n: int, ahead: int = 4):
             yield frame
 
 
+@contextlib.contextmanager
+def _native_stderr_silenced():
+    """File descriptor 2 to /dev/null for a moment: OpenCV's AVI parser prints what it finds odd in a
+    container straight to it, past any log level; evclust says in one line what went wrong."""
+    sys.stderr.flush()
+    saved = os.dup(2)
+    try:
+        with open(os.devnull, "wb") as null:
+            os.dup2(null.fileno(), 2)
+        yield
+    finally:
+        os.dup2(saved, 2)
+        os.close(saved)
+
+
 class VideoSource:
     def __init__(self, path: Path, fps: float | None = None, max_frames: int | None = None):
         self.path = Path(path)
@@ -50,8 +67,9 @@ class VideoSource:
             n_frames = len(self.images)
         else:
             self.images = None
-            capture = cv2.VideoCapture(str(self.path))
-            ok, first = capture.read() if capture.isOpened() else (False, None)
+            with _native_stderr_silenced():
+                capture = cv2.VideoCapture(str(self.path))
+                ok, first = capture.read() if capture.isOpened() else (False, None)
             if not ok:
                 capture.release()
                 raise EvclustError(f"{self.path}: OpenCV cannot read a frame from this file (unreadable or empty video)")
@@ -95,7 +113,8 @@ class VideoSource:
             paths = self.images[: int(min(limit, len(self.images)))]
             yield from _decoded_ahead(lambda k: self._check_size(self._read_image(paths[k]), k), len(paths))
             return
-        capture = cv2.VideoCapture(str(self.path))
+        with _native_stderr_silenced():
+            capture = cv2.VideoCapture(str(self.path))
         try:
             k = 0
             while k < limit:
