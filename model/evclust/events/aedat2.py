@@ -58,9 +58,7 @@ def aedat2_header(path: Path) -> tuple[dict, int | None]:
     offset, _ = header(path)
     size = path.stat().st_size - offset
     if size % RECORD.itemsize:
-        raise EvclustError(
-            f"{path}: {size} bytes of records is not a whole number of {RECORD.itemsize}-byte events (the file is cut short?)"
-        )
+        raise EvclustError(f"{path}: the last event is cut short ({size % RECORD.itemsize} of its {RECORD.itemsize} bytes)")
     return {"width": SIZE, "height": SIZE, "source": path.stem, "has_colour": False}, None
 
 
