@@ -154,11 +154,49 @@ def test_aedat2_packed_by_hand_reads_as_jaer_decodes_it(tmp_path):
     assert dvs(got) == [(10, 0, 127, 1), (12, 127, 0, -1), (4_294_967_290, 27, 122, -1), ((1 << 32) + 20, 26, 121, 1)]
 
 
+def _aedat31_bytes(packets, header=b"#!AER-DAT3.1\r\n#Format: RAW\r\n#Source 1: DVS128\r\n#!END-HEADER\r\n", overflow=0):
+    """cAER packets from libcaer's common.h and polarity.h: a 28-byte little-endian header, then
+    8-byte polarity events (data: bit 0 valid, bit 1 ON, bits 2-16 y, bits 17-31 x; timestamp)."""
+    out = header
+    for kind, events in packets:
+        size = 8
+        out += struct.pack("<hhiiiiii", kind, 1, size, 4, overflow, len(events), len(events), len(events))
+        out += b"".join(struct.pack("<Ii", data, t) for data, t in events)
+    return out
+
+
+def test_aedat31_packed_by_hand_reads_as_libcaer_decodes_it(tmp_path):
+    def pol(x, y, on, valid=1):
+        return (x << 17) | (y << 2) | (on << 1) | valid
+
+    packets = [
+        (1, [(pol(0, 0, 1), 5), (pol(127, 127, 0), 9), (pol(3, 4, 1, valid=0), 9)]),  # the invalid one is skipped
+        (2, [(0x1234, 10)]),  # a frame or special packet: skipped
+        (1, [(pol(10, 20, 0), 12)]),
+    ]
+    path = tmp_path / "cam.aedat"
+    path.write_bytes(_aedat31_bytes(packets))
+    got, meta = read_events(path)
+    assert (meta.width, meta.height, meta.has_colour) == (128, 128, False)
+    assert dvs(got) == [(5, 0, 0, 1), (9, 127, 127, -1), (12, 10, 20, -1)]
+    wrapped = tmp_path / "wrapped.aedat"
+    wrapped.write_bytes(_aedat31_bytes([(1, [(pol(1, 1, 1), 7)])], overflow=2))
+    assert dvs(read_events(wrapped)[0]) == [((2 << 31) | 7, 1, 1, 1)]
+    unknown = tmp_path / "unknown.aedat"
+    unknown.write_bytes(_aedat31_bytes(packets, header=b"#!AER-DAT3.1\r\n#Source 1: Prototype\r\n#!END-HEADER\r\n"))
+    with pytest.raises(EvclustError) as err:
+        read_events(unknown)
+    one_line(err, "unknown.aedat: the file gives no sensor size")
+    assert dvs(read_events(unknown, sensor_size=(200, 128))[0]) == dvs(got)
+
+
 @pytest.mark.parametrize(
     "content, fragments",
     [
         (_aedat2_bytes([(2, 10)]) + b"\x00\x01\x02", ("the last event is cut short (3 of its 8 bytes)",)),
-        (b"#!AER-DAT3.1\r\n#End Of ASCII Header\r\n" + b"\x00" * 28, ("AEDAT 3.1 is not read",)),
+        (b"#!AER-DAT5.0\r\n" + b"\x00" * 28, ("AEDAT '5.0' is not read",)),
+        (b"#!AER-DAT3.1\r\n#Source 1: DVS128\r\n" + b"\x00" * 28, ("without its '#!END-HEADER' line",)),
+        (_aedat31_bytes([(1, [((3 << 17) | (2 << 2) | 3, 5)])])[:-3], ("ends inside the packet at byte",)),
         (b"not an aedat file at all", ("not an AEDAT file",)),
     ],
 )

@@ -69,7 +69,7 @@ def refuse_overwriting(args) -> None:
         taken.append((dest, path))
 
 
-EVENT_FILES = ".npz, .h5, .aedat4, .raw (EVT2/EVT3), .dat, .es, .aedat (AEDAT 2.0), .txt (t x y p, seconds), .csv"
+EVENT_FILES = ".npz, .h5, .aedat4, .raw (EVT2/EVT3), .dat, .es, .aedat (AEDAT 2.0/3.1), .txt (t x y p, seconds), .csv"
 POLARITY_CONVENTIONS = ("auto", "01", "pm1")
 
 

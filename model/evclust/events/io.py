@@ -5,7 +5,8 @@ Formats, by suffix:
 - `.h5`, `.hdf5`: `events/{t,x,y,p[,Y,Cb,Cr]}` datasets plus the metadata as attributes;
 - `.aedat4` (iniVation DV), `.raw` (Prophesee EVT3, or EVT2), `.dat` (Prophesee DAT) and `.es`
   (Event Stream): DVS events only, via faery (evclust.events.camera);
-- `.aedat` (jAER AEDAT 2.0, DVS128): evclust.events.aedat2;
+- `.aedat`: jAER's AEDAT 2.0 (DVS128) and cAER's AEDAT 3.1 through evclust.events.aedat_legacy,
+  AEDAT 4 through faery;
 - `.txt` (the Event Camera Dataset's `t x y p`, t in seconds) and `.csv` (named columns):
   evclust.events.text.
 
@@ -28,7 +29,7 @@ from collections.abc import Iterator
 import numpy as np
 
 from evclust.errors import EvclustError, atomic_output
-from evclust.events import aedat2, camera, text
+from evclust.events import aedat_legacy, camera, text
 from evclust.events.format import COLOUR_FIELDS, DVS_FIELDS, EVENT_DTYPE, EventMeta, concat_events, sort_events
 from evclust.events.validate import validate_events
 
@@ -36,7 +37,7 @@ HDF5_SUFFIXES = (".h5", ".hdf5")
 NPZ_SUFFIXES = (".npz",)
 SUFFIXES = (
     NPZ_SUFFIXES + HDF5_SUFFIXES + camera.AEDAT_SUFFIXES + camera.EVT_SUFFIXES + camera.DAT_SUFFIXES + camera.ES_SUFFIXES
-    + aedat2.SUFFIXES + text.ECD_SUFFIXES + text.CSV_SUFFIXES
+    + aedat_legacy.SUFFIXES + text.ECD_SUFFIXES + text.CSV_SUFFIXES
 )  # fmt: skip
 TEXT_KINDS = ("ecd", "csv")
 CHUNK = 1 << 20  # events per chunk: about 15 MB of records
@@ -51,7 +52,7 @@ def _kind(path: Path) -> str:
         ("evt", camera.EVT_SUFFIXES),
         ("dat", camera.DAT_SUFFIXES),
         ("es", camera.ES_SUFFIXES),
-        ("aedat2", aedat2.SUFFIXES),
+        ("aedat2", aedat_legacy.SUFFIXES),
         ("ecd", text.ECD_SUFFIXES),
         ("csv", text.CSV_SUFFIXES),
     ):
@@ -99,7 +100,7 @@ class EventReader:
         elif self.kind == "es":
             meta_dict, self.count = camera.es_header(path)
         elif self.kind == "aedat2":
-            meta_dict, self.count = aedat2.aedat2_header(path)
+            meta_dict, self.count = aedat_legacy.legacy_header(path)
         else:
             meta_dict, self.count = text.text_header(path, self.kind)
         self._sized = "width" in meta_dict and "height" in meta_dict
@@ -119,7 +120,7 @@ class EventReader:
         elif self.kind == "hdf5":
             pieces = self._hdf5_chunks(size)
         elif self.kind == "aedat2":
-            pieces = _order_ties(aedat2.aedat2_chunks(self.path, size))
+            pieces = _order_ties(aedat_legacy.legacy_chunks(self.path, size))
         elif self.kind in TEXT_KINDS:
             pieces = _order_ties(text.text_chunks(self.path, self.kind, self.meta, self.polarity, size=min(size, text.LINES)))
         else:
@@ -394,7 +395,7 @@ def event_writer(path: str | Path, meta: EventMeta, evt_version: str = "evt3"):
         elif kind == "es":
             writer = camera.EsWriter(tmp, meta)
         elif kind == "aedat2":
-            writer = aedat2.Aedat2Writer(tmp, meta)
+            writer = aedat_legacy.Aedat2Writer(tmp, meta)
         else:
             writer = text.TextWriter(tmp, meta, kind)
         checked = _CheckedWriter(writer, path, meta)
