@@ -189,7 +189,7 @@ def test_render_draws_from_the_scene_as_from_its_event_file(crossing_events, cap
     "name, content, fragments",
     [
         ("bad.aedat4", b"garbage" * 40, ("bad.aedat4", "not a readable event-camera file")),
-        ("bad.raw", b"% evt 3.0\n% end\n" + b"\x00" * 64, ("bad.raw", "not a readable event-camera file")),
+        ("bad.raw", b"% evt 3.0\n% end\n" + b"\x00" * 64, ("bad.raw", "no sensor size", "--sensor-size WxH")),
         ("bad.h5", b"not hdf5 at all", ("bad.h5", "not a readable HDF5 file")),
     ],
 )
@@ -219,8 +219,8 @@ def test_track_refuses_bad_options_and_writes_nothing(crossing_events, tmp_path,
 
 
 def test_simulate_refuses_an_unknown_event_format_and_writes_nothing(tmp_path, capsys):
-    code, _, err = run_cli(capsys, "simulate", "crossing", "-o", str(tmp_path / "e.dat"), "-q")
-    assert_one_line_error(code, err, "e.dat", "unknown event file type '.dat'")
+    code, _, err = run_cli(capsys, "simulate", "crossing", "-o", str(tmp_path / "e.evt"), "-q")
+    assert_one_line_error(code, err, "e.evt", "unknown event file type '.evt'")
     assert list(tmp_path.iterdir()) == []
 
 

@@ -114,7 +114,7 @@ def test_ties_out_of_order_are_refused(tmp_path):
             lambda p: np.savez(p, events=np.zeros(3, [("t", "f8"), ("x", "u2"), ("y", "u2"), ("p", "i1")]), meta=np.array(META.to_json())),
             "field t has type float64",
         ),
-        (lambda p: np.savez(p, events=some_events()), "metadata has no sensor width"),
+        (lambda p: np.savez(p, events=some_events()), "the file gives no sensor size: give it with --sensor-size WxH"),
     ],
 )
 def test_malformed_files_fail_with_one_line(tmp_path, make, fault):
@@ -126,8 +126,8 @@ def test_malformed_files_fail_with_one_line(tmp_path, make, fault):
 
 
 def test_unknown_suffix_and_missing_file(tmp_path):
-    with pytest.raises(EvclustError, match="unknown event file type '.csv'"):
-        read_events(tmp_path / "x.csv")
+    with pytest.raises(EvclustError, match="unknown event file type '.evt'"):
+        read_events(tmp_path / "x.evt")
     with pytest.raises(EvclustError, match="no such event file"):
         read_events(tmp_path / "absent.npz")
 

@@ -259,7 +259,7 @@ def test_bad_input_gets_one_line_and_no_output(tmp_path, capsys):
     small = tmp_path / "small.npz"
     write_events(small, make_events()[:0], EventMeta(width=32, height=32, source="unit", t_frame_us=PERIOD))
     one_line_error(capsys, ["render", str(small), str(tracks_path), "-o", str(out_png)], "64x48", "32x32")
-    one_line_error(capsys, ["render", str(tracks_path), str(tracks_path), "-o", str(out_png)], "tracks.csv", "unknown event file type")
+    one_line_error(capsys, ["render", str(tracks_path), str(tracks_path), "-o", str(out_png)], "tracks.csv", "column")
     one_line_error(capsys, ["plot", str(tracks_path), "--truth", str(truth_path), "-o", str(tmp_path / "p.txt")], "p.txt", ".png")
     one_line_error(capsys, ["plot", str(tracks_path), "--truth", str(tmp_path / "nope.csv"), "-o", str(out_png)], "nope.csv")
     one_line_error(capsys, ["plot", str(tracks_path), "--truth", str(truth_path), "-o", str(out_png), "--kind", "scatter"], "--events")

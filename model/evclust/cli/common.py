@@ -67,3 +67,40 @@ def refuse_overwriting(args) -> None:
                 role = "an input" if other in inputs else "another output"
                 raise EvclustError(f"{_label(dest)} {value}: is {role} of this run ({_label(other)} {other_path}); write it elsewhere")
         taken.append((dest, path))
+
+
+EVENT_FILES = ".npz, .h5, .aedat4, .raw (EVT2/EVT3), .dat, .es, .aedat (AEDAT 2.0/3.1), .txt (t x y p, seconds), .csv"
+POLARITY_CONVENTIONS = ("auto", "01", "pm1")
+
+
+def sensor_size(text: str) -> tuple[int, int]:
+    """argparse type for --sensor-size WxH."""
+    import argparse
+
+    width, sep, height = text.lower().partition("x")
+    if (
+        not sep
+        or not width.strip().isdigit()
+        or not height.strip().isdigit()
+        or not (1 <= int(width) <= 65535 and 1 <= int(height) <= 65535)
+    ):
+        raise argparse.ArgumentTypeError(f"'{text}' is not a sensor size WxH in pixels, 1 to 65535 each (e.g. 346x260)")
+    return int(width), int(height)
+
+
+def add_event_file_options(p) -> None:
+    """--sensor-size and --polarity, for verbs that read an event file."""
+    p.add_argument(
+        "--sensor-size",
+        type=sensor_size,
+        metavar="WxH",
+        help="sensor size of an event file that gives none (.txt, .csv; .raw or .dat whose header lacks it); "
+        "for a file that gives one it must agree",
+    )
+    p.add_argument(
+        "--polarity",
+        default="auto",
+        choices=POLARITY_CONVENTIONS,
+        help="polarity column of a text event file (.txt, .csv): 01 = 0 OFF / 1 ON, pm1 = -1 OFF / +1 ON, "
+        "auto (default) = 1 ON, 0 or -1 OFF",
+    )

@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
+from evclust.cli.common import EVENT_FILES, add_event_file_options
 from evclust.errors import EvclustError
 
 
@@ -23,7 +24,7 @@ def add_parser(sub) -> None:
     p.add_argument(
         "events",
         metavar="EVENTS",
-        help="event file (.npz, .h5, .aedat4, .raw), or the scene or video the tracks came from (simulated again)",
+        help=f"event file ({EVENT_FILES}), or the scene or video the tracks came from (simulated again)",
     )
     p.add_argument("tracks", metavar="TRACKS", help="track file (tracks.csv from 'evclust track')")
     p.add_argument("-o", "--output", required=True, metavar="OUT", help="video (.mp4) or picture (.png) to write")
@@ -34,6 +35,7 @@ def add_parser(sub) -> None:
     p.add_argument(
         "--arrow-frames", type=float, default=5.0, metavar="F", help="velocity arrows show the motion over F frames (default: 5)"
     )
+    add_event_file_options(p)
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     p.set_defaults(run=run)
 
@@ -57,7 +59,7 @@ def run(args) -> int:
         value = getattr(args, name)
         if value is not None and not 0 <= value < math.inf:
             raise EvclustError(f"--{name} {value:g}: must be a finite time in µs, >= 0")
-    source = open_events(args.events)
+    source = open_events(args.events, sensor_size=args.sensor_size, polarity=args.polarity)
     events, ev_meta = source.read(), source.meta
     tracks, track_meta = read_tracks(args.tracks)
     common = dict(window_us=args.window, scale=args.scale, arrow_frames=args.arrow_frames)

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from evclust.choices import TRACK_MODELS
-from evclust.cli.common import preset_list
+from evclust.cli.common import EVENT_FILES, add_event_file_options, preset_list
 
 
 def add_parser(sub) -> None:
@@ -19,14 +19,15 @@ def add_parser(sub) -> None:
             "table, or a preset name), else from the preset of the events' source scene, else the defaults, which "
             "hold across the generalization suite: their time constants are in frames of the event file's frame "
             "period (printed with the summary). "
-            "DVS-only event files (AEDAT4, EVT, or HDF5 without colour) run with colour off."
+            "DVS-only event files (camera and text formats, or HDF5 without colour) run with colour off."
         ),
     )
     p.add_argument(
         "events",
         metavar="EVENTS",
-        help="event file (.npz, .h5, .aedat4 or .raw EVT2/EVT3), or a scene or video to simulate on the fly (no event file written)",
+        help=f"event file ({EVENT_FILES}), or a scene or video to simulate on the fly (no event file written)",
     )
+    add_event_file_options(p)
     p.add_argument("-o", "--output", required=True, metavar="TRACKS", help="track file to write (.csv, or .parquet: smaller and faster)")
     p.add_argument("--params", metavar="P", help=f"parameter file (.toml) or preset ({preset_list()})")
     p.add_argument("--model", default="float", choices=TRACK_MODELS, help="clusterer model (default: float)")
@@ -68,7 +69,7 @@ def run(args) -> int:
         raise EvclustError(f"--frame-us {args.frame_us}: the frame period must be a positive, finite number of µs")
     if (args.ranges or args.beta_shift) and args.model != "fixed":
         raise EvclustError("--ranges and --beta-shift are options of the fixed model: add --model fixed")
-    reader = open_events(args.events, progress=not args.quiet)
+    reader = open_events(args.events, progress=not args.quiet, sensor_size=args.sensor_size, polarity=args.polarity)
     meta = reader.meta
     if args.frame_us is not None:
         meta = dataclasses.replace(meta, t_frame_us=args.frame_us)

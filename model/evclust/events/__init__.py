@@ -1,4 +1,4 @@
-"""Events: one structured dtype everywhere; files in .npz, HDF5, AEDAT4 and EVT2/3, read and
+"""Events: one structured dtype everywhere; files in .npz, HDF5, AEDAT4, EVT2/3, DAT, ES, AEDAT 2.0 and text, read and
 written in chunks, validated on read."""
 
 from evclust.events.format import EVENT_DTYPE, COLOUR_FIELDS, EventMeta, concat_events, empty_events, sort_events

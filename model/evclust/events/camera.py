@@ -1,4 +1,5 @@
-"""Event-camera files through faery: AEDAT4 (iniVation DV) and EVT2/EVT3 `.raw` (Prophesee).
+"""Event-camera files through faery: AEDAT4 (iniVation DV), EVT2/EVT3 `.raw` and DAT `.dat`
+(Prophesee), Event Stream `.es` (Neuromorphic Paris).
 
 These formats carry DVS events only (t, x, y, polarity). Reading gives events with zero colour
 fields and `has_colour=False`; writing drops the colour fields. AEDAT4 files written here keep
@@ -20,8 +21,14 @@ from evclust.jit import njit
 
 AEDAT_SUFFIXES = (".aedat4",)
 EVT_SUFFIXES = (".raw",)
+DAT_SUFFIXES = (".dat",)
+ES_SUFFIXES = (".es",)
 EVT_VERSIONS = ("evt2", "evt3")
 META_ATTRIBUTE = "evclustMeta"  # AEDAT4 info-node attribute holding EventMeta as JSON
+# The size faery is given for a file whose header has none: nothing is outside it, so the
+# validator, not faery, names the first event outside the size the user gave (--sensor-size).
+NO_SIZE = (65535, 65535)
+DAT_MAX_T = 1 << 32  # DAT stores 32-bit µs timestamps, with no overflow marker
 
 
 def faery_dtype() -> np.dtype:
@@ -159,22 +166,37 @@ class AedatWriter:
 # EVT2 / EVT3 (.raw)
 
 
-def evt_header(path: Path) -> tuple[dict, None]:
-    from faery import evt
-
+def _sized_header(path: Path, decoder_class, version_fallback) -> dict:
+    """The metadata of an EVT or DAT file; no width and height when its header has none."""
     try:
-        with evt.Decoder(path, None, None) as decoder:
+        with decoder_class(path, None, version_fallback) as decoder:
             width, height = decoder.dimensions
     except Exception as exc:
-        raise _faery_error(path, exc) from None
-    return {"width": width, "height": height, "source": path.stem, "has_colour": False}, None
+        if "no size information" not in str(exc):
+            raise _faery_error(path, exc) from None
+        try:  # is the size the only thing missing?
+            with decoder_class(path, NO_SIZE, version_fallback):
+                pass
+        except Exception:
+            raise _faery_error(path, exc) from None
+        return {"source": path.stem, "has_colour": False}
+    return {"width": width, "height": height, "source": path.stem, "has_colour": False}
 
 
-def evt_packets(path: Path) -> Iterator[np.ndarray]:
+def evt_header(path: Path) -> tuple[dict, None]:
+    """(metadata, None): EVT headers give no event count. No width and height when the header has
+    none (Gen3 and some Gen4 recordings): the reader then asks for --sensor-size."""
+    from faery import evt
+
+    return _sized_header(path, evt.Decoder, None), None
+
+
+def evt_packets(path: Path, sized: bool = True) -> Iterator[np.ndarray]:
+    """faery's packets; `sized` False for a header without a size (the reader checks it)."""
     from faery import evt
 
     try:
-        with evt.Decoder(path, None, None) as decoder:
+        with evt.Decoder(path, None if sized else NO_SIZE, None) as decoder:
             for packet in decoder:
                 events = packet.get("events")
                 if events is not None and len(events):
@@ -195,6 +217,125 @@ class EvtWriter:
     def write(self, ev: np.ndarray) -> None:
         if ev.size:
             self._encoder.write({"events": to_faery(ev)})
+
+    def close(self, failed: bool = False) -> None:
+        self._encoder.__exit__(None, None, None)
+
+
+# ------------------------------------------------------------------------------------------------
+# DAT (Prophesee's decoded CD events: 32-bit µs timestamp, x, y, polarity in a 32-bit word)
+
+
+def dat_header(path: Path) -> tuple[dict, int | None]:
+    """(metadata, event count from the file's size). A header without `% Version` is read as
+    DAT 2, the only version Metavision writes; without `% Width`/`% Height` the size is asked
+    for (--sensor-size)."""
+    from faery import dat
+
+    meta = _sized_header(path, dat.Decoder, "dat2")
+    try:
+        with dat.Decoder(path, NO_SIZE, "dat2") as decoder:
+            kind = decoder.event_type
+    except Exception as exc:
+        raise _faery_error(path, exc) from None
+    if kind != "cd":
+        raise EvclustError(f"{path}: a DAT file of {kind} events; only CD (contrast detection) events are read")
+    return meta, None
+
+
+def dat_packets(path: Path, sized: bool = True) -> Iterator[np.ndarray]:
+    from faery import dat
+
+    try:
+        with dat.Decoder(path, None if sized else NO_SIZE, "dat2") as decoder:
+            for packet in decoder:
+                if len(packet):
+                    events = np.empty(packet.size, faery_dtype())
+                    events["t"], events["x"], events["y"] = packet["t"], packet["x"], packet["y"]
+                    events["on"] = packet["payload"] > 0  # payload 1 = ON, 0 = OFF
+                    yield events
+    except Exception as exc:
+        raise _faery_error(path, exc) from None
+
+
+class DatWriter:
+    """DAT 2, CD events. Its timestamps are 32-bit: a stream reaching 2^32 µs (71.6 minutes)
+    is refused rather than written wrapped."""
+
+    def __init__(self, tmp: Path, meta: EventMeta):
+        from faery import dat
+
+        self._encoder = dat.Encoder(tmp, "dat2", "cd", False, (meta.width, meta.height)).__enter__()
+
+    def write(self, ev: np.ndarray) -> None:
+        if not ev.size:
+            return
+        if int(ev["t"][-1]) >= DAT_MAX_T:
+            i = int(np.flatnonzero(ev["t"] >= DAT_MAX_T)[0])
+            raise EvclustError(
+                f"event at t={int(ev['t'][i])} us: DAT stores 32-bit µs timestamps (up to {DAT_MAX_T - 1}); write .h5 or .raw"
+            )
+        packet = np.empty(ev.size, [("t", "<u8"), ("x", "<u2"), ("y", "<u2"), ("payload", "u1")])
+        packet["t"], packet["x"], packet["y"] = ev["t"], ev["x"], ev["y"]
+        packet["payload"] = ev["p"] > 0
+        self._encoder.write(packet)
+
+    def close(self, failed: bool = False) -> None:
+        self._encoder.__exit__(None, None, None)
+
+
+# ------------------------------------------------------------------------------------------------
+# Event Stream (.es), version 2, DVS events. ES puts y = 0 at the bottom row: it is turned to the
+# image convention (y = 0 at the top) on reading and back on writing, as faery's own stream API
+# does (faery.file_decoder / file_encoder).
+
+
+def es_header(path: Path) -> tuple[dict, None]:
+    from faery import es
+
+    try:
+        with es.Decoder(path, 0) as decoder:
+            kind, dimensions = decoder.event_type, decoder.dimensions
+    except Exception as exc:
+        raise _faery_error(path, exc) from None
+    if kind not in ("dvs", "atis") or dimensions is None:
+        raise EvclustError(f"{path}: an Event Stream file of {kind} events; only DVS and ATIS events are read")
+    width, height = dimensions
+    return {"width": width, "height": height, "source": path.stem, "has_colour": False}, None
+
+
+def es_packets(path: Path, height: int) -> Iterator[np.ndarray]:
+    from faery import es
+
+    try:
+        with es.Decoder(path, 0) as decoder:
+            atis = decoder.event_type == "atis"
+            for packet in decoder:
+                if atis:  # ATIS: keep the change detections, drop the exposure measurements
+                    packet = packet[np.logical_not(packet["exposure"])]
+                if not len(packet):
+                    continue
+                events = np.empty(packet.size, faery_dtype())
+                events["t"], events["x"] = packet["t"], packet["x"]
+                events["y"] = height - 1 - packet["y"].astype(np.int64)
+                events["on"] = packet["polarity"] if atis else packet["on"]
+                yield events
+    except Exception as exc:
+        raise _faery_error(path, exc) from None
+
+
+class EsWriter:
+    def __init__(self, tmp: Path, meta: EventMeta):
+        from faery import es
+
+        self.height = meta.height
+        self._encoder = es.Encoder(tmp, "dvs", False, (meta.width, meta.height)).__enter__()
+
+    def write(self, ev: np.ndarray) -> None:
+        if ev.size:
+            packet = to_faery(ev)
+            packet["y"] = self.height - 1 - ev["y"].astype(np.int64)
+            self._encoder.write(packet)
 
     def close(self, failed: bool = False) -> None:
         self._encoder.__exit__(None, None, None)

@@ -3,8 +3,16 @@
 Formats, by suffix:
 - `.npz`: native, the whole stream in one array (written at once: keep it for small streams);
 - `.h5`, `.hdf5`: `events/{t,x,y,p[,Y,Cb,Cr]}` datasets plus the metadata as attributes;
-- `.aedat4` (iniVation DV) and `.raw` (Prophesee EVT3, or EVT2): DVS events only, via faery
-  (evclust.events.camera).
+- `.aedat4` (iniVation DV), `.raw` (Prophesee EVT3, or EVT2), `.dat` (Prophesee DAT) and `.es`
+  (Event Stream): DVS events only, via faery (evclust.events.camera);
+- `.aedat`: jAER's AEDAT 2.0 (DVS128) and cAER's AEDAT 3.1 through evclust.events.aedat_legacy,
+  AEDAT 4 through faery;
+- `.txt` (the Event Camera Dataset's `t x y p`, t in seconds) and `.csv` (named columns):
+  evclust.events.text.
+
+Files without a sensor size (text, and EVT or DAT whose header has none) are read with the size
+the caller gives (`sensor_size`, the CLI's --sensor-size); a size given for a file that has one
+must agree with it.
 
 Readers validate every chunk and the seams between chunks, and fail with one line. Writers are
 atomic: a failed write leaves no file.
@@ -21,13 +29,17 @@ from collections.abc import Iterator
 import numpy as np
 
 from evclust.errors import EvclustError, atomic_output
-from evclust.events import camera
+from evclust.events import aedat_legacy, camera, text
 from evclust.events.format import COLOUR_FIELDS, DVS_FIELDS, EVENT_DTYPE, EventMeta, concat_events, sort_events
 from evclust.events.validate import validate_events
 
 HDF5_SUFFIXES = (".h5", ".hdf5")
 NPZ_SUFFIXES = (".npz",)
-SUFFIXES = NPZ_SUFFIXES + HDF5_SUFFIXES + camera.AEDAT_SUFFIXES + camera.EVT_SUFFIXES
+SUFFIXES = (
+    NPZ_SUFFIXES + HDF5_SUFFIXES + camera.AEDAT_SUFFIXES + camera.EVT_SUFFIXES + camera.DAT_SUFFIXES + camera.ES_SUFFIXES
+    + aedat_legacy.SUFFIXES + text.ECD_SUFFIXES + text.CSV_SUFFIXES
+)  # fmt: skip
+TEXT_KINDS = ("ecd", "csv")
 CHUNK = 1 << 20  # events per chunk: about 15 MB of records
 
 
@@ -38,6 +50,11 @@ def _kind(path: Path) -> str:
         ("hdf5", HDF5_SUFFIXES),
         ("aedat", camera.AEDAT_SUFFIXES),
         ("evt", camera.EVT_SUFFIXES),
+        ("dat", camera.DAT_SUFFIXES),
+        ("es", camera.ES_SUFFIXES),
+        ("aedat2", aedat_legacy.SUFFIXES),
+        ("ecd", text.ECD_SUFFIXES),
+        ("csv", text.CSV_SUFFIXES),
     ):
         if suffix in suffixes:
             return kind
@@ -52,14 +69,23 @@ class EventReader:
     """An event file opened for reading: its metadata now, its records chunk by chunk.
 
     `count` is the number of events when the file says so without decoding it (else None).
+    `sensor_size` (width, height) is the size of a file that gives none; `polarity` the
+    convention of a text file's polarity column (evclust.events.text.POLARITY).
     """
 
-    def __init__(self, path: str | Path):
+    def __init__(self, path: str | Path, sensor_size: tuple[int, int] | None = None, polarity: str = "auto"):
         self.path = path = Path(path)
         self.kind = _kind(path)
         if not path.is_file():
             raise EvclustError(f"{path}: no such event file")
+        if polarity not in text.POLARITY:
+            raise EvclustError(f"polarity convention '{polarity}' is not one of {', '.join(text.POLARITY)}")
+        if polarity != "auto" and self.kind not in TEXT_KINDS:
+            raise EvclustError(f"{path}: --polarity {polarity} is for text files (.txt, .csv); this format's polarity is a bit it defines")
+        self.polarity = polarity
         self._columns = None
+        if self.kind == "aedat2":
+            self.kind = _aedat_version(path)
         if self.kind == "npz":
             self._columns, meta_dict = _read_npz(path)
             self.count = len(self._columns.get("t", ()))
@@ -67,11 +93,18 @@ class EventReader:
             meta_dict, self.count = _hdf5_header(path)
         elif self.kind == "aedat":
             meta_dict, self.count = camera.aedat_header(path)
-        else:
+        elif self.kind == "evt":
             meta_dict, self.count = camera.evt_header(path)
-        for key in ("width", "height"):
-            if key not in meta_dict:
-                raise EvclustError(f"{path}: metadata has no sensor {key}")
+        elif self.kind == "dat":
+            meta_dict, self.count = camera.dat_header(path)
+        elif self.kind == "es":
+            meta_dict, self.count = camera.es_header(path)
+        elif self.kind == "aedat2":
+            meta_dict, self.count = aedat_legacy.legacy_header(path)
+        else:
+            meta_dict, self.count = text.text_header(path, self.kind)
+        self._sized = "width" in meta_dict and "height" in meta_dict
+        meta_dict = _with_size(path, meta_dict, sensor_size)
         try:
             self.meta = EventMeta.from_dict(meta_dict)
         except EvclustError as exc:
@@ -86,8 +119,17 @@ class EventReader:
             pieces = (ev[lo : lo + size] for lo in range(0, ev.size, size))
         elif self.kind == "hdf5":
             pieces = self._hdf5_chunks(size)
+        elif self.kind == "aedat2":
+            pieces = _order_ties(aedat_legacy.legacy_chunks(self.path, size))
+        elif self.kind in TEXT_KINDS:
+            pieces = _order_ties(text.text_chunks(self.path, self.kind, self.meta, self.polarity, size=min(size, text.LINES)))
         else:
-            packets = camera.aedat_packets(self.path) if self.kind == "aedat" else camera.evt_packets(self.path)
+            packets = {
+                "aedat": lambda: camera.aedat_packets(self.path),
+                "evt": lambda: camera.evt_packets(self.path, self._sized),
+                "dat": lambda: camera.dat_packets(self.path, self._sized),
+                "es": lambda: camera.es_packets(self.path, self.meta.height),
+            }[self.kind]()
             # Cut faery's small packets into chunks first: one conversion per chunk, not per packet.
             pieces = _order_ties(camera.from_faery(chunk) for chunk in _regroup(packets, size))
         offset, last = 0, None
@@ -125,9 +167,35 @@ class EventReader:
             raise EvclustError(f"{self.path}: not a readable HDF5 file ({exc})") from None
 
 
-def read_events(path: str | Path) -> tuple[np.ndarray, EventMeta]:
+def _aedat_version(path: Path) -> str:
+    """`.aedat` holds AEDAT 2.0 (jAER), 3.1 (cAER) or 4.0 (DV): the first line says which."""
+    try:
+        with open(path, "rb") as f:
+            first = f.readline(64)
+    except OSError as exc:
+        raise EvclustError(f"{path}: cannot be read ({exc.strerror})") from None
+    return "aedat" if first.startswith(b"#!AER-DAT4") else "aedat2"
+
+
+def _with_size(path: Path, meta: dict, sensor_size: tuple[int, int] | None) -> dict:
+    """The file's size, or the one given where it has none; one line where neither is known or
+    the two disagree."""
+    has = "width" in meta and "height" in meta
+    if sensor_size is None:
+        if not has:
+            raise EvclustError(f"{path}: the file gives no sensor size: give it with --sensor-size WxH")
+        return meta
+    width, height = sensor_size
+    if has and (meta["width"], meta["height"]) != (width, height):
+        raise EvclustError(
+            f"{path}: --sensor-size {width}x{height} disagrees with the file's {meta['width']}x{meta['height']}; leave it out"
+        )
+    return {**meta, "width": width, "height": height}
+
+
+def read_events(path: str | Path, sensor_size: tuple[int, int] | None = None, polarity: str = "auto") -> tuple[np.ndarray, EventMeta]:
     """Return (events, meta). DVS-only files get zero colour fields and `meta.has_colour=False`."""
-    reader = EventReader(path)
+    reader = EventReader(path, sensor_size, polarity)
     events = reader.read()
     return events, reader.meta
 
@@ -308,8 +376,8 @@ class _Hdf5Writer:
 def event_writer(path: str | Path, meta: EventMeta, evt_version: str = "evt3"):
     """Yield a writer with `.write(chunk)`; the file appears only if the block succeeds.
 
-    Camera formats drop the colour fields (DVS events only); `evt_version` picks EVT3 or EVT2
-    for `.raw`.
+    Camera and text formats drop the colour fields (DVS events only); `evt_version` picks EVT3
+    or EVT2 for `.raw`. `.aedat` is written as AEDAT 2.0 (DVS128, at most 128x128).
     """
     path = Path(path)
     kind = _kind(path)
@@ -320,8 +388,16 @@ def event_writer(path: str | Path, meta: EventMeta, evt_version: str = "evt3"):
             writer = _Hdf5Writer(tmp, meta)
         elif kind == "aedat":
             writer = camera.AedatWriter(tmp, meta)
-        else:
+        elif kind == "evt":
             writer = camera.EvtWriter(tmp, meta, evt_version)
+        elif kind == "dat":
+            writer = camera.DatWriter(tmp, meta)
+        elif kind == "es":
+            writer = camera.EsWriter(tmp, meta)
+        elif kind == "aedat2":
+            writer = aedat_legacy.Aedat2Writer(tmp, meta)
+        else:
+            writer = text.TextWriter(tmp, meta, kind)
         checked = _CheckedWriter(writer, path, meta)
         try:
             yield checked

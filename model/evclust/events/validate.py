@@ -29,7 +29,11 @@ def validate_events(ev: np.ndarray, meta: EventMeta, name: str, offset: int = 0,
         outside = np.flatnonzero(ev[axis] >= limit)
         if outside.size:
             i = int(outside[0])
-            raise EvclustError(f"{name}: record {i + offset}: {axis}={int(ev[axis][i])} is outside the {meta.width}x{meta.height} sensor")
+            e = ev[i]
+            raise EvclustError(
+                f"{name}: record {i + offset}: {axis}={int(e[axis])} is outside the {meta.width}x{meta.height} sensor "
+                f"(event t={int(e['t'])} us, x={int(e['x'])}, y={int(e['y'])}, p={int(e['p']):+d})"
+            )
     t = ev["t"]
     back = np.flatnonzero(t[1:] < t[:-1])
     if back.size:

@@ -46,6 +46,13 @@ def is_scene(ref: str | Path) -> bool:
     return suffix in SCENE_SUFFIXES + VIDEO_SUFFIXES or path.is_dir() or (suffix == "" and "/" not in str(ref) and not path.exists())
 
 
-def open_events(ref: str | Path, progress: bool = False):
-    """An EventReader for an event file, else a SceneEvents that simulates the scene."""
-    return SceneEvents(str(ref), progress=progress) if is_scene(ref) else EventReader(ref)
+def open_events(ref: str | Path, progress: bool = False, sensor_size: tuple[int, int] | None = None, polarity: str = "auto"):
+    """An EventReader for an event file, else a SceneEvents that simulates the scene.
+    `sensor_size` and `polarity` are for event files (EventReader); a scene has its own size."""
+    if is_scene(ref):
+        from evclust.errors import EvclustError
+
+        if sensor_size is not None or polarity != "auto":
+            raise EvclustError(f"{ref}: --sensor-size and --polarity are for event files; a scene or video gives its own")
+        return SceneEvents(str(ref), progress=progress)
+    return EventReader(ref, sensor_size, polarity)
