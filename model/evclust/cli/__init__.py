@@ -49,6 +49,15 @@ def _terminate(signum, frame):
     raise Terminated
 
 
+def _stop_readers() -> None:
+    """Finish now the generators an interrupted run left suspended (the simulator's frame reader
+    among them): their cleanup stops their threads, which the interpreter's exit would otherwise
+    kill inside OpenCV ("terminate called without an active exception", exit -6, not 130)."""
+    import gc
+
+    gc.collect()
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     try:
@@ -68,9 +77,11 @@ def main(argv: list[str] | None = None) -> int:
         print(f"evclust: error: {exc}", file=sys.stderr)
         return 2
     except Terminated:
+        _stop_readers()
         print("evclust: terminated", file=sys.stderr)
         return 128 + signal.SIGTERM
     except KeyboardInterrupt:
+        _stop_readers()
         print("evclust: interrupted", file=sys.stderr)
         return 130
     except OSError as exc:  # output folder not writable, disk full, ...

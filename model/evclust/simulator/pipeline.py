@@ -5,6 +5,7 @@ from __future__ import annotations
 import dataclasses
 import os
 import queue
+import contextlib
 import threading
 import time
 from concurrent.futures import ThreadPoolExecutor
@@ -225,18 +226,23 @@ class Simulator:
         if self.pool is not None:  # decode and observe the next frames while this one is detected
             observed = _prefetched(observed)
         ref = l_prev = rgb_prev = None
-        bar = tqdm(observed, total=total, unit="frame", disable=None if progress else True, desc="simulate")
-        for k, (level, colour) in enumerate(bar):
-            counter[0] = k + 1
-            if ref is None:
-                ref = level.astype(np.float64)  # the reference starts at the first frame: no events
-            else:
-                t0 = (k - 1) * g.t_sample_us
-                events = self._detect(l_prev, level, rgb_prev, colour, ref, t0)
-                for effect in self.interval_effects:
-                    events = effect.interval(events, Interval(k, t0, t0 + g.t_sample_us, rgb_prev.reshape(shape), colour.reshape(shape)))
-                yield events
-            l_prev, rgb_prev = level, colour
+        # Closed here, not when the garbage collector gets to it: an interrupted run stops the
+        # reader thread before the interpreter exits, never while the thread is inside OpenCV.
+        with contextlib.closing(observed):
+            bar = tqdm(observed, total=total, unit="frame", disable=None if progress else True, desc="simulate")
+            for k, (level, colour) in enumerate(bar):
+                counter[0] = k + 1
+                if ref is None:
+                    ref = level.astype(np.float64)  # the reference starts at the first frame: no events
+                else:
+                    t0 = (k - 1) * g.t_sample_us
+                    events = self._detect(l_prev, level, rgb_prev, colour, ref, t0)
+                    for effect in self.interval_effects:
+                        events = effect.interval(
+                            events, Interval(k, t0, t0 + g.t_sample_us, rgb_prev.reshape(shape), colour.reshape(shape))
+                        )
+                    yield events
+                l_prev, rgb_prev = level, colour
 
 
 class SimulationStream:
