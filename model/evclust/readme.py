@@ -59,6 +59,8 @@ TABLES = (
     Table("hardware", "docs/report/REPORT.md", "REPORT", "### Word lengths and N: accuracy against area and cycles",
           (_c("configuration"), _c("cycles/event"), _c("traffic: velocity NRMSE"), _c("traffic: position RMSE (px)"),
            _c("pedestrian: velocity NRMSE"), _c("pedestrian: position RMSE (px)"), _c("LUT (+INV)"), _c("FF"), _c("DSP48E1"))),
+    Table("clusterer", "docs/BENCHMARKS.md", "BENCHMARKS:clusterer", "<!-- bench:clusterer:start -->",
+          (_c("scene"), _c("parameters"), _c("model"), _c("N"), _c("events"), _c("Mevents/s (median)")), ("traffic",)),
     Table("speed", "docs/BENCHMARKS.md", "BENCHMARKS:simulator", "<!-- bench:simulator:start -->",
           (_c("case"), _c("frames"), _c("size"), _c("events per pixel-frame"), _c("Mpx-frames/s"), _c("Mev/s")),
           ("traffic ideal", "video ideal")),
