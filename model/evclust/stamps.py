@@ -234,6 +234,7 @@ def probe_records() -> list[tuple[str, bytes]]:
 
     from evclust.clusterer import ClustererParams, FloatClusterer, load_params, preset_names
     from evclust.clusterer.objects import FloatObjects
+    from evclust.events import EVENT_DTYPE
 
     simulated = probe_events()
     out = [(label, data) for label, data in simulated if not label.startswith("events ")]
@@ -245,18 +246,12 @@ def probe_records() -> list[tuple[str, bytes]]:
         src = scene.source
         for name, params in configs:
             model = FloatClusterer(params, src.width, src.height, src.t_frame_us)
-            rows = model.feed(np.frombuffer(events[label], dtype=_event_dtype()))
+            rows = model.feed(np.frombuffer(events[label], dtype=EVENT_DTYPE))
             out.append((f"{label} {name} clusters", _rounded(rows)))
             if params.objects:
                 objects = FloatObjects(model.params, src.width, src.height, src.t_frame_us)
                 out.append((f"{label} {name} objects", _rounded(objects.feed(rows, model.steps))))
     return out
-
-
-def _event_dtype():
-    from evclust.events import EVENT_DTYPE
-
-    return EVENT_DTYPE
 
 
 def _hash(parts) -> str:

@@ -330,7 +330,8 @@ def hardware_section(results, img: Path, scene_names: list[str], quick: bool) ->
     ]
     synthesised = [r for r in results if isinstance(r.area, dict)]
     if quick or not synthesised:
-        lines += ["Area: not synthesised in this run (`--quick` skips Yosys and the guard-bit rows; `make report` runs both).", ""]
+        why = "`--quick` skips Yosys and the guard-bit rows; `make report` runs both" if quick else "every Yosys run failed"
+        lines += [f"Area: not synthesised in this run ({why}).", ""]
     else:
         figures.area_against_accuracy(
             [r.config.label for r in synthesised], [r.area for r in synthesised],
