@@ -4,8 +4,10 @@ Data flows one way: scene -> simulator -> events -> clusterer -> tracks -> metri
 """
 
 import os
+import time
 
 __version__ = "0.1.0"
+STARTED = time.perf_counter()  # when the package was imported: `track` counts its start-up from here
 
 # OpenCV's and FFmpeg's own messages (a damaged block of a video, a missing moov atom) would reach
 # stderr beside evclust's one-line error; a user who wants them sets these before the run. They

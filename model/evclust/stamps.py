@@ -91,6 +91,7 @@ DOCUMENTS = (
     _bench("synth-defaults", ("formats", "rtl"), "synth/synth.py --defaults --write docs/BENCHMARKS.md"),
     _bench("timing", ("formats", "rtl"), "make timing"),
     _bench("peers", ("simulator",), "make bench-peers"),
+    _bench("recordings", ("float",), "make bench (bench/recordings.py)"),
     Document("RTL:datasheet", "docs/RTL.md", "<!-- datasheet:timing:start -->", "<!-- datasheet:timing:end -->", ("formats", "rtl"),
              "make timing"),
     Document("VERIFICATION:coverage", "docs/VERIFICATION.md", "<!-- coverage:begin -->", "<!-- coverage:end -->",

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from evclust.cli import main
+from evclust.choices import FRAMELESS_PERIOD_US
 from evclust.events import read_events, write_events
 from evclust.tracks import read_tracks
 
@@ -113,13 +114,18 @@ def test_camera_recordings_track_with_colour_off_as_the_same_dvs_stream_in_hdf5(
     assert np.all(got["class"] == -1) and not got["Y"].any()
 
 
-def test_a_recording_without_frame_period_asks_for_one(crossing_events, capsys):
+def test_a_recording_without_frame_period_is_tracked_at_the_frameless_period_and_says_so(crossing_events, capsys):
     recording = crossing_events / "noframe.raw"
     assert main(["simulate", "crossing", "-o", str(recording), "-q"]) == 0
-    out = crossing_events / "never.parquet"
-    code, _, err = run_cli(capsys, "track", str(recording), "-o", str(out), "-q")
-    assert_one_line_error(code, err, "no frame period", "--frame-us")
-    assert not out.exists()
+    out, given = crossing_events / "noframe.parquet", crossing_events / "given.parquet"
+    code, stdout, err = run_cli(capsys, "track", str(recording), "-o", str(out), "-q")
+    assert code == 0, err
+    assert "no frame period in the file: the time constants are taken at 40,000 µs (25 fps" in stdout and "x25 for px/s" in stdout
+    # The same as giving that period: nothing else changes.
+    code, stdout, err = run_cli(capsys, "track", str(recording), "-o", str(given), "--frame-us", str(FRAMELESS_PERIOD_US), "-q")
+    assert code == 0 and "no frame period" not in stdout, err
+    (got, got_meta), (want, want_meta) = read_tracks(out), read_tracks(given)
+    assert got_meta.t_frame_us == want_meta.t_frame_us == FRAMELESS_PERIOD_US and got.size > 0 and np.array_equal(got, want)
 
 
 def test_parquet_and_csv_track_files_hold_the_same_records(crossing_events, capsys):

@@ -257,6 +257,33 @@ def test_csv_columns_found_by_name_in_any_order(tmp_path):
     assert dvs(read_events(seconds, sensor_size=(8, 4))[0]) == [(250_000, 1, 1, -1)]
 
 
+def test_text_files_that_say_their_size_in_their_own_way_need_no_sensor_size(tmp_path):
+    import cv2
+
+    # faery's CSV names the coordinate columns x@W, y@H.
+    (tmp_path / "f.csv").write_text("t,x@320,y@240,on\n5,319,239,1\n")
+    got, meta = read_events(tmp_path / "f.csv")
+    assert (meta.width, meta.height) == (320, 240) and dvs(got) == [(5, 319, 239, 1)]
+    # The Event Camera Dataset: images.txt beside events.txt lists the frames; the first one's size is the sensor's.
+    (tmp_path / "images").mkdir()
+    assert cv2.imwrite(str(tmp_path / "images" / "frame_00000000.png"), np.zeros((180, 240), np.uint8))
+    (tmp_path / "images.txt").write_text("0.000000000 images/frame_00000000.png\n")
+    (tmp_path / "events.txt").write_text("0.1 239 179 0\n")
+    got, meta = read_events(tmp_path / "events.txt")
+    assert (meta.width, meta.height) == (240, 180) and dvs(got) == [(100_000, 239, 179, -1)]
+    with pytest.raises(EvclustError) as err:
+        read_events(tmp_path / "events.txt", sensor_size=(346, 260))
+    one_line(err, "--sensor-size 346x260 disagrees with the file's 240x180")
+    (tmp_path / "images" / "frame_00000000.png").write_bytes(b"not a picture")
+    with pytest.raises(EvclustError) as err:
+        read_events(tmp_path / "events.txt")
+    one_line(err, "frame_00000000.png", "not a readable image", "--sensor-size")
+    (tmp_path / "bad.csv").write_text("t,x@wide,y,p\n1,2,3,1\n")
+    with pytest.raises(EvclustError) as err:
+        read_events(tmp_path / "bad.csv", sensor_size=(8, 8))
+    one_line(err, "bad.csv", "'x@wide'", "not a whole number")
+
+
 @pytest.mark.parametrize(
     "name, content, options, fragments",
     [

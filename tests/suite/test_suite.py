@@ -26,21 +26,25 @@ def test_generalize_writes_the_page_for_a_few_scenes(tmp_path, capsys):
     # (the defaults' objects, the paper's clusters), then every one's cluster records.
     def overall(title):
         table = text.split(f"## Overall: {title}")[1].split("\n## ")[0]
-        rows = [line for line in table.splitlines() if re.match(r"\| (default|paper) \| (float|fixed) \|", line)]
+        rows = [
+            line for line in table.splitlines() if re.match(r"\| (default|default, frame period withheld|paper) \| (float|fixed) \|", line)
+        ]
         return [[cell.strip() for cell in r.split("|")[1:4]] for r in rows]
 
     assert overall("what each configuration reports") == [
         ["default", "float", "objects"],
         ["default", "fixed", "objects"],
+        ["default, frame period withheld", "float", "objects"],
         ["paper", "float", "clusters"],
     ]
     assert overall("cluster records") == [
         ["default", "float", "clusters"],
         ["default", "fixed", "clusters"],
+        ["default, frame period withheld", "float", "clusters"],
         ["paper", "float", "clusters"],
     ]
     for section in ("## Targets", "## By category: default, float model, objects", "## By category: default, float model, its cluster records",
-                    "## Per scene", "## Typical failures", "## Commands", "## Fixed against float"):  # fmt: skip
+                    "## Per scene", "## Typical failures", "## Commands", "## Fixed against float", "## Frame period withheld"):  # fmt: skip
         assert section in text
     assert all(f"gen_{s}" in text for s in SMALL_TEST_SEEDS)
     assert (tmp_path / "img" / "g_failures.png").stat().st_size > 10_000

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from evclust.choices import TRACK_MODELS
+from evclust.choices import FRAMELESS_PERIOD_US, TRACK_MODELS
 from evclust.cli.common import EVENT_FILES, add_event_file_options, preset_list
 
 
@@ -35,7 +35,8 @@ def add_parser(sub) -> None:
         "--frame-us",
         type=float,
         metavar="US",
-        help="frame period in µs, the unit of the velocities (default: the event file's; camera recordings have none)",
+        help=f"frame period in µs, the unit of the velocities (default: the event file's; a file without one, such as a camera "
+        f"recording, is tracked at {FRAMELESS_PERIOD_US:,.0f} µs)",
     )
     p.add_argument(
         "--clusters", action="store_true", help="write the cluster records (the event-rate clusterer's output) instead of the objects"
@@ -59,7 +60,7 @@ def run(args) -> int:
     import dataclasses
 
     from evclust.clusterer import load_params
-    from evclust.run import prepare_run, track_stream
+    from evclust.run.track import frameless, prepare_run, track_stream
     from evclust.errors import EvclustError
     from evclust.simulator.source import open_events
     from evclust.tracks import track_writer
@@ -94,12 +95,31 @@ def run(args) -> int:
         if thinner:
             thinner.close()
     times = params.times(out_meta.t_frame_us)
+    if frameless(meta, params):
+        fps = 1e6 / FRAMELESS_PERIOD_US
+        times += (f"; no frame period in the file: the time constants are taken at {FRAMELESS_PERIOD_US:,.0f} µs "
+                  f"({fps:g} fps, --frame-us to choose), velocities are in px per {FRAMELESS_PERIOD_US / 1e3:g} ms: x{fps:g} for px/s")  # fmt: skip
     kind = "object" if objects else "cluster"
     written = f"; {writer.count} {kind} records written" + (f", one per {kind} per frame" if per_frame else "")
     print(f"{args.events}: parameters from {origin}{note} ({times}); {result.summary()}{written}")
+    print(_time_line(result))
     if args.ranges:
         print_ranges(result.clusterer)
     return 0
+
+
+def _time_line(result) -> str:
+    """Where the command's time went, so that a short file's wall time is not read as the tracker's
+    speed: the compiled code's start-up and the event loop apart from the rest."""
+    import time
+
+    from evclust import STARTED
+
+    total = time.perf_counter() - STARTED
+    ready = result.startup.seconds if result.startup else 0.0
+    parts = [f"compiled code {ready:.2f} s"] if result.startup else []
+    parts += [f"event loop {result.wall_s:.2f} s", f"the rest (imports, opening and writing files) {total - ready - result.wall_s:.2f} s"]
+    return f"time: {total:.2f} s since evclust was imported: " + ", ".join(parts)
 
 
 def print_ranges(clusterer) -> None:

@@ -7,7 +7,9 @@
   column has the exact name); other columns are ignored. Time: `t`, `ts`, `timestamp` or `t_us` in whole µs, or `t_s` in seconds.
   Coordinates: `x`, `y`. Polarity: `p`, `pol`, `polarity` or `on`.
 
-Neither carries the sensor size: the reader is given it (`track --sensor-size WxH`). Polarity
+The sensor size comes from the file where it can: a CSV whose coordinate columns are named
+`x@W` and `y@H` (faery's layout), or an `events.txt` with the dataset's `images.txt` and frames
+beside it (the first frame's size). Otherwise the reader is given it (`track --sensor-size WxH`). Polarity
 values are read by `POLARITY` conventions: `auto` takes 1 as ON and 0 or -1 as OFF; `01` takes
 only 0/1, `pm1` only -1/+1. Any other value, a garbled line, a negative time or a coordinate
 outside the sensor is refused in one line naming the file's line number. Written files use p 0/1,
@@ -64,7 +66,17 @@ class TextFormat:
                         break
         except UnicodeDecodeError:
             raise EvclustError(f"{path}: not a text file (bytes that are not UTF-8 in its first lines)") from None
-        names = [name.strip() for name in header.strip().split(",")]
+        names, self.size = [], {}
+        for column in header.strip().split(","):
+            # faery writes the sensor size into the coordinate columns' names: `x@320,y@240`.
+            name, at, size = column.strip().partition("@")
+            names.append(name.strip())
+            if at and name.strip().lower() in ("x", "y"):
+                if not size.strip().isdigit() or int(size) < 1:
+                    raise EvclustError(
+                        f"{path}: line {self.header_lines}: column {column.strip()!r}: the size after '@' is not a whole number"
+                    )
+                self.size[name.strip().lower()] = int(size)
         found = {}
         for field, accepted in CSV_NAMES.items():
             # Exact names first: a colour file's luma column `Y` is not its row `y`.
@@ -90,8 +102,33 @@ class TextFormat:
 
 
 def text_header(path: Path, kind: str) -> tuple[dict, None]:
-    TextFormat(path, kind)  # refuses a CSV header without the four columns now
-    return {"source": path.stem, "has_colour": False}, None
+    form = TextFormat(path, kind)  # refuses a CSV header without the four columns now
+    meta = {"source": path.stem, "has_colour": False}
+    if kind == "csv" and {"x", "y"} <= form.size.keys():
+        meta.update(width=form.size["x"], height=form.size["y"])
+    elif kind == "ecd":
+        meta.update(_frame_size(path))
+    return meta, None
+
+
+def _frame_size(path: Path) -> dict:
+    """The Event Camera Dataset keeps the camera's frames beside `events.txt`, listed in
+    `images.txt` (`t images/frame_….png`): the first frame's size is the sensor's. Nothing when
+    there is no such list or frame (the reader then needs --sensor-size)."""
+    listing = path.with_name("images.txt")
+    if not listing.is_file():
+        return {}
+    with open(listing, encoding="utf-8", errors="replace") as f:
+        first = next((line.split() for line in f if line.strip() and not line.lstrip().startswith("#")), [])
+    frame = path.parent / first[1] if len(first) == 2 else None
+    if frame is None or not frame.is_file():
+        return {}
+    import cv2
+
+    image = cv2.imread(str(frame), cv2.IMREAD_UNCHANGED)
+    if image is None:
+        raise EvclustError(f"{frame}: the first frame {listing.name} lists is not a readable image; give the size with --sensor-size WxH")
+    return {"width": int(image.shape[1]), "height": int(image.shape[0])}
 
 
 def text_chunks(path: Path, kind: str, meta: EventMeta, polarity: str = "auto", size: int = LINES) -> Iterator[np.ndarray]:

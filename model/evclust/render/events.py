@@ -15,6 +15,8 @@ from evclust.colour import ycbcr_to_rgb
 from evclust.errors import EvclustError, atomic_output
 from evclust.events.format import EventMeta
 
+MAX_BINS = 2000  # of the event-rate histogram
+
 
 def _window(ev: np.ndarray, meta: EventMeta, t0_us: float | None, span_us: float | None) -> np.ndarray:
     if ev.size == 0:
@@ -61,16 +63,19 @@ def draw_events(ev: np.ndarray, meta: EventMeta, path: str | Path, t0_us: float 
         ax.set_ylabel("y (px)")
     ax = fig.add_subplot(grid[1, :])
     if ev.size:
-        frame = meta.t_frame_us or 33333.0
-        bins = np.arange(0, int(ev["t"][-1]) + frame, frame)
+        # From the first event, not from 0: a camera's clock may start anywhere (a DAVIS writes
+        # Unix time). At most MAX_BINS bins: a longer stream gets wider ones.
+        first, last = int(ev["t"][0]), int(ev["t"][-1])
+        frame = max(meta.t_frame_us or 33333.0, (last - first + 1) / MAX_BINS)
+        bins = first + np.arange(0, last - first + 2 * frame, frame)
         for sign, name, colour_ in ((1, "ON", "tab:red"), (-1, "OFF", "tab:blue")):
             sel = ev["p"] == sign
             ax.hist(ev["t"][sel] / 1e6, bins=bins / 1e6, histtype="step", color=colour_, label=name)
         if win.size:
             ax.axvspan(int(win["t"][0]) / 1e6, int(win["t"][-1]) / 1e6, color="0.85", zorder=0, label="window above")
         ax.legend(loc="upper right", fontsize=8)
+        ax.set_ylabel("events per frame" if frame == (meta.t_frame_us or 33333.0) else f"events per {frame / 1e3:.4g} ms")
     ax.set_xlabel("time (s)")
-    ax.set_ylabel("events per frame")
     fig.suptitle(f"{meta.source or 'events'}: {ev.size} events, {meta.width}x{meta.height}", fontsize=12)
     with atomic_output(path) as tmp:
         fig.savefig(tmp, dpi=90, format=Path(path).suffix.lstrip(".") or "png")

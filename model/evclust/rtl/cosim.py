@@ -19,7 +19,8 @@ from filelock import FileLock
 
 from evclust.choices import SIMULATORS
 from evclust.errors import EvclustError
-from evclust.rtl.sources import BUILD, IN_CHECKOUT, REPO, RTL_DIR, RTL_INCLUDES, RTL_SOURCES, TB_DIR, require_rtl
+from evclust.paths import BUILD, IN_CHECKOUT, REPO
+from evclust.rtl.sources import RTL_DIR, RTL_INCLUDES, RTL_SOURCES, TB_DIR, require_rtl
 
 INCLUDES = tuple(RTL_DIR / name for name in RTL_INCLUDES)
 TOPLEVEL = "evclust_tb"

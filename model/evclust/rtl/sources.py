@@ -5,22 +5,18 @@ Two places hold the RTL, looked for in this order:
   rtl/ and tb/evclust_core/evclust_tb.v there, keeping their layout);
 - the repository that holds this package (an editable install, `pip install -e .`), whose rtl/ is
   read directly, so an edit there is seen without reinstalling.
-The builds (co-simulation, streams, synthesis) go to $EVCLUST_BUILD_DIR if set, else to the
-repository's build/ in a checkout. An installed wheel's package folder may be read-only, so its
-builds go to the user's cache folder ($XDG_CACHE_HOME/evclust, by default ~/.cache/evclust), or
-to ./build when that cannot be made.
+The builds (co-simulation, streams, synthesis) go to evclust.paths.BUILD: $EVCLUST_BUILD_DIR,
+the checkout's build/, or the user's cache folder.
 """
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
 from evclust.errors import EvclustError
+from evclust.paths import IN_CHECKOUT, REPO
 
 PACKAGED = Path(__file__).resolve().parent / "hdl"  # a wheel's copy (setup.py)
-REPO = Path(__file__).resolve().parents[3]  # the checkout of an editable install (model/evclust/rtl/ in it)
-IN_CHECKOUT = (REPO / "rtl").is_dir() and (REPO / "model" / "evclust" / "rtl").is_dir()
 # The wheel's copy first, else the checkout's; neither: require_rtl says so.
 HDL_ROOT = PACKAGED if (PACKAGED / "rtl").is_dir() or not IN_CHECKOUT else REPO
 RTL_DIR = HDL_ROOT / "rtl"
@@ -44,28 +40,6 @@ RTL_SOURCES = (
     "evclust_stage_reg.v",
 )
 RTL_INCLUDES = ("evclust_arith.vh", "evclust_increments.vh", "evclust_require.vh")
-
-
-def _can_make(folder: Path) -> bool:
-    """Whether `folder` exists as a writable folder or could be made (its nearest existing ancestor
-    is a writable folder); nothing is created."""
-    for path in (folder, *folder.parents):
-        if path.exists():
-            return path.is_dir() and os.access(path, os.W_OK | os.X_OK)
-    return False
-
-
-def _build_root() -> Path:
-    if os.environ.get("EVCLUST_BUILD_DIR"):
-        return Path(os.environ["EVCLUST_BUILD_DIR"]).resolve()
-    if IN_CHECKOUT:
-        return REPO / "build"
-    cache = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
-    user = Path(cache).resolve() / "evclust"
-    return user if _can_make(user) else Path("build").resolve()
-
-
-BUILD = _build_root()
 
 
 def require_rtl() -> None:

@@ -13,7 +13,8 @@ import numpy as np
 from evclust.clusterer import ClustererParams
 from evclust.errors import atomic_output
 from evclust.rtl.cosim import run
-from evclust.rtl.sources import BUILD, params_header, require_rtl
+from evclust.paths import BUILD
+from evclust.rtl.sources import params_header, require_rtl
 
 
 @dataclasses.dataclass(frozen=True)

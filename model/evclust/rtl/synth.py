@@ -26,7 +26,8 @@ import time
 from pathlib import Path
 
 from evclust.errors import EvclustError
-from evclust.rtl.sources import BUILD, REPO, RTL_DIR, RTL_INCLUDES, RTL_SOURCES, require_repository
+from evclust.paths import BUILD, REPO
+from evclust.rtl.sources import RTL_DIR, RTL_INCLUDES, RTL_SOURCES, require_repository
 
 TOP = "evclust_core"
 # -noiopad: the core is an IP block inside a larger design (its record port alone is

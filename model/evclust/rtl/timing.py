@@ -23,7 +23,8 @@ from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
 
 from evclust.errors import EvclustError
-from evclust.rtl.sources import BUILD, REPO, RTL_SOURCES, require_repository
+from evclust.paths import BUILD, REPO
+from evclust.rtl.sources import RTL_SOURCES, require_repository
 from evclust.rtl.synth import ABC9_KNOBS, last_step, rtl_snapshot, run_tool, stage_sources, yowasp_command
 
 TOP = "evclust_core"

@@ -11,15 +11,33 @@ from collections.abc import Callable, Iterable
 import numpy as np
 from tqdm import tqdm
 
-from evclust.choices import TRACK_MODELS
+from evclust.choices import FRAMELESS_PERIOD_US, TRACK_MODELS
 from evclust.clusterer.params import ClustererParams
 from evclust.clusterer.run import FloatClusterer, records_to_tracks, rows_to_records
 from evclust.errors import EvclustError
-from evclust.events import EventMeta
-from evclust.tracks import OBJECT_DTYPE, TRACK_DTYPE, TrackMeta
+from evclust.events import EVENT_DTYPE, EventMeta
+from evclust.jit import compiled_code
+from evclust.tracks import OBJECT_DTYPE, TRACK_DTYPE, VELOCITY_METHODS, TrackMeta
 
 CHUNK = 1 << 18  # events per compiled call: the progress bar's granularity
 STEPS_PER_FEED = 1 << 12  # filter steps per object-layer call in rerun_objects (its output buffer is per step)
+
+
+@dataclasses.dataclass(frozen=True)
+class Startup:
+    """What a run spent before its first event: making the model's compiled loops ready."""
+
+    seconds: float
+    loaded: int  # specialisations taken from numba's disk cache
+    compiled: int  # ... and compiled (a first run, or a changed source)
+
+    def describe(self) -> str:
+        how = (
+            f"{self.compiled} compiled, {self.loaded} loaded from numba's cache"
+            if self.compiled
+            else f"loaded from numba's cache ({self.loaded})"
+        )
+        return f"compiled code ready in {self.seconds:.2f} s ({how})"
 
 
 @dataclasses.dataclass
@@ -32,6 +50,7 @@ class TrackRun:
     objects: np.ndarray | None = None  # object records (None: no object layer, or they went to a sink)
     object_meta: TrackMeta | None = None  # their metadata (None: no object layer)
     step_times: np.ndarray | None = None  # every filter step's time, records or not (None: records went to a sink)
+    startup: Startup | None = None  # the compiled loops made ready, apart from wall_s (None: the RTL)
 
     @property
     def output(self) -> tuple[np.ndarray, TrackMeta]:
@@ -49,7 +68,7 @@ class TrackRun:
         return (
             f"{s['events']} events, {s['steps']} filter steps, {s['records']} cluster records{objects}, "
             f"{s['created']} clusters created ({s['evicted']} by eviction), {s['dropped']} events dropped, "
-            f"wall time {self.wall_s:.2f} s, {rate / 1e6:.2f} Mevents/s"
+            f"event loop {self.wall_s:.2f} s, {rate / 1e6:.2f} Mevents/s" + (f"; {self.startup.describe()}" if self.startup else "")
         )
 
 
@@ -99,15 +118,36 @@ def track_meta(params: ClustererParams, meta: EventMeta, model: str, t_frame_us:
     )
 
 
+def frameless(meta: EventMeta, params: ClustererParams) -> bool:
+    """Whether a run on this stream takes its time constants at FRAMELESS_PERIOD_US."""
+    return not (params.t_frame_us or meta.t_frame_us)
+
+
+def at_frame_period(run: TrackRun, t_frame_us: float) -> TrackRun:
+    """The run's records with their velocities in px per `t_frame_us` instead of per the run's own
+    frame period, and their metadata saying so: a frameless run scored against a truth in px per
+    frame of the scene."""
+    scale = t_frame_us / run.meta.t_frame_us
+
+    def convert(records, meta):
+        if records is None or meta is None:
+            return records, meta
+        records = records.copy()
+        for _, vx, vy in VELOCITY_METHODS[meta.kind]:
+            records[vx] *= scale
+            records[vy] *= scale
+        return records, dataclasses.replace(meta, t_frame_us=float(t_frame_us))
+
+    tracks, meta = convert(run.tracks, run.meta)
+    objects, object_meta = convert(run.objects, run.object_meta)
+    return dataclasses.replace(run, tracks=tracks, meta=meta, objects=objects, object_meta=object_meta)
+
+
 def prepare_run(meta: EventMeta, params: ClustererParams, model: str) -> tuple[ClustererParams, TrackMeta]:
     """Check the model and the frame period; resolve the parameters; the track file's metadata."""
     if model not in MODELS:
         raise EvclustError(f"unknown model '{model}' (available: {', '.join(MODELS)})")
-    t_frame_us = params.t_frame_us or meta.t_frame_us
-    if not t_frame_us:
-        raise EvclustError(
-            f"{meta.source or 'events'}: no frame period (velocities are in px/frame): give --frame-us or set clusterer.t_frame_us"
-        )
+    t_frame_us = params.t_frame_us or meta.t_frame_us or FRAMELESS_PERIOD_US
     params = params.resolved(float(t_frame_us))
     return params, track_meta(params, meta, model, float(t_frame_us))
 
@@ -132,6 +172,7 @@ def track_stream(
     clusterer = MODELS[model](params, meta.width, meta.height, out_meta.t_frame_us, out_meta.has_colour, **options)
     layer = _object_layer(clusterer, params, model, meta.width, meta.height, out_meta.t_frame_us)
     object_meta = dataclasses.replace(out_meta, kind="objects") if layer is not None else None
+    startup = _ready(clusterer, layer) if model in ("float", "fixed") else None
     start = time.perf_counter()
     kept, kept_objects, kept_steps, n_records, n_objects = [], [], [], 0, 0
     with tqdm(total=total, unit="ev", unit_scale=True, disable=None if progress else True, desc=f"track ({model})") as bar:
@@ -164,7 +205,19 @@ def track_stream(
     if layer is not None:
         stats |= layer.stats() | {"object_records": n_objects}
     step_times = None if sink is not None else (np.concatenate(kept_steps) if kept_steps else np.zeros(0))
-    return TrackRun(tracks, out_meta, stats, wall, clusterer, objects, object_meta, step_times)
+    return TrackRun(tracks, out_meta, stats, wall, clusterer, objects, object_meta, step_times, startup)
+
+
+def _ready(clusterer, layer) -> Startup:
+    """Feed the model, and its object layer, nothing: numba compiles their loops, or loads them
+    from its cache, here, so that the event loop's time is the loop's own (a short recording
+    would otherwise read as a slow tracker). An empty feed changes no state."""
+    before, start = compiled_code(), time.perf_counter()
+    rows = clusterer.feed(np.zeros(0, EVENT_DTYPE))
+    if layer is not None:
+        layer.feed(rows, clusterer.steps)
+    loaded, compiled = (now - then for now, then in zip(compiled_code(), before))
+    return Startup(time.perf_counter() - start, loaded, compiled)
 
 
 def rerun_objects(run: TrackRun, params: ClustererParams) -> TrackRun:

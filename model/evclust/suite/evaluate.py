@@ -11,6 +11,8 @@ import numpy as np
 from evclust.clusterer import ClustererParams
 from evclust.run import track_events
 from evclust.run import rerun_objects
+from evclust.run.track import at_frame_period
+from evclust.errors import EvclustError
 from evclust.events import read_events
 from evclust.metrics import tracking
 from evclust.scenes.truth import read_truth
@@ -51,13 +53,15 @@ def _cluster_key(name: str, params: ClustererParams) -> tuple[str, str]:
 
 
 def evaluate_scene(files: SceneFiles, params: ClustererParams, model: str = "float", cache: dict | None = None,
-                   trackeval: bool = True, cluster_runs: dict | None = None) -> SceneResult:  # fmt: skip
+                   trackeval: bool = True, cluster_runs: dict | None = None, withhold_frame: bool = False) -> SceneResult:  # fmt: skip
     """Track one scene and score what the run reports (its object records when the parameters
     have an object layer; its cluster records, scored too, in `.clusters`). `cache` (a dict)
     keeps the scene's events and truth for the next call in this process; trackeval=False skips
     HOTA/MOTA/IDF1 (a tuning loop's speed). `cluster_runs` (a dict; float model) keeps each
     scene's cluster run per cluster parameter set, so that a call that changes only the object
-    layer's parameters runs the object layer alone."""
+    layer's parameters runs the object layer alone. `withhold_frame`: the tracker is not told the
+    scene's frame period (a camera's stream has none, evclust.choices.FRAMELESS_PERIOD_US), and its
+    velocities are scored converted to px per frame of the scene."""
     if cache is not None and files.name in cache:
         events, meta, truth = cache[files.name]
     else:
@@ -70,6 +74,11 @@ def evaluate_scene(files: SceneFiles, params: ClustererParams, model: str = "flo
         if key not in cluster_runs:
             cluster_runs[key] = track_events(events, meta, params.model_copy(update={"objects": False}), model=model)
         run = rerun_objects(cluster_runs[key], params)
+    elif withhold_frame:
+        if params.t_frame_us:
+            raise EvclustError("withhold_frame: these parameters set t_frame_us themselves")
+        run = track_events(events, dataclasses.replace(meta, t_frame_us=None), params, model=model)
+        run = at_frame_period(run, meta.t_frame_us)
     else:
         run = track_events(events, meta, params, model=model)
     wall = time.perf_counter() - start

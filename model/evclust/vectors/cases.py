@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
+from evclust.choices import FRAMELESS_PERIOD_US
 from evclust.clusterer import ClustererParams, PaletteEntry, load_params
 from evclust.events import EVENT_DTYPE
 from evclust.scenes import load_scene
@@ -466,9 +467,7 @@ def file_case(path: str | Path, max_events: int, params: ClustererParams, t_fram
             f"{path}: DVS-only events (no colour): the RTL is built with the colour datapath, so its vectors need "
             "colour events; track the file with the float or fixed model instead"
         )
-    t_frame_us = t_frame_us or params.t_frame_us or meta.t_frame_us
-    if not t_frame_us:
-        raise EvclustError(f"{path}: no frame period (velocities are in px/frame): give --frame-us")
+    t_frame_us = t_frame_us or params.t_frame_us or meta.t_frame_us or FRAMELESS_PERIOD_US  # as `track` takes it
     pieces, n = [], 0
     for chunk in reader.chunks():
         pieces.append(chunk[: max_events - n])
