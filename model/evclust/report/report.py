@@ -330,7 +330,7 @@ def hardware_section(results, img: Path, scene_names: list[str], quick: bool) ->
     ]
     synthesised = [r for r in results if isinstance(r.area, dict)]
     if quick or not synthesised:
-        why = "`--quick` skips Yosys and the guard-bit rows; `make report` runs both" if quick else "every Yosys run failed"
+        why = "`--quick` skips Yosys, the guard-bit rows and N = 8; `make report` runs them all" if quick else "every Yosys run failed"
         lines += [f"Area: not synthesised in this run ({why}).", ""]
     else:
         figures.area_against_accuracy(
