@@ -21,7 +21,7 @@ from pathlib import Path
 
 from evclust.clusterer import ClustererParams
 from evclust.errors import EvclustError
-from evclust.rtl.sources import BUILD
+from evclust.paths import BUILD
 from evclust.rtl.sources import params_header as rtl_header
 from evclust.rtl.synth import rtl_snapshot, synthesise
 

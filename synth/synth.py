@@ -17,7 +17,8 @@ from pathlib import Path
 
 from evclust.clusterer import load_params
 from evclust.errors import EvclustError
-from evclust.rtl.sources import BUILD, RTL_DIR
+from evclust.paths import BUILD
+from evclust.rtl.sources import RTL_DIR
 from evclust.rtl.sources import params_header as rtl_header
 from evclust.rtl.synth import ABC9_KNOBS, rtl_snapshot, synthesise
 

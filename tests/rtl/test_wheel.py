@@ -137,7 +137,7 @@ def test_the_wheel_carries_the_rtl_and_the_testbench_top(wheel):
 
 def test_the_installed_wheel_runs_the_rtl_from_outside_the_checkout(venv, outside):
     site = _purelib(venv / "bin" / "python")
-    probe = "import evclust; from evclust.rtl.sources import BUILD, RTL_DIR, TB_DIR as TB; print(evclust.__file__, RTL_DIR, TB, BUILD, sep=chr(10))"
+    probe = "import evclust; from evclust.paths import BUILD; from evclust.rtl.sources import RTL_DIR, TB_DIR as TB; print(evclust.__file__, RTL_DIR, TB, BUILD, sep=chr(10))"
     where = subprocess.run([str(venv / "bin" / "python"), "-c", probe], cwd=outside, env=_env(), capture_output=True, text=True)
     assert where.returncode == 0, where.stderr
     package, rtl, tb, build = (Path(line) for line in where.stdout.splitlines())
