@@ -109,7 +109,7 @@ def _sha256(path: Path) -> str:
 
 
 def present(recording: Recording) -> bool:
-    """Every member is there (checked by size and name; `fetch` checked the digests when it wrote them)."""
+    """Every member is there (by name only: `fetch` checked the digests when it wrote them)."""
     return all((recording.folder / _local(recording, m)).is_file() for m in recording.members)
 
 
