@@ -186,7 +186,7 @@ demo-video: $(STAMP) $(VTEST)
 # reach), alternately on the same frames: docs/BENCHMARKS.md.
 bench-peers: $(STAMP) $(VTEST)
 	bash bench/build_peers.sh $(BUILD)/peers $(PY)
-	PYTHONPATH=$(BUILD)/peers/esim_py $(PY) bench/peers.py --write docs/BENCHMARKS.md
+	$(PY) bench/peers.py --write docs/BENCHMARKS.md
 
 # The vtest.avi section of docs/RESULTS.md: the demo's path timed, and what each sensor effect and
 # the table size do to the event count and the tracking figures (about 3 minutes).

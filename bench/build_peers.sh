@@ -4,8 +4,9 @@
 #   (a checkout of rpg_vid2e) if set, else a clone from GitHub. Needs Debian's libopencv-dev,
 #   libeigen3-dev, libboost-filesystem-dev and cmake; pybind11 comes from PyPI.
 # - v2e's emulator (SensorsINI/v2e, its v2ecore package) into $1/src/v2e, with its own environment
-#   $1/v2e-venv (CPU torch from PyPI, about 6 GB). Sources: $V2E_SRC (a checkout) if set, else a
-#   clone from GitHub.
+#   $1/v2e-venv on Debian's Python and Debian's CPU-only torch (python3-torch 1.13): PyPI's Linux
+#   torch is the CUDA build, several GB of NVIDIA libraries this benchmark never uses. Sources:
+#   $V2E_SRC (a checkout) if set, else a clone from GitHub.
 set -euo pipefail
 out="$1"
 python="$2"
@@ -18,9 +19,15 @@ build_v2e() {
     git clone --depth 1 https://github.com/SensorsINI/v2e "$out/src/v2e" 2>/dev/null \
       || { echo "evclust: cannot clone github.com/SensorsINI/v2e; set V2E_SRC to a checkout of it" >&2; exit 2; }
   fi
-  python3 -m venv "$out/v2e-venv"
-  "$out/v2e-venv/bin/pip" install --quiet torch numpy opencv-python-headless h5py screeninfo tqdm scipy \
-    engineering-notation easygui numba dv-processing
+  local debian="python3-torch python3-opencv python3-h5py python3-numba python3-tk python3-scipy python3-tqdm"
+  for pkg in $debian; do
+    dpkg -s "$pkg" >/dev/null 2>&1 || { echo "evclust: bench-peers needs Debian's $pkg for v2e: apt-get install $debian" >&2; exit 2; }
+  done
+  /usr/bin/python3 -m venv --system-site-packages "$out/v2e-venv"
+  # --no-deps: what these need is Debian's already; pip would otherwise pull a numpy that torch 1.13 was not built for.
+  "$out/v2e-venv/bin/pip" install --quiet --no-deps screeninfo engineering-notation easygui dv-processing
+  "$out/v2e-venv/bin/python" -c "import torch; assert not torch.cuda.is_available()" \
+    || { echo "evclust: the v2e environment's torch does not import" >&2; exit 2; }
   touch "$out/v2e-venv/done"
 }
 build_v2e

@@ -15,6 +15,7 @@ import numpy as np
 from evclust import limits
 from evclust.errors import EvclustError
 from evclust.events.format import MAX_SENSOR_SIDE
+from evclust.threads import worker_threads
 
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".webp", ".ppm", ".pgm")
 
@@ -22,8 +23,8 @@ IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".webp", ".p
 def _decoded_ahead(load, n: int, ahead: int = 4):
     """load(0), load(1), ... in order, up to `ahead` decoded at once on threads: images are
     independent files and OpenCV decodes without the GIL, so a folder reads at the speed of all
-    cores. The window bounds the memory."""
-    workers = min(ahead, os.cpu_count() or 1)
+    cores (EVCLUST_THREADS of them). The window bounds the memory."""
+    workers = min(ahead, worker_threads())
     if workers < 2:
         yield from (load(k) for k in range(n))
         return

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import dataclasses
-import os
 import queue
 import contextlib
 import threading
@@ -20,6 +19,7 @@ from evclust.events.format import EventMeta, concat_events, sort_events
 from evclust.scenes.schema import SensorSpec
 from evclust.simulator.effects import Effect, Interval, SensorGeometry
 from evclust.simulator.kernel import EventBuffer, detect_interval
+from evclust.threads import worker_threads
 
 
 @dataclasses.dataclass
@@ -102,7 +102,7 @@ class Simulator:
             self.th_off = np.array([sensor.threshold_off], dtype=np.float64)
             self.th_stride = 0
         n_pixels = geometry.width * geometry.height
-        threads = threads or int(os.environ.get("EVCLUST_THREADS", 0)) or os.cpu_count() or 1
+        threads = threads or worker_threads()
         # Bands of whole rows, one per thread; a frame too small to be worth splitting stays whole.
         n_bands = max(1, min(threads, geometry.height, n_pixels // (1 << 15)))
         self._set_bands(np.linspace(0, geometry.height, n_bands + 1).round().astype(int))
