@@ -93,6 +93,48 @@ def detect_interval(l0, l1, rgb0, rgb1, ref, th_on, th_off, th_stride, width, t0
     return n, l0.size
 
 
+@njit(cache=True, nogil=True, boundscheck=False)
+def _time_ordered_words(words, keys, starts, counts, out):
+    """Write the packed records of the buffer parts (starts[p], counts[p]) into `out` in key order.
+
+    A key is (t - floor(t0)) << 32 | buffer index, so key order is time order, ties in buffer
+    (= emission) order. A stable counting sort on the time offset gives exactly that in two
+    passes; an interval so long that its histogram would outweigh its events sorts the keys."""
+    total = 0
+    top = np.uint64(0)
+    for p in range(starts.size):
+        total += counts[p]
+        for j in range(starts[p], starts[p] + counts[p]):
+            top = max(top, keys[j] >> np.uint64(32))
+    bins = np.int64(top) + 1
+    if bins > 4 * total + 65536:
+        chosen = np.empty(total, np.uint64)
+        k = 0
+        for p in range(starts.size):
+            for j in range(starts[p], starts[p] + counts[p]):
+                chosen[k] = keys[j]
+                k += 1
+        chosen.sort()
+        for k in range(total):
+            j = np.int64(chosen[k] & np.uint64(0xFFFFFFFF))
+            out[2 * k] = words[2 * j]
+            out[2 * k + 1] = words[2 * j + 1]
+        return
+    next_slot = np.zeros(bins + 1, np.int64)  # events before each time offset, then where the next goes
+    for p in range(starts.size):
+        for j in range(starts[p], starts[p] + counts[p]):
+            next_slot[np.int64(keys[j] >> np.uint64(32)) + 1] += 1
+    for b in range(bins):
+        next_slot[b + 1] += next_slot[b]
+    for p in range(starts.size):
+        for j in range(starts[p], starts[p] + counts[p]):
+            b = np.int64(keys[j] >> np.uint64(32))
+            k = next_slot[b]
+            next_slot[b] = k + 1
+            out[2 * k] = words[2 * j]
+            out[2 * k + 1] = words[2 * j + 1]
+
+
 class EventBuffer:
     """Room for the events of one call of detect_interval, and their sort keys."""
 
@@ -100,15 +142,13 @@ class EventBuffer:
         self.words = np.empty(2 * capacity, np.uint64)
         self.keys = np.empty(capacity, np.uint64)
 
-    def time_ordered(self, parts: list[tuple[int, int]]) -> np.ndarray:
-        """A copy of the events in the (offset, count) parts of the buffer, ordered by time, ties
-        by emission index (= y, then x: parts are in row order and their keys carry the offset).
-
-        The keys are unique, so a plain (SIMD) sort of them gives the permutation."""
-        keys = (
-            self.keys[parts[0][0] : parts[0][0] + parts[0][1]]
-            if len(parts) == 1
-            else np.concatenate([self.keys[o : o + n] for o, n in parts])
-        )
-        order = np.sort(keys) & np.uint64(0xFFFFFFFF)
-        return self.words.view(EVENT_DTYPE)[order.astype(np.intp)]
+    def time_ordered(self, parts: list[tuple[int, int]], out: np.ndarray | None = None) -> np.ndarray:
+        """The events in the (offset, count) parts of the buffer, ordered by time, ties by emission
+        index (= y, then x: parts are in row order and their keys carry the offset), written into
+        `out` (as many events as the parts hold) or a new array."""
+        starts = np.array([o for o, _ in parts], np.int64)
+        counts = np.array([n for _, n in parts], np.int64)
+        if out is None:
+            out = np.empty(int(counts.sum()), EVENT_DTYPE)
+        _time_ordered_words(self.words, self.keys, starts, counts, out.view(np.uint64))
+        return out

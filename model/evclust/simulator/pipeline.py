@@ -15,7 +15,7 @@ from tqdm import tqdm
 
 from evclust.colour import RGB_TO_YCBCR, frame_to_luma
 from evclust.errors import EvclustError
-from evclust.events.format import EventMeta, concat_events, sort_events
+from evclust.events.format import EVENT_DTYPE, EventMeta, concat_events, empty_events, sort_events
 from evclust.scenes.schema import SensorSpec
 from evclust.simulator.effects import Effect, Interval, SensorGeometry
 from evclust.simulator.kernel import EventBuffer, detect_interval
@@ -73,6 +73,37 @@ def _join_at_boundary(previous: np.ndarray, current: np.ndarray) -> None:
     current[:hi] = tied[previous.size - lo :]
 
 
+class _EventArena:
+    """A run's events, written in place interval after interval (`Simulator.run` with no interval or
+    stream effect), so a run makes no array per interval and no copy at the end.
+
+    Room is reserved in large blocks that never move, so every view handed out stays valid; the
+    pages the events never reach are never touched and cost address space only."""
+
+    BLOCK_EVENTS = 1 << 26  # 1 GiB of address space
+
+    def __init__(self):
+        self.blocks: list[np.ndarray] = []
+        self.filled: list[int] = []
+
+    def take(self, n: int) -> np.ndarray:
+        if not self.blocks or self.filled[-1] + n > self.blocks[-1].size:
+            try:
+                self.blocks.append(np.empty(max(n, self.BLOCK_EVENTS), EVENT_DTYPE))
+            except MemoryError:  # strict overcommit: reserve what is needed now, and more later
+                self.blocks.append(np.empty(max(n, 1 << 20), EVENT_DTYPE))
+            self.filled.append(0)
+        start = self.filled[-1]
+        self.filled[-1] += n
+        return self.blocks[-1][start : start + n]
+
+    def events(self) -> np.ndarray:
+        parts = [block[:filled] for block, filled in zip(self.blocks, self.filled)]
+        if not parts:
+            return empty_events()
+        return parts[0] if len(parts) == 1 else concat_events(parts)  # a single block: no copy
+
+
 class Simulator:
     """The sensor model of SPEC §3 with the effects a scene switched on."""
 
@@ -108,10 +139,12 @@ class Simulator:
         self._set_bands(np.linspace(0, geometry.height, n_bands + 1).round().astype(int))
         self.buffer = EventBuffer(max(1 << 16, n_pixels // 2))
         self.pool = ThreadPoolExecutor(len(self.bands)) if len(self.bands) > 1 else None
+        self._arena: _EventArena | None = None
 
     def _observe(self, rgb: np.ndarray, level: np.ndarray) -> np.ndarray:
-        """Fill `level` (flat float32) with the detector input L; return the (H*W, 3) float32 RGB
-        the pixels measure colour from."""
+        """Fill `level` (flat float32) with the detector input L; return the (H*W, 3) RGB the
+        pixels measure colour from: float32, or a decoded frame's own uint8 where nothing else reads
+        it (the detector takes either; a uint8 value is exact in both)."""
         if self.observer is not None:
             intensity, rgb = self.observer.observe(rgb)
         else:
@@ -126,6 +159,8 @@ class Simulator:
             level[:] = intensity
         for effect in self.photoreceptor:
             effect.photoreceptor(level, intensity)
+        if rgb.dtype == np.uint8 and not self.interval_effects:  # interval effects read float32
+            return np.ascontiguousarray(rgb).reshape(-1, 3)
         return np.ascontiguousarray(rgb, dtype=np.float32).reshape(-1, 3)
 
     def _detect(self, l0, l1, rgb0, rgb1, ref, t0_us: float) -> np.ndarray:
@@ -142,19 +177,29 @@ class Simulator:
             return self._kernel(l0, l1, rgb0, rgb1, ref, t0_us, lo, hi, b * share, share)
 
         results = list(self.pool.map(band, range(len(self.bands)))) if self.pool else [band(0)]
-        chunks = [buf.time_ordered([(b * share, n) for b, (n, _) in enumerate(results)])]
-        for b, (_, pixel) in enumerate(results):  # a band that filled its share goes on alone
-            hi = self.bands[b][1]
-            while pixel < hi:
-                n, pixel = self._kernel(l0, l1, rgb0, rgb1, ref, t0_us, pixel, hi, 0, self.buffer.keys.size)
-                if n == 0 and pixel < hi:  # one pixel crosses more levels than the buffer holds
-                    self.buffer = EventBuffer(2 * self.buffer.keys.size)
-                    continue
-                chunks.append(self.buffer.time_ordered([(0, n)]))
-        events = chunks[0] if len(chunks) == 1 else sort_events(concat_events(chunks))  # each chunk is in order, not their union
+        parts = [(b * share, n) for b, (n, _) in enumerate(results)]
+        if all(pixel == hi for (_, pixel), (_, hi) in zip(results, self.bands)):  # every band had room: the usual case
+            events = buf.time_ordered(parts, self._room(sum(n for _, n in parts)))
+        else:
+            chunks = [buf.time_ordered(parts)]
+            for b, (_, pixel) in enumerate(results):  # a band that filled its share goes on alone
+                hi = self.bands[b][1]
+                while pixel < hi:
+                    n, pixel = self._kernel(l0, l1, rgb0, rgb1, ref, t0_us, pixel, hi, 0, self.buffer.keys.size)
+                    if n == 0 and pixel < hi:  # one pixel crosses more levels than the buffer holds
+                        self.buffer = EventBuffer(2 * self.buffer.keys.size)
+                        continue
+                    chunks.append(self.buffer.time_ordered([(0, n)]))
+            joined = sort_events(concat_events(chunks))  # each chunk is in order, not their union
+            events = self._room(joined.size)
+            events[:] = joined
         if self.pool:
             self._balance(events)
         return events
+
+    def _room(self, n: int) -> np.ndarray:
+        """Where the next n ordered events go: the run's arena (`run`), or an array of their own."""
+        return self._arena.take(n) if self._arena is not None else np.empty(n, EVENT_DTYPE)
 
     def _kernel(self, l0, l1, rgb0, rgb1, ref, t0_us, first, end, offset, room) -> tuple[int, int]:
         """Detect pixels first..end-1 into buffer slots offset..offset+room-1: (events, next pixel)."""
@@ -206,7 +251,16 @@ class Simulator:
             frame_period_us: float | None = None) -> Simulation:  # fmt: skip
         """The whole stream in memory: `stream` joined."""
         stream = self.stream(frames, source, total, progress, frame_period_us)
-        events = concat_events(stream)
+        if self.interval_effects or self.stream_effects:  # they make new arrays of their own
+            events = concat_events(stream)
+        else:
+            self._arena = _EventArena()
+            try:
+                for _ in stream:  # each interval is made in place, in order, after the one before
+                    pass
+                events = self._arena.events()
+            finally:
+                self._arena = None
         return Simulation(events, stream.meta, stream.samples, self.geometry.t_sample_us, stream.wall_s)
 
     def _observed(self, frames: Iterable[np.ndarray]):
