@@ -109,7 +109,7 @@ def measure(videos: dict[str, Path], rounds: int, cores: int) -> list[str]:
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--rounds", type=int, default=3)
+    parser.add_argument("--rounds", type=int, default=5)
     parser.add_argument("--write", metavar="MD")
     args = parser.parse_args()
     if not any(ESIM_PATH.glob("esim_py*.so")):

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 from typing import NamedTuple
 
-import cv2
 import numpy as np
 
 
@@ -57,10 +56,15 @@ def ycbcr_to_rgb(ycc: np.ndarray) -> np.ndarray:
 
 def frame_to_luma(rgb: np.ndarray) -> np.ndarray:
     """An (H, W, 3) RGB frame -> (H, W) float32 Y; the only plane the change detector needs.
-    OpenCV's RGB->GRAY weights are BT.601's (0.299, 0.587, 0.114), and it is the fastest path."""
+    OpenCV's RGB->GRAY weights are BT.601's (0.299, 0.587, 0.114), and it is the fastest path.
+    OpenCV is imported here, not with the module: `track` needs the colour tables, not OpenCV."""
+    import cv2
+
     return cv2.cvtColor(np.ascontiguousarray(rgb, dtype=np.float32), cv2.COLOR_RGB2GRAY)
 
 
 def frame_to_ycbcr(rgb: np.ndarray) -> np.ndarray:
     """An (H, W, 3) float32 RGB frame -> (H, W, 3) float32 YCbCr planes; fast path for the simulator."""
+    import cv2
+
     return cv2.transform(np.ascontiguousarray(rgb, dtype=np.float32), RGB_TO_YCBCR.astype(np.float32))
