@@ -141,6 +141,17 @@ def test_console_script_reports_bad_input_without_traceback(tmp_path):
     ]
 
 
+def test_the_console_script_ends_at_once_yet_flushes_all_that_main_printed(capsys):
+    # The script leaves by os._exit (evclust.cli.entry): piped and buffered (PYTHONUNBUFFERED
+    # unset), the end of the output would be lost without the flush.
+    code, out, _ = run_cli(capsys, "formats")
+    exe = __import__("shutil").which("evclust") or str(__import__("pathlib").Path(sys.executable).parent / "evclust")
+    env = {k: v for k, v in __import__("os").environ.items() if k != "PYTHONUNBUFFERED"}
+    result = subprocess.run([exe, "formats"], capture_output=True, text=True, env=env)
+    assert code == 0 and out.startswith("formats for ")
+    assert (result.returncode, result.stdout) == (code, out)
+
+
 def test_a_video_with_a_truth_csv_beside_it_passes_the_truth_through(tmp_path, capsys):
     video = tmp_path / "clip.avi"
     frames = [np.full((24, 32, 3), v, np.uint8) for v in (40, 40, 200)]
