@@ -223,6 +223,25 @@ def test_aedat2_writer_refuses_a_sensor_larger_than_the_dvs128(tmp_path):
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.parametrize(
+    "name, word, what",
+    [("e.dat", 8, "event"), ("e2.raw", 4, "EVT word"), ("e3.raw", 2, "EVT word")],
+)
+def test_a_prophesee_file_cut_inside_a_word_is_refused_in_one_line(tmp_path, name, word, what):
+    # DAT records are 8 bytes, EVT 2.0 words 4, EVT 3.0 words 2 (Prophesee's format pages); a file
+    # whose binary part is not a whole number of them was cut short, however its decoder copes.
+    path = tmp_path / name
+    write_events(path, events(n=300), META, **({} if name == "e.dat" else {"evt_version": "evt2" if name == "e2.raw" else "evt3"}))
+    whole = path.read_bytes()
+    assert read_events(path)[0].size == 300
+    for cut in range(1, word):
+        path.write_bytes(whole[:-cut])
+        with pytest.raises(EvclustError) as err:
+            read_events(path)
+        one_line(err, name, f"ends inside its last {what} ({word - cut} of its {word} bytes)", "truncated")
+        assert path.read_bytes() == whole[:-cut]
+
+
 # ------------------------------------------------------------------------------------------------
 # Text: the Event Camera Dataset's t x y p, and CSV
 

@@ -166,6 +166,33 @@ class AedatWriter:
 # EVT2 / EVT3 (.raw)
 
 
+def _text_header(path: Path) -> tuple[int, list[str]]:
+    """(byte where the binary part starts, the header's lines) of a Prophesee file, whose header is
+    lines of printable text that begin '% '. Binary data that happened to begin the same way would
+    need a whole printable line before a newline, so the end is not mistaken."""
+    with open(path, "rb") as f:
+        head = f.read(1 << 16)
+    start, lines = 0, []
+    while head.startswith(b"% ", start):
+        end = head.find(b"\n", start)
+        line = head[start:end]
+        if end < 0 or not all(0x20 <= b < 0x7F for b in line.rstrip(b"\r")):
+            break
+        lines.append(line.decode().rstrip("\r"))
+        start = end + 1
+    return start, lines
+
+
+def _refuse_a_cut_word(path: Path, payload: int, word: int, what: str) -> None:
+    """A file that ends inside one of its fixed-size words was cut short: refused in one line."""
+    if word and payload % word:
+        raise EvclustError(f"{path}: the file ends inside its last {what} ({payload % word} of its {word} bytes): a truncated file")
+
+
+# Bytes per word of each EVT version, as the header names it ('% evt 3.0', or '% format EVT3').
+_EVT_WORD_BYTES = {"2.0": 4, "2.1": 8, "3.0": 2, "EVT2": 4, "EVT21": 8, "EVT3": 2}
+
+
 def _sized_header(path: Path, decoder_class, version_fallback) -> dict:
     """The metadata of an EVT or DAT file; no width and height when its header has none."""
     try:
@@ -188,7 +215,12 @@ def evt_header(path: Path) -> tuple[dict, None]:
     none (Gen3 and some Gen4 recordings): the reader then asks for --sensor-size."""
     from faery import evt
 
-    return _sized_header(path, evt.Decoder, None), None
+    meta = _sized_header(path, evt.Decoder, None)
+    start, lines = _text_header(path)
+    names = [line.split()[2] for line in lines if len(line.split()) == 3 and line.split()[1] in ("evt", "format")]
+    word = next((_EVT_WORD_BYTES[name] for name in names if name in _EVT_WORD_BYTES), 0)
+    _refuse_a_cut_word(path, path.stat().st_size - start, word, "EVT word")
+    return meta, None
 
 
 def evt_packets(path: Path, sized: bool = True) -> Iterator[np.ndarray]:
@@ -240,6 +272,12 @@ def dat_header(path: Path) -> tuple[dict, int | None]:
         raise _faery_error(path, exc) from None
     if kind != "cd":
         raise EvclustError(f"{path}: a DAT file of {kind} events; only CD (contrast detection) events are read")
+    start, _ = _text_header(path)
+    with open(path, "rb") as f:  # after the text: one byte of event type, one of event size
+        f.seek(start)
+        kind_and_size = f.read(2)
+    if len(kind_and_size) == 2:
+        _refuse_a_cut_word(path, path.stat().st_size - start - 2, kind_and_size[1], "event")
     return meta, None
 
 
