@@ -26,12 +26,7 @@ FRAME_US = 33_333.0  # tracking needs a frame period; real cameras have none (th
 
 @pytest.fixture(params=[r.name for r in RECORDINGS])
 def recording(request):
-    try:
-        return require(request.param)
-    except EvclustError as exc:
-        if os.environ.get("CI"):  # CI fetches them (make test): absent there is a failure, not a skip
-            pytest.fail(str(exc))
-        pytest.skip(str(exc))
+    return _required(request.param)
 
 
 def _canonical(t, x, y, p) -> np.ndarray:
@@ -119,6 +114,30 @@ def test_a_file_without_its_sensor_size_is_refused_in_one_line(tmp_path, capsys)
     code, _, err = run_cli(capsys, "track", str(require("gen3").path), "-o", str(tmp_path / "t.csv"), "--frame-us", "33333", "-q")
     assert code != 0 and "--sensor-size" in err and len(err.strip().splitlines()) == 1
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("name, keep, fragment", [("davis346", 100_001, "not a readable event-camera file"),
+                                                  ("evk4", -1, "truncated"), ("gen3", -1, "truncated"), ("gen4", -1, "truncated")])  # fmt: skip
+def test_a_recording_cut_inside_its_events_is_refused_in_one_line_and_nothing_is_written(tmp_path, capsys, name, keep, fragment):
+    # One byte short ends inside an EVT word or a DAT record; an AEDAT4 file ends in an index
+    # that holds no events, so it is cut inside a packet instead. (An Event Stream or a text file
+    # cut short can still be a valid shorter file, so they are not here.)
+    recording = _required(name)
+    cut = tmp_path / f"cut{recording.path.suffix}"
+    cut.write_bytes(recording.path.read_bytes()[:keep])
+    output = tmp_path / "tracks.csv"
+    code, _, err = run_cli(capsys, "track", str(cut), "-o", str(output), "--frame-us", str(FRAME_US), *_size_args(recording))
+    assert code == 2 and len(err.strip().splitlines()) == 1 and fragment in err, err
+    assert sorted(p.name for p in tmp_path.iterdir()) == [cut.name]
+
+
+def _required(name: str):
+    try:
+        return require(name)
+    except EvclustError as exc:
+        if os.environ.get("CI"):  # CI fetches them (make test): absent there is a failure, not a skip
+            pytest.fail(str(exc))
+        pytest.skip(str(exc))
 
 
 def _size_args(recording) -> list[str]:
