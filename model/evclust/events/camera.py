@@ -29,6 +29,7 @@ META_ATTRIBUTE = "evclustMeta"  # AEDAT4 info-node attribute holding EventMeta a
 # validator, not faery, names the first event outside the size the user gave (--sensor-size).
 NO_SIZE = (65535, 65535)
 DAT_MAX_T = 1 << 32  # DAT stores 32-bit µs timestamps, with no overflow marker
+DAT_CD_TYPE, DAT_CD_BYTES = 0x0C, 8  # the two bytes after a DAT header: CD events of 8 bytes each
 
 
 def faery_dtype() -> np.dtype:
@@ -276,8 +277,8 @@ def dat_header(path: Path) -> tuple[dict, int | None]:
     with open(path, "rb") as f:  # after the text: one byte of event type, one of event size
         f.seek(start)
         kind_and_size = f.read(2)
-    if len(kind_and_size) == 2:
-        _refuse_a_cut_word(path, path.stat().st_size - start - 2, kind_and_size[1], "event")
+    if kind_and_size == bytes([DAT_CD_TYPE, DAT_CD_BYTES]):  # where the header was found to end for sure
+        _refuse_a_cut_word(path, path.stat().st_size - start - 2, DAT_CD_BYTES, "event")
     return meta, None
 
 
