@@ -242,6 +242,19 @@ def test_a_prophesee_file_cut_inside_a_word_is_refused_in_one_line(tmp_path, nam
         assert path.read_bytes() == whole[:-cut]
 
 
+def test_an_evt3_header_naming_its_version_only_in_its_format_line_is_checked_too(tmp_path):
+    # Metavision 4 names the version as '% format EVT3;width=...;height=...' (faery writes that
+    # line beside '% evt 3.0'); without the '% evt' line the word size comes from it.
+    path = tmp_path / "e.raw"
+    write_events(path, events(n=300), META)
+    whole = path.read_bytes()
+    assert b"% format EVT3;" in whole and b"% evt 3.0\n" in whole
+    path.write_bytes(whole.replace(b"% evt 3.0\n", b"", 1)[:-1])
+    with pytest.raises(EvclustError) as err:
+        read_events(path)
+    one_line(err, "e.raw", "ends inside its last EVT word (1 of its 2 bytes)")
+
+
 # ------------------------------------------------------------------------------------------------
 # Text: the Event Camera Dataset's t x y p, and CSV
 

@@ -190,7 +190,7 @@ def _refuse_a_cut_word(path: Path, payload: int, word: int, what: str) -> None:
         raise EvclustError(f"{path}: the file ends inside its last {what} ({payload % word} of its {word} bytes): a truncated file")
 
 
-# Bytes per word of each EVT version, as the header names it ('% evt 3.0', or '% format EVT3').
+# Bytes per word of each EVT version, as the header names it.
 _EVT_WORD_BYTES = {"2.0": 4, "2.1": 8, "3.0": 2, "EVT2": 4, "EVT21": 8, "EVT3": 2}
 
 
@@ -218,7 +218,8 @@ def evt_header(path: Path) -> tuple[dict, None]:
 
     meta = _sized_header(path, evt.Decoder, None)
     start, lines = _text_header(path)
-    names = [line.split()[2] for line in lines if len(line.split()) == 3 and line.split()[1] in ("evt", "format")]
+    # '% evt 3.0', '% format EVT3', or Metavision 4's '% format EVT3;height=720;width=1280'
+    names = [line.split()[2].split(";")[0] for line in lines if len(line.split()) == 3 and line.split()[1] in ("evt", "format")]
     word = next((_EVT_WORD_BYTES[name] for name in names if name in _EVT_WORD_BYTES), 0)
     _refuse_a_cut_word(path, path.stat().st_size - start, word, "EVT word")
     return meta, None
