@@ -2,8 +2,11 @@
 
 from __future__ import annotations
 
+import os
+import shutil
 import subprocess
 import sys
+from pathlib import Path
 
 import cv2
 import numpy as np
@@ -132,9 +135,12 @@ def test_a_video_and_the_same_frames_as_images_give_the_same_events(tmp_path, ca
     assert meta_video.t_frame_us == pytest.approx(meta_images.t_frame_us)
 
 
+def _console_script() -> str:
+    return shutil.which("evclust") or str(Path(sys.executable).parent / "evclust")
+
+
 def test_console_script_reports_bad_input_without_traceback(tmp_path):
-    exe = __import__("shutil").which("evclust") or str(__import__("pathlib").Path(sys.executable).parent / "evclust")
-    result = subprocess.run([exe, "simulate", "nosuch", "-o", str(tmp_path / "e.npz")], capture_output=True, text=True)
+    result = subprocess.run([_console_script(), "simulate", "nosuch", "-o", str(tmp_path / "e.npz")], capture_output=True, text=True)
     assert result.returncode == 2
     assert result.stderr.strip().splitlines() == [
         "evclust: error: unknown scene 'nosuch': built-in scenes are crossing, grey_on_grey, pedestrian, slow, traffic"
@@ -145,9 +151,8 @@ def test_the_console_script_ends_at_once_yet_flushes_all_that_main_printed(capsy
     # The script leaves by os._exit (evclust.cli.entry): piped and buffered (PYTHONUNBUFFERED
     # unset), the end of the output would be lost without the flush.
     code, out, _ = run_cli(capsys, "formats")
-    exe = __import__("shutil").which("evclust") or str(__import__("pathlib").Path(sys.executable).parent / "evclust")
-    env = {k: v for k, v in __import__("os").environ.items() if k != "PYTHONUNBUFFERED"}
-    result = subprocess.run([exe, "formats"], capture_output=True, text=True, env=env)
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONUNBUFFERED"}
+    result = subprocess.run([_console_script(), "formats"], capture_output=True, text=True, env=env)
     assert code == 0 and out.startswith("formats for ")
     assert (result.returncode, result.stdout) == (code, out)
 
