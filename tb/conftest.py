@@ -1,6 +1,6 @@
 """The rotating shares' key, printed at the end of a run that ran any of them (tests marked
 `rotating`: the switch cover's rows, and the vector cases, streams, reset points, built-in
-constants and broken proofs of tb/cosim.py's cosim_share), so that a failure can be run again
+constants, pipelined streams, leaf builds and broken proofs of tb/cosim.py's cosim_share), so that a failure can be run again
 with the same selection."""
 
 from __future__ import annotations
@@ -18,5 +18,6 @@ def pytest_terminal_summary(terminalreporter):
         rows, how = selected_rows()
         terminalreporter.write_line(f"switch cover: {len(rows)} of {len(cover())} rows ({how})")
     if not full():
-        terminalreporter.write_line(f"rotating shares (vector cases, streams, resets, built-in constants, palette builds, broken proofs) drawn from "
+        terminalreporter.write_line(f"rotating shares (vector cases, streams, resets, built-in constants, pipelined streams, palette and update builds, "
+                                    f"broken proofs) drawn from "
                                     f"{rotation_key()[:12]}; make test-full runs them all")  # fmt: skip

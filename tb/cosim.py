@@ -53,6 +53,19 @@ def rotating_subset(count: int, size: int, salt: str) -> list[int]:
     return sorted(np.random.default_rng(seed).choice(count, min(size, count), replace=False).tolist())
 
 
+# Icarus is some 30 to 40 times slower than Verilator on the core (bench/rtl: about 340 events/s
+# against 25,000). In `make test` it runs each model-in-the-loop stream on a sensor that reports
+# within ICARUS_EVENTS events, and no more of them; streams on the traffic sensor, which report
+# nothing before 6,000 events, run under Verilator there. `make test-full` runs everything whole
+# under both (docs/VERIFICATION.md, "What make test runs").
+ICARUS_EVENTS = 1500
+
+
+def short_icarus(sim: str) -> bool:
+    """Whether this run is Icarus in `make test`, which takes the short streams above."""
+    return sim == "icarus" and not full()
+
+
 def cosim_share(items, size: int, salt: str, sim: str = "") -> list:
     """What `make test` runs of `items` under simulator `sim`: a rotating subset of `size`, drawn
     apart for each simulator (so that one commit covers more of the list); all of them under

@@ -234,17 +234,23 @@ def velocity_section(img: Path, quick: bool, tick) -> list[str]:
     return lines
 
 
-def effects_section(img: Path, tick) -> list[str]:
-    points = effect_costs("traffic", progress=tick)
+EFFECT_REPEATS = {False: 2, True: 1}  # --quick times each simulation once
+
+
+def effects_section(img: Path, tick, quick: bool = False) -> list[str]:
+    repeats = EFFECT_REPEATS[quick]
+    best = "best of two" if repeats == 2 else "one run"
+    runs = "best of two runs" if repeats == 2 else "time of one run"
+    points = effect_costs("traffic", progress=tick, repeats=repeats)
     base = points[0]
     figures.cost_against_accuracy(
         [p.effect for p in points], [p.simulate_s for p in points], [100 * (p.velocity_nrmse or 0) for p in points],
         img / "effects_traffic.png", "traffic: each sensor effect's simulation time against the velocity error",
-        "simulation time (s, best of two)", "velocity NRMSE, better method (%)",
+        f"simulation time (s, {best})", "velocity NRMSE, better method (%)",
     )  # fmt: skip
     lines = [
         "The `traffic` scene simulated without effects, then with each effect on at its defaults (one `[effects.NAME]` "
-        "table), and tracked with its preset. Simulation time is the best of two runs; `vs ideal` divides it by the ideal "
+        f"table), and tracked with its preset. Simulation time is the {runs}; `vs ideal` divides it by the ideal "
         "sensor's, timed alternately with it in the same run. An effect the scene does not name is never constructed "
         "(tests/simulator/test_effects.py makes every effect class raise if touched and simulates a scene without effects), so "
         "the ideal sensor's time is the floor every other row pays on top of.",
@@ -423,7 +429,7 @@ def write_report(out: Path, quick: bool = False, progress: bool = True) -> Path:
     figures.error_vs_bits(curves, {s: formats[s].frac_bits for s in signals}, img / "error_vs_bits_traffic.png",
                           "traffic: error against fraction bits, one signal quantised at a time")  # fmt: skip
     velocity_lines = velocity_section(img, quick, lambda: bar.update(1))
-    effect_lines = effects_section(img, lambda: bar.update(1))
+    effect_lines = effects_section(img, lambda: bar.update(1), quick)
     yosys_running = synthesis is not None and len(synthesis.results) < len(CONFIGS)  # while the timings run
     rtl = rtl_runtime(first_meta, first_events, first_params, RTL_EVENTS[quick])
     bar.update(1)

@@ -93,10 +93,10 @@ class EffectPoint:
     palette_accuracy: float | None
 
 
-def effect_costs(scene: str = "traffic", progress=None) -> list[EffectPoint]:
+def effect_costs(scene: str = "traffic", progress=None, repeats: int = 2) -> list[EffectPoint]:
     """The scene without effects, then with each effect on at its defaults: simulation time
-    (best of two), its ratio to the ideal sensor's (timed alternately with it, so machine load
-    cancels), events, and the task on the scene's preset."""
+    (best of `repeats`), its ratio to the ideal sensor's (timed alternately with it, so machine
+    load cancels), events, and the task on the scene's preset."""
     base_text = resources.files("evclust.scenes").joinpath("builtin", f"{scene}.toml").read_text()
     params, _ = load_params(scene)
     ideal = scene_from_toml(base_text, f"{scene}+ideal")
@@ -112,7 +112,7 @@ def effect_costs(scene: str = "traffic", progress=None) -> list[EffectPoint]:
         text = base_text if effect is None else base_text + f"\n[effects.{effect}]\n"
         spec = scene_from_toml(text, f"{scene}+{effect or 'ideal'}")
         walls, ideal_walls = [], []
-        for _ in range(2):
+        for _ in range(repeats):
             wall, sim = timed(spec)
             walls.append(wall)
             ideal_walls.append(timed(ideal)[0])
