@@ -366,3 +366,16 @@ def test_a_truncated_case_fails_clearly(sim, tmp_path):
     folder = _tampered_copy(tmp_path, "bursts", edit)
     with pytest.raises(AssertionError, match=r"events.hex: 1995 lines, the manifest says 2000 \(truncated\?\)"):
         run(sim, _case_header("bursts"), "replay_vectors", {"cases": [str(folder)], "seed": 1, "gap": 0, "stall": 0})
+
+
+def test_verilator_makes_only_the_testbench_top_visible():
+    # evclust.rtl.cosim.TOP_ONLY in place of cocotb's --public-flat-rw: the harness reaches only
+    # the toplevel's signals, and every co-simulation here passes with that alone. The build is
+    # the traffic_clip case's, which make test builds anyway.
+    from cosim import build
+
+    _, folder = build("verilator", _case_header("traffic_clip"))
+    command = (folder / "Vtop__verFiles.dat").read_text().splitlines()[1]
+    assert "--public-depth 1" in command and "--public-flat-rw" not in command
+    symbols = sum(path.stat().st_size for path in folder.glob("Vtop__Syms__*.cpp"))
+    assert symbols < 1_000_000, symbols  # every signal's VPI entry made 5 to 6 MB
