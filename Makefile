@@ -46,7 +46,8 @@ demo-real: $(STAMP)
 	@echo "pictures: $(REAL)_events.png $(REAL)_tracks.png $(REAL)_tracks.mp4"
 
 # worksteal: a worker that runs out of tests takes some of the other's, so a long test near the
-# end does not leave a core idle. `make test` is the tier CI runs (under 20 minutes on 2 cores):
+# end does not leave a core idle. `make test` is the tier CI runs (budget: 20 minutes on 2 cores,
+# setup included; the last fresh-clone times are in docs/RTL.md, "What make test shares"):
 # of the runs marked `rotating` (vector cases, random streams, reset points, built-in-constants
 # cases, switch-cover rows, broken proofs) it runs the anchors and a share drawn from the commit
 # hash for each simulator (tb/cosim.py: cosim_share), so successive commits rotate through them.
