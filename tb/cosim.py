@@ -53,11 +53,11 @@ def rotating_subset(count: int, size: int, salt: str) -> list[int]:
     return sorted(np.random.default_rng(seed).choice(count, min(size, count), replace=False).tolist())
 
 
-# Icarus is some 30 to 40 times slower than Verilator on the core (bench/rtl: about 340 events/s
-# against 25,000). In `make test` it runs each model-in-the-loop stream on a sensor that reports
-# within ICARUS_EVENTS events, and no more of them; streams on the traffic sensor, which report
-# nothing before 6,000 events, run under Verilator there. `make test-full` runs everything whole
-# under both (docs/VERIFICATION.md, "What make test runs").
+# Icarus is far slower than Verilator on the core (bench/rtl: 348 against 26,253 events/s). In
+# `make test` it runs each model-in-the-loop stream on a sensor that reports within
+# ICARUS_EVENTS events, and no more of them; streams on the traffic sensor, which report nothing
+# in their first 5,000 events, run under Verilator there. `make test-full` runs everything whole
+# under both (docs/RTL.md, "What make test shares").
 ICARUS_EVENTS = 1500
 
 

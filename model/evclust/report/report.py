@@ -234,13 +234,12 @@ def velocity_section(img: Path, quick: bool, tick) -> list[str]:
     return lines
 
 
-EFFECT_REPEATS = {False: 2, True: 1}  # --quick times each simulation once
+# Runs per simulation, the figure's axis label, the text's words; --quick times each once.
+EFFECT_TIMING = {False: (2, "best of two", "best of two runs"), True: (1, "one run", "time of one run")}
 
 
 def effects_section(img: Path, tick, quick: bool = False) -> list[str]:
-    repeats = EFFECT_REPEATS[quick]
-    best = "best of two" if repeats == 2 else "one run"
-    runs = "best of two runs" if repeats == 2 else "time of one run"
+    repeats, best, runs = EFFECT_TIMING[quick]
     points = effect_costs("traffic", progress=tick, repeats=repeats)
     base = points[0]
     figures.cost_against_accuracy(
