@@ -6,7 +6,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 BUILD  := build
 
-.PHONY: formal setup recordings demo-real demo demo-video results-video bench-peers test test-full cosim cosim-full coverage lint synth timing bench results report params registers-html vectors generalize clean
+.PHONY: formal setup warm recordings demo-real demo demo-video results-video bench-peers test test-full cosim cosim-full coverage lint synth timing bench results report params registers-html vectors generalize clean
 
 setup: $(STAMP)
 
@@ -45,6 +45,12 @@ demo-real: $(STAMP)
 	$(VENV)/bin/evclust render $(REAL_EVENTS) $(REAL)_tracks.csv -o $(REAL)_tracks.mp4 -q
 	@echo "pictures: $(REAL)_events.png $(REAL)_tracks.png $(REAL)_tracks.mp4"
 
+# The compiled loops into numba's disk cache once, spread over the cores (evclust.warm), before
+# the test workers start: in a fresh clone each worker, and each command-line test's subprocess,
+# would otherwise compile the same loop for a minute or two.
+warm: $(STAMP)
+	$(PY) -m evclust.warm
+
 # worksteal: a worker that runs out of tests takes some of the other's, so a long test near the
 # end does not leave a core idle. `make test` is the tier CI runs (budget: 20 minutes on 2 cores,
 # setup included; the last fresh-clone times are in docs/RTL.md, "What make test shares"):
@@ -53,10 +59,10 @@ demo-real: $(STAMP)
 # hash for each simulator (tb/cosim.py: cosim_share), so successive commits rotate through them.
 # `make test-full` runs every one of them, whole, under both simulators. --durations: the
 # slowest tests at the end of a CI log, where the budget goes.
-test: $(STAMP) recordings
+test: $(STAMP) recordings warm
 	$(PY) -m pytest -q -n auto --dist worksteal --durations=15
 
-test-full: $(STAMP) recordings
+test-full: $(STAMP) recordings warm
 	EVCLUST_COVER=all $(PY) -m pytest -q -n auto --dist worksteal
 
 # Real recordings from physical cameras, out of two PyPI packages' source archives (faery's and

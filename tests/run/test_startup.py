@@ -6,11 +6,14 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from evclust.clusterer import ClustererParams
+from evclust.clusterer import ClustererParams, float_model
 from evclust.events import EVENT_DTYPE, EventMeta
+from evclust.events.format import LOOP_FIELDS, loop_columns
+from evclust.fixed import fixed_model
 from evclust.jit import compiled_code
 from evclust.run import track_events
 from evclust.run.track import MODELS, _object_layer
+from evclust.warm import sample_stream
 
 from testkit import classic_params, simulate_toml, square_scene
 
@@ -73,3 +76,29 @@ def test_a_stream_without_frame_period_is_tracked_at_the_frameless_period():
     at_25 = dataclasses.replace(sim.meta, t_frame_us=FRAMELESS_PERIOD_US)
     given = track_events(sim.events, at_25, classic_params())
     assert np.array_equal(given.tracks, withheld.tracks)
+
+
+def test_loop_columns_are_contiguous_writable_columns_of_the_events():
+    events = np.zeros(50, EVENT_DTYPE)
+    events["t"], events["x"], events["Cr"] = np.arange(50) * 7, np.arange(50) % 13, 200
+    events.flags.writeable = False  # as a read-only map of a file gives them
+    for name, column in zip(LOOP_FIELDS, loop_columns(events)):
+        assert column.flags.c_contiguous and column.flags.writeable, name
+        assert column.dtype == EVENT_DTYPE[name]
+        assert np.array_equal(column, events[name])
+
+
+@pytest.mark.parametrize("model", ["float", "fixed"])
+def test_one_compiled_loop_serves_record_arrays_read_only_maps_and_slices(model, tmp_path):
+    # Each argument layout would compile the loop again, a minute or two in a fresh clone: the
+    # columns are made contiguous and writable first (evclust.events.format.loop_columns).
+    events, meta = sample_stream()
+    np.save(tmp_path / "events.npy", events)
+    mapped = np.load(tmp_path / "events.npy", mmap_mode="r")  # read-only
+    params = classic_params()
+    loop = {"float": float_model, "fixed": fixed_model}[model].run_events
+    first = track_events(events, meta, params, model=model).tracks
+    compiled = len(loop.signatures)
+    for variant in (mapped, events[::1], np.ascontiguousarray(events)):
+        assert np.array_equal(track_events(variant, meta, params, model=model).tracks, first)
+    assert len(loop.signatures) == compiled

@@ -11,6 +11,7 @@ from evclust.clusterer.layout import (
     BG_CB, BG_CR, BG_Y, GLOBAL_COLUMNS, PENDING_COLUMNS, RECORD_COLUMNS, SLOT_COLUMNS, STEP, run_stats, support_shape,
 )  # fmt: skip
 from evclust.clusterer.params import ClustererParams
+from evclust.events.format import loop_columns
 from evclust.tracks import TRACK_DTYPE
 
 
@@ -46,7 +47,7 @@ class FloatClusterer:
         first = self.globals[STEP]
         n = float_model.run_events(
             self.slots, self.hist, self.globals, self.k, self.palette, self.background_mask, self.support, self.delay_line,
-            events["t"], events["x"], events["y"], events["Y"], events["Cb"], events["Cr"], out, steps, self.precision,
+            *loop_columns(events), out, steps, self.precision,
         )  # fmt: skip
         self.steps = steps[: int(self.globals[STEP] - first)]
         return out[:n]

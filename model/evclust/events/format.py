@@ -23,6 +23,15 @@ EVENT_DTYPE = np.dtype(
 )
 COLOUR_FIELDS = ("Y", "Cb", "Cr")
 DVS_FIELDS = ("t", "x", "y", "p")
+LOOP_FIELDS = ("t", "x", "y", "Y", "Cb", "Cr")  # what the clusterers' compiled loops read
+
+
+def loop_columns(events: np.ndarray) -> tuple[np.ndarray, ...]:
+    """The columns a compiled clusterer loop reads, each C-contiguous, writable and of its
+    EVENT_DTYPE type. numba compiles a loop once per argument layout, and a loop takes one to two
+    minutes to compile: a record array's strided fields, a file's read-only map and a columnar
+    table's arrays would each compile it again. A copy of six columns costs far less than a loop."""
+    return tuple(np.require(events[name], EVENT_DTYPE[name], "CW") for name in LOOP_FIELDS)
 
 
 @dataclasses.dataclass(frozen=True)

@@ -6,6 +6,7 @@ import numpy as np
 
 from evclust.clusterer.layout import BG_CB, BG_CR, BG_Y, PENDING_COLUMNS, RECORD_COLUMNS, SLOT_COLUMNS, STEP, run_stats, support_shape
 from evclust.clusterer.params import ClustererParams
+from evclust.events.format import loop_columns
 from evclust.fixed import fixed_model
 from evclust.fixed.constants import constant_vector
 from evclust.fixed.formats import FormatTable, build_formats, decay_table
@@ -75,7 +76,7 @@ class FixedClusterer:
         first = self.globals[STEP]
         n = fixed_model.run_events(
             self.slots, self.hist, self.globals, self.k, self.decay, self.gains, self.palette, self.inv_ww, self.background_mask,
-            self.support, self.seen, self.delay_line, events["t"], events["x"], events["y"], events["Y"], events["Cb"], events["Cr"], out, steps,
+            self.support, self.seen, self.delay_line, *loop_columns(events), out, steps,
             self.overflow, self.ranges, trace,
         )  # fmt: skip
         self.steps = steps[: int(self.globals[STEP] - first)]

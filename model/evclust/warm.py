@@ -1,0 +1,100 @@
+"""Compile the package's compiled loops into numba's disk cache before the runs that need them.
+
+`python -m evclust.warm` (`make warm`, which `make test` runs first). A first run of a model
+compiles its loop for one to two minutes, and numba writes the cache only when it is done. Runs
+started meanwhile (the test workers, the command-line tests' subprocesses) each compile the same
+loop again. Here each loop is compiled once, the jobs spread over the cores, on a small made-up
+stream: what is compiled depends on the argument types, not on the events.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import time
+from concurrent.futures import ProcessPoolExecutor, as_completed
+
+import numpy as np
+
+WIDTH, HEIGHT, EVENTS = 96, 72, 4_000
+
+
+def sample_stream():
+    """A blob drifting right: events that create clusters, reach filter steps and give records."""
+    from evclust.events import EVENT_DTYPE, EventMeta
+
+    rng = np.random.default_rng(0)
+    events = np.zeros(EVENTS, EVENT_DTYPE)
+    events["t"] = np.arange(EVENTS, dtype=np.uint64) * 50
+    events["x"] = np.clip(20 + events["t"] / 5_000 + rng.normal(0, 2, EVENTS), 0, WIDTH - 1).astype(np.uint16)
+    events["y"] = np.clip(36 + rng.normal(0, 2, EVENTS), 0, HEIGHT - 1).astype(np.uint16)
+    events["p"] = 1
+    events["Y"], events["Cb"], events["Cr"] = 120, 90, 200
+    return events, EventMeta(WIDTH, HEIGHT, "warm", t_frame_us=33_333.0)
+
+
+def _track(model: str, **options) -> None:
+    from evclust.clusterer import load_params
+    from evclust.run import track_events
+
+    events, meta = sample_stream()
+    params, _ = load_params(None, meta.source)
+    track_events(events, meta, params, model=model, **options)
+
+
+def _emulate() -> None:
+    from evclust.clusterer import load_params
+    from evclust.fixed.formats import build_formats
+    from evclust.report.budget import emulate
+
+    events, meta = sample_stream()
+    params, _ = load_params(None, meta.source)
+    table = build_formats(params, meta.width, meta.height, params.t_frame_us or meta.t_frame_us)
+    emulate(events, meta, params, table, ("centre",))
+
+
+def _traced() -> None:
+    from evclust.clusterer import load_params
+    from evclust.fixed.model import FixedClusterer
+    from evclust.vectors.write import model_words
+
+    events, meta = sample_stream()
+    params, _ = load_params(None, meta.source)
+    model_words(FixedClusterer(params, meta.width, meta.height, meta.t_frame_us), events)
+
+
+def _simulator() -> None:
+    from evclust.scenes import load_scene
+    from evclust.simulator import simulate_scene
+
+    simulate_scene(load_scene("slow"))
+
+
+# Longest first, so that two cores finish together.
+JOBS = {
+    "fixed model": lambda: _track("fixed"),
+    "fixed model, traced (vectors, co-simulation)": _traced,
+    "float model": lambda: _track("float"),
+    "float model, emulating formats (report)": _emulate,
+    "simulator": _simulator,
+}
+
+
+def _run(name: str) -> tuple[str, float]:
+    start = time.perf_counter()
+    JOBS[name]()
+    return name, time.perf_counter() - start
+
+
+def warm(workers: int | None = None, out=sys.stderr) -> float:
+    """Run every job, `workers` at a time (default: one per core); the wall time."""
+    start = time.perf_counter()
+    with ProcessPoolExecutor(max_workers=workers or os.cpu_count() or 1) as pool:
+        for done in as_completed([pool.submit(_run, name) for name in JOBS]):
+            name, seconds = done.result()
+            print(f"warm: {name}: {seconds:.1f} s", file=out, flush=True)
+    return time.perf_counter() - start
+
+
+if __name__ == "__main__":
+    print(f"warm: compiled code ready in {warm():.1f} s", file=sys.stderr)
