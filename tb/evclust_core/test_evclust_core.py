@@ -25,6 +25,7 @@ from evclust.vectors import CASES
 ROOT = Path(__file__).resolve().parents[2]
 VECTORS = ROOT / "vectors"
 SIMS = selected_simulators()
+SIMS_TIMING = selected_simulators(icarus_in_make_test=False)  # Icarus in make test-full only
 GAP, STALL = 64, 96  # random input gaps 25 % of cycles, output stalls 37.5 %
 
 
@@ -127,7 +128,9 @@ PIPELINED = [("small", 2), ("defaults", 1), ("defaults", 2)]  # one a simulator 
 
 
 @pytest.mark.rotating
-@pytest.mark.parametrize("sim, preset, delay", [(sim, *case) for sim in SIMS for case in cosim_share(PIPELINED, 1, "pipelined", sim)])
+@pytest.mark.parametrize(
+    "sim, preset, delay", [(sim, *case) for sim in SIMS_TIMING for case in cosim_share(PIPELINED, 1, "pipelined", sim)]
+)
 def test_the_pipelined_core_matches_the_model_in_the_loop_through_gaps_and_stalls(sim, preset, delay):
     # update_delay = 1: each update commits as the next event finishes; 2: as the one after
     # finishes, its second half computed a stage later. The pipeline is event-clocked, so the
@@ -155,7 +158,7 @@ def _second_parameter_set(params):
     ))  # fmt: skip
 
 
-@pytest.mark.parametrize("sim", SIMS)
+@pytest.mark.parametrize("sim", SIMS_TIMING)
 def test_parameters_written_over_axi_lite_between_two_streams_are_bit_exact(sim):
     from evclust.clusterer import ClustererParams
 
@@ -225,7 +228,7 @@ def test_a_reset_in_the_middle_of_a_stream_recovers_the_models_state_after_reset
     assert result["events"] == count
 
 
-@pytest.mark.parametrize("sim", SIMS)
+@pytest.mark.parametrize("sim", SIMS_TIMING)
 def test_no_event_is_lost_or_duplicated_under_heavy_back_pressure(sim):
     # The output stalled 75 % of the cycles, with input gaps: the trace must count every event
     # once, in order, and every record must match the model. 10^5 events under Verilator; Icarus,
@@ -239,7 +242,7 @@ def test_no_event_is_lost_or_duplicated_under_heavy_back_pressure(sim):
     assert result["events"] == count
 
 
-@pytest.mark.parametrize("sim", SIMS)
+@pytest.mark.parametrize("sim", SIMS_TIMING)
 def test_a_sparse_input_feeds_events_while_the_sweep_emits_records(sim):
     # Input gaps 94 % of the cycles: stage A is often empty when a sweep starts, so it takes the
     # next event while records leave (the coverage bin "an event in and a record out in one cycle").
@@ -250,7 +253,7 @@ def test_a_sparse_input_feeds_events_while_the_sweep_emits_records(sim):
     assert result["coverage"]["stream: an event in and a record out in one cycle"] > 0
 
 
-@pytest.mark.parametrize("sim", SIMS)
+@pytest.mark.parametrize("sim", SIMS_TIMING)
 def test_one_cycle_per_event_and_max_n_p_plus_the_tail_per_sweep(sim):
     # Without gaps or stalls: each event takes one cycle (the seek of the next overlaps its
     # update); each filter step its phase cycle (fewer than two tau boundaries here), max(N, P)
@@ -287,7 +290,7 @@ def test_one_cycle_per_event_and_max_n_p_plus_the_tail_per_sweep(sim):
     )
 
 
-@pytest.mark.parametrize("sim", SIMS)
+@pytest.mark.parametrize("sim", SIMS_TIMING)
 def test_each_merge_holds_the_sweep_for_the_dividers_steps_plus_three_cycles(sim):
     # Without gaps or stalls: each filter step's 1 + max(N, P) + tail cycles plus, for each
     # merge, the detection, the dividers' start, their MERGE_MOMENT_W steps and the write; outside
@@ -324,7 +327,7 @@ def _tampered_copy(tmp_path, case: str, edit) -> Path:
     return folder
 
 
-@pytest.mark.parametrize("sim", SIMS)
+@pytest.mark.parametrize("sim", SIMS_TIMING)
 def test_a_wrong_expected_record_is_reported_field_by_field(sim, tmp_path):
     from evclust.fixed.layouts import record_fields
     from evclust.vectors.pack import pack, unpack

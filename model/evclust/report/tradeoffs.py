@@ -96,9 +96,9 @@ class EffectPoint:
 def effect_costs(scene: str = "traffic", progress=None, repeats: int = 2) -> list[EffectPoint]:
     """The scene without effects, then with each effect on at its defaults: simulation time
     (best of `repeats`), its ratio to the ideal sensor's (timed alternately with it, so machine
-    load cancels), events, and the task on the scene's preset."""
+    load cancels), events, and the task on the scene's preset (the defaults if it has none)."""
     base_text = resources.files("evclust.scenes").joinpath("builtin", f"{scene}.toml").read_text()
-    params, _ = load_params(scene)
+    params, _ = load_params(None, scene)  # its preset, or the defaults where it has none
     ideal = scene_from_toml(base_text, f"{scene}+ideal")
     simulate_scene(ideal)  # compile outside the timing
     points = []
