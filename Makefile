@@ -46,8 +46,8 @@ demo-real: $(STAMP)
 	@echo "pictures: $(REAL)_events.png $(REAL)_tracks.png $(REAL)_tracks.mp4"
 
 # The compiled loops into numba's disk cache once, spread over the cores (evclust.warm), before
-# the test workers start: in a fresh clone each worker, and each command-line test's subprocess,
-# would otherwise compile the same loop for a minute or two.
+# the test workers start, so that no two compile the same loop and each test's duration is its
+# own (in a fresh clone it did not shorten make test: docs/RTL.md, "What make test shares").
 warm: $(STAMP)
 	$(PY) -m evclust.warm
 

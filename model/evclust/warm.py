@@ -1,10 +1,11 @@
 """Compile the package's compiled loops into numba's disk cache before the runs that need them.
 
 `python -m evclust.warm` (`make warm`, which `make test` runs first). A first run of a model
-compiles its loop for one to two minutes, and numba writes the cache only when it is done. Runs
-started meanwhile (the test workers, the command-line tests' subprocesses) each compile the same
-loop again. Here each loop is compiled once, the jobs spread over the cores, on a small made-up
-stream: what is compiled depends on the argument types, not on the events.
+compiles its loop for 45 to 75 s, and numba writes the cache only when it is done; a run started
+meanwhile compiles the same loop again. Here each loop is compiled once, the jobs spread over the
+cores, on a small made-up stream (what is compiled depends on the argument types, not on the
+events), so the tests' durations are their own. Measured in a fresh clone (docs/RTL.md), it did
+not shorten `make test`: the first test to need each loop had paid for it, not two at once.
 """
 
 from __future__ import annotations

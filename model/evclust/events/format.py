@@ -28,9 +28,10 @@ LOOP_FIELDS = ("t", "x", "y", "Y", "Cb", "Cr")  # what the clusterers' compiled 
 
 def loop_columns(events: np.ndarray) -> tuple[np.ndarray, ...]:
     """The columns a compiled clusterer loop reads, each C-contiguous, writable and of its
-    EVENT_DTYPE type. numba compiles a loop once per argument layout, and a loop takes one to two
-    minutes to compile: a record array's strided fields, a file's read-only map and a columnar
-    table's arrays would each compile it again. A copy of six columns costs far less than a loop."""
+    EVENT_DTYPE type. numba compiles a loop once per argument layout, and a loop takes 45 s (float)
+    to 75 s (fixed) to compile: a record array's strided fields, a read-only map and contiguous
+    columns each compiled it again (numba's cache held five specialisations of each loop). The
+    copy is of six columns per call, outside the per-event loop."""
     return tuple(np.require(events[name], EVENT_DTYPE[name], "CW") for name in LOOP_FIELDS)
 
 
