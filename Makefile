@@ -33,11 +33,14 @@ demo: $(STAMP)
 
 # A real recording end to end: a DAVIS346 looking down on a street (2.4 s, 78,830 events, from
 # faery's test data; `make recordings`), tracked with the defaults and drawn, 1.23 s into the clip
-# where three cars are tracked. A camera has no frame period: 33,333 µs is given here.
+# where three cars are tracked. A camera has no frame period: 33,333 µs is given here. `track`'s
+# entry points are built ahead of time first (evclust.jit.ahead; about 20 s, a minute more on a
+# first run), so that the run itself loads no numba: under a second on this clip.
 REAL := $(BUILD)/real/davis346
 REAL_EVENTS := $(BUILD)/recordings/davis346/davis346.aedat4
 demo-real: $(STAMP)
 	$(PY) -m evclust.events.recordings davis346
+	$(PY) -m evclust.warm --ahead
 	mkdir -p $(BUILD)/real
 	$(VENV)/bin/evclust track $(REAL_EVENTS) -o $(REAL)_tracks.csv --frame-us 33333
 	$(VENV)/bin/evclust show $(REAL_EVENTS) -o $(REAL)_events.png
@@ -47,7 +50,8 @@ demo-real: $(STAMP)
 
 # The compiled loops into numba's disk cache once, spread over the cores (evclust.warm), before
 # the test workers start, so that no two compile the same loop and each test's duration is its
-# own (in a fresh clone it did not shorten make test: docs/RTL.md, "What make test shares").
+# own (in a fresh clone it did not shorten make test: docs/RTL.md, "What make test shares");
+# and `track`'s entry points built ahead of time (evclust.jit.ahead).
 warm: $(STAMP)
 	$(PY) -m evclust.warm
 

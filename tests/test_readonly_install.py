@@ -70,13 +70,13 @@ def without_times(text: str) -> str:
 
 
 def test_every_compiled_function_goes_through_evclust_jit():
-    """numba's own decorators would bring the failure back: only evclust/jit.py may call them."""
+    """numba's own decorators would bring the failure back: only evclust/jit/ may call them."""
     decorators = r"(njit|jit|vectorize|guvectorize|cfunc|stencil)\b"
     direct = re.compile(rf"\bnumba\.{decorators}|^\s*from numba import .*\b{decorators}")
     offenders = [
         f"{path.relative_to(PACKAGE)}:{number}: {line.strip()}"
         for path in PACKAGE.rglob("*.py")
-        if path != PACKAGE / "jit.py"
+        if path.parent != PACKAGE / "jit"
         for number, line in enumerate(path.read_text().splitlines(), 1)
         if direct.search(line)
     ]
@@ -98,10 +98,12 @@ def test_the_environment_defeats_numba_and_evclust_still_starts(readonly, numba_
     plain = subprocess.run([sys.executable, "-c", probe], env=env, capture_output=True, text=True)
     assert plain.returncode != 0
     assert "RuntimeError: cannot cache function 'f': no locator available" in plain.stderr
-    # `evclust formats` imports the float and the fixed-point models (every decorator runs).
+    # `evclust formats` imports the float and the fixed-point models (every decorator runs) and
+    # compiles nothing: numba is never imported (evclust.jit makes dispatchers when first needed),
+    # so nothing warns. A run that compiles warns once: the test below.
     run = evclust_cli(["formats"], tmp_path, env)
     assert run.returncode == 0, run.stderr
-    assert run.stderr == WARNING
+    assert run.stderr == ""
     assert run.stdout == formats_table
     assert_nothing_cached(readonly)
 

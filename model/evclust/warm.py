@@ -1,4 +1,5 @@
-"""Compile the package's compiled loops into numba's disk cache before the runs that need them.
+"""Compile the package's compiled loops into numba's disk cache before the runs that need them,
+and build what `track` calls ahead of time.
 
 `python -m evclust.warm` (`make warm`, which `make test` runs first). A first run of a model
 compiles its loop for 45 to 75 s, and numba writes the cache only when it is done; a run started
@@ -6,12 +7,20 @@ meanwhile compiles the same loop again. Here each loop is compiled once, the job
 cores, on a small made-up stream (what is compiled depends on the argument types, not on the
 events), so the tests' durations are their own. Measured in a fresh clone (docs/RTL.md), it did
 not shorten `make test`: the first test to need each loop had paid for it, not two at once.
+
+One job also builds `track`'s entry points ahead of time (evclust.jit.ahead), after calling them
+as `track` does: a default run of the float model, and a read of each event-camera format. Then a
+`track` with the defaults loads them without numba. `python -m evclust.warm --ahead` runs that
+job alone (`make demo-real`).
 """
 
 from __future__ import annotations
 
+import argparse
+import importlib
 import os
 import sys
+import tempfile
 import time
 from concurrent.futures import ProcessPoolExecutor, as_completed
 
@@ -41,6 +50,38 @@ def _track(model: str, **options) -> None:
     events, meta = sample_stream()
     params, _ = load_params(None, meta.source)
     track_events(events, meta, params, model=model, **options)
+
+
+# What `track` calls from Python with the defaults (the float model, its object layer, and the
+# conversion of every event-camera format's packets); tests/run/test_ahead.py checks that a
+# default `track` of a camera file needs nothing else compiled.
+TRACK_ENTRY_POINTS = (
+    "evclust.clusterer.float_model:run_events",
+    "evclust.clusterer.objects:run_steps",
+    "evclust.events.camera:_convert",
+)
+CAMERA_FILES = ("sample.aedat4", "sample.raw", "sample.dat", "sample.es")
+
+
+def _track_ahead() -> None:
+    """Call `track`'s entry points as `track` does, under numba (an earlier build would serve them
+    otherwise, and numba would make nothing to build from), then build them ahead of time unless
+    the build for these sources is there already."""
+    from evclust.events.io import read_events, write_events
+    from evclust.jit import ahead
+
+    os.environ[ahead.DISABLE] = "0"  # this job's process only
+    _track("float")
+    events, meta = sample_stream()
+    with tempfile.TemporaryDirectory() as folder:
+        for name in CAMERA_FILES:
+            write_events(os.path.join(folder, name), events, meta)
+            read_events(os.path.join(folder, name))
+    if ahead.location() is not None:
+        return
+    functions = [getattr(importlib.import_module(module), name) for module, name in (e.split(":") for e in TRACK_ENTRY_POINTS)]
+    if ahead.build(functions) is None:
+        raise SystemExit("warm: track's entry points were not built ahead of time (the line above says why)")
 
 
 def _emulate() -> None:
@@ -75,7 +116,7 @@ def _simulator() -> None:
 JOBS = {
     "fixed model": lambda: _track("fixed"),
     "fixed model, traced (vectors, co-simulation)": _traced,
-    "float model": lambda: _track("float"),
+    "float model, and track's entry points ahead of time": _track_ahead,
     "float model, emulating formats (report)": _emulate,
     "simulator": _simulator,
 }
@@ -87,15 +128,19 @@ def _run(name: str) -> tuple[str, float]:
     return name, time.perf_counter() - start
 
 
-def warm(workers: int | None = None, out=sys.stderr) -> float:
-    """Run every job, `workers` at a time (default: one per core); the wall time."""
+def warm(workers: int | None = None, out=sys.stderr, jobs=tuple(JOBS)) -> float:
+    """Run `jobs` (default: all), `workers` at a time (default: one per core); the wall time."""
     start = time.perf_counter()
     with ProcessPoolExecutor(max_workers=workers or os.cpu_count() or 1) as pool:
-        for done in as_completed([pool.submit(_run, name) for name in JOBS]):
+        for done in as_completed([pool.submit(_run, name) for name in jobs]):
             name, seconds = done.result()
             print(f"warm: {name}: {seconds:.1f} s", file=out, flush=True)
     return time.perf_counter() - start
 
 
 if __name__ == "__main__":
-    print(f"warm: compiled code ready in {warm():.1f} s", file=sys.stderr)
+    parser = argparse.ArgumentParser(prog="python -m evclust.warm", description=__doc__.split("\n\n")[0])
+    parser.add_argument("--ahead", action="store_true", help="only build track's entry points ahead of time")
+    ahead = parser.parse_args().ahead
+    jobs = [name for name in JOBS if JOBS[name] is _track_ahead] if ahead else tuple(JOBS)
+    print(f"warm: compiled code ready in {warm(jobs=jobs):.1f} s", file=sys.stderr)

@@ -30,14 +30,13 @@ class Startup:
     seconds: float
     loaded: int  # specialisations taken from numba's disk cache
     compiled: int  # ... and compiled (a first run, or a changed source)
+    ahead: int = 0  # functions that ran their ahead-of-time build (evclust.jit.ahead)
 
     def describe(self) -> str:
-        how = (
-            f"{self.compiled} compiled, {self.loaded} loaded from numba's cache"
-            if self.compiled
-            else f"loaded from numba's cache ({self.loaded})"
-        )
-        return f"compiled code ready in {self.seconds:.2f} s ({how})"
+        parts = [f"{self.ahead} built ahead of time"] if self.ahead else []
+        parts += [f"{self.compiled} compiled"] if self.compiled else []
+        parts += [f"{self.loaded} loaded from numba's cache"] if self.loaded else []
+        return f"compiled code ready in {self.seconds:.2f} s ({'; '.join(parts) or 'nothing to make'})"
 
 
 @dataclasses.dataclass
@@ -216,8 +215,8 @@ def _ready(clusterer, layer) -> Startup:
     rows = clusterer.feed(np.zeros(0, EVENT_DTYPE))
     if layer is not None:
         layer.feed(rows, clusterer.steps)
-    loaded, compiled = (now - then for now, then in zip(compiled_code(), before))
-    return Startup(time.perf_counter() - start, loaded, compiled)
+    ahead, loaded, compiled = (now - then for now, then in zip(compiled_code(), before))
+    return Startup(time.perf_counter() - start, loaded, compiled, ahead)
 
 
 def rerun_objects(run: TrackRun, params: ClustererParams) -> TrackRun:
