@@ -112,11 +112,12 @@ def _simulator() -> None:
     simulate_scene(load_scene("slow"))
 
 
+AHEAD_JOB = "float model, and track's entry points ahead of time"
 # Longest first, so that two cores finish together.
 JOBS = {
     "fixed model": lambda: _track("fixed"),
     "fixed model, traced (vectors, co-simulation)": _traced,
-    "float model, and track's entry points ahead of time": _track_ahead,
+    AHEAD_JOB: _track_ahead,
     "float model, emulating formats (report)": _emulate,
     "simulator": _simulator,
 }
@@ -141,6 +142,5 @@ def warm(workers: int | None = None, out=sys.stderr, jobs=tuple(JOBS)) -> float:
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(prog="python -m evclust.warm", description=__doc__.split("\n\n")[0])
     parser.add_argument("--ahead", action="store_true", help="only build track's entry points ahead of time")
-    ahead = parser.parse_args().ahead
-    jobs = [name for name in JOBS if JOBS[name] is _track_ahead] if ahead else tuple(JOBS)
+    jobs = [AHEAD_JOB] if parser.parse_args().ahead else tuple(JOBS)
     print(f"warm: compiled code ready in {warm(jobs=jobs):.1f} s", file=sys.stderr)

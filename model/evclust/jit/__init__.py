@@ -11,9 +11,10 @@ then nothing of numba is loaded: importing numba and decorating the package's fu
 replaced by their dispatchers, so numba compiles calls between them, and inlines them, as before.
 
 **Ahead of time.** `evclust.jit.ahead` loads a build of `track`'s entry points (one extension
-module, made by `python -m evclust.warm`) whose key matches the package's sources. A call whose
-arguments are of the kinds an export was built for runs that export, without numba; any other
-call goes to numba. docs/DESIGN.md, "Compiled code ahead of time".
+module, made by `python -m evclust.warm`) whose key matches the package's sources as they were
+when this module was imported. A call whose arguments are of the kinds an export was built for
+runs that export, without numba; any other call goes to numba. docs/DESIGN.md, "Compiled code
+ahead of time".
 
 **The disk cache where it can be written.** Call sites keep ``cache=True``: it asks for the
 cache, and gets it whenever numba could write one. numba (0.68) looks for a cache folder when a
@@ -32,24 +33,21 @@ from __future__ import annotations
 import functools
 import os
 import sys
-import tempfile
+import threading
 
 import numpy as np
 
+from evclust.jit.ahead import argument_kinds, exports_for, source_key, writable_folder
+
+source_key()  # the sources as imported: a build for them, not for a later edit, is what may load
+
 _warned = False
-_numba = None  # numba, once `_materialise` has run
+_numba = None  # numba, once imported
+_ready = False  # every dispatcher made and in place
+_materialising = False  # `_materialise` is at work (in the thread holding `_LOCK`)
+_LOCK = threading.RLock()  # the simulator's threads may make the first call together
 _COMPILED: list[Compiled] = []  # every function made by `njit` or `vectorize`, in order
 _DISPATCHERS = []  # numba's dispatchers of the `njit` ones, once made
-
-
-def writable_folder(folder: str) -> bool:
-    """What numba's cache locators check: the folder can be created and a file written in it."""
-    try:
-        os.makedirs(folder, exist_ok=True)
-        tempfile.TemporaryFile(dir=folder).close()
-    except OSError:  # read-only, missing permissions, a file or a device on the path, ...
-        return False
-    return True
 
 
 @functools.cache
@@ -90,10 +88,17 @@ def _cache_for(func) -> bool:
     return False
 
 
+def _with_cache(func, options: dict) -> dict:
+    """`options` with ``cache=True`` kept only where numba can write the cache."""
+    return {**options, "cache": bool(options.get("cache")) and _cache_for(func)}
+
+
 class Compiled:
     """A compiled function of evclust. Called, it runs its ahead-of-time export when one was built
     for arguments of these kinds, and numba's dispatcher otherwise. Any other attribute
     (``signatures``, ``overloads``, ...) is the dispatcher's."""
+
+    _OWN = frozenset({"py_func", "ran_ahead", "dispatcher", "_make", "_dispatcher", "_exports"})
 
     def __init__(self, func, make):
         functools.update_wrapper(self, func)
@@ -107,15 +112,17 @@ class Compiled:
     @property
     def dispatcher(self):
         if self._dispatcher is None:
-            _materialise()
+            with _LOCK:
+                if _materialising:  # asked for while `_materialise` makes the others (numba typing a caller)
+                    self._dispatcher = self._make(_numba)
+                else:
+                    _materialise()
         return self._dispatcher
 
     def __call__(self, *args, **kwargs):
         if self._dispatcher is None and not kwargs:
             if self._exports is None:
-                from evclust.jit.ahead import exports_for  # the build is looked for on the first call only
-
-                self._exports = exports_for(self.py_func)
+                self._exports = exports_for(self.py_func)  # the build is looked for on the first call only
             if self._exports:
                 kinds = argument_kinds(args)
                 for built_for, export in self._exports:
@@ -125,8 +132,8 @@ class Compiled:
         return self.dispatcher(*args, **kwargs)
 
     def __getattr__(self, name):
-        if name.startswith("__") or name in ("_dispatcher", "_make", "_exports", "py_func"):
-            raise AttributeError(name)  # not made yet (copying, pickling): never numba for these
+        if name.startswith("__") or name in self._OWN:
+            raise AttributeError(name)  # not set yet (copying, pickling, a failed make): never numba for these
         return getattr(self.dispatcher, name)
 
     def __reduce__(self):  # pickled by name, as a plain function is
@@ -145,32 +152,48 @@ def _by_name(module: str, qualname: str):
 def _materialise() -> None:
     """Import numba, make every dispatcher, and put them in place of their `Compiled` wherever a
     module of evclust holds one, so that numba sees dispatchers when it compiles a caller (and
-    inlines what asks for it). A `Compiled` held anywhere else types as its dispatcher."""
-    global _numba
-    if _numba is not None:
-        return
-    import numba
-    from numba.core.typing.typeof import typeof_impl
+    inlines what asks for it). A `Compiled` held anywhere else types as its dispatcher. Under
+    `_LOCK`; a failure leaves what was made in place, and the next call makes the rest."""
+    global _numba, _ready, _materialising
+    with _LOCK:
+        if _ready:
+            return
+        import numba
+        from numba.core.typing.typeof import typeof_impl
 
-    _numba = numba
-    typeof_impl.register(Compiled)(lambda value, context: typeof_impl(value.dispatcher, context))
-    held = {}  # id of a Compiled -> the (module, name) pairs that hold it
-    for name, module in list(sys.modules.items()):
-        if module is not None and (name == "evclust" or name.startswith("evclust.")):
-            for attribute, value in list(vars(module).items()):
-                if isinstance(value, Compiled):
-                    held.setdefault(id(value), []).append((module, attribute))
-    # In order of definition, each put in place before the next is made: a ufunc with explicit
-    # signatures compiles when made, and must find the ones it calls made already.
-    for compiled in _COMPILED:
-        compiled._dispatcher = compiled._make(numba)
-        for module, attribute in held.get(id(compiled), ()):
-            setattr(module, attribute, compiled._dispatcher)
+        if _numba is None:
+            typeof_impl.register(Compiled)(lambda value, context: typeof_impl(value.dispatcher, context))
+        _numba = numba
+        held = {}  # id of a Compiled -> the (module, name) pairs that hold it
+        for name, module in list(sys.modules.items()):
+            if module is not None and (name == "evclust" or name.startswith("evclust.")):
+                for attribute, value in list(vars(module).items()):
+                    if isinstance(value, Compiled):
+                        held.setdefault(id(value), []).append((module, attribute))
+        # In order of definition, each put in place before the next is made: a ufunc with explicit
+        # signatures compiles when made, and must find the ones it calls made already.
+        _materialising = True
+        try:
+            for compiled in _COMPILED:
+                if compiled._dispatcher is None:
+                    compiled._dispatcher = compiled._make(numba)
+                for module, attribute in held.get(id(compiled), ()):
+                    setattr(module, attribute, compiled._dispatcher)
+        finally:
+            _materialising = False
+        _ready = True
 
 
 def numba_loaded() -> bool:
     """Whether this process has needed numba so far."""
     return _numba is not None
+
+
+def _lazily(func, make):
+    """`make(numba)` now if numba is in use already (callers compiled later expect the dispatcher
+    itself), else a `Compiled` that makes it when first needed."""
+    with _LOCK:
+        return make(_numba) if _ready else Compiled(func, make)
 
 
 def njit(func=None, /, **options):
@@ -180,56 +203,16 @@ def njit(func=None, /, **options):
         return functools.partial(njit, **options)
 
     def make(numba):
-        dispatcher = numba.njit(func, **{**options, "cache": bool(options.get("cache")) and _cache_for(func)})
+        dispatcher = numba.njit(func, **_with_cache(func, options))
         _DISPATCHERS.append(dispatcher)
         return dispatcher
 
-    if _numba is not None:  # numba is in use already: the dispatcher itself, as callers compiled later expect
-        return make(_numba)
-    return Compiled(func, make)
+    return _lazily(func, make)
 
 
 def vectorize(signatures, **options):
     """`numba.vectorize` with explicit signatures, ``cache=True`` handled as by `njit`."""
-
-    def decorate(func):
-        def make(numba):
-            return numba.vectorize(signatures, **{**options, "cache": bool(options.get("cache")) and _cache_for(func)})(func)
-
-        return make(_numba) if _numba is not None else Compiled(func, make)
-
-    return decorate
-
-
-def argument_kinds(args) -> tuple:
-    """What numba types a call by, in the words `evclust.jit.ahead` describes an export with: each
-    array's dtype, dimensions, layout and writability; a record's dtype; a tuple's class
-    and its items' kinds; a scalar's numba type. Calls of the same kinds run the same specialisation."""
-    return tuple(_kind(value) for value in args)
-
-
-_INT64 = (-(1 << 63), (1 << 63) - 1)
-
-
-def _kind(value):
-    if isinstance(value, np.ndarray):
-        layout = "C" if value.flags.c_contiguous else "F" if value.flags.f_contiguous else "A"
-        return ("array", value.dtype, value.ndim, layout, value.flags.writeable)  # numba's typeof ignores alignment
-    if isinstance(value, np.void):
-        return ("record", value.dtype)
-    if isinstance(value, tuple):
-        return ("tuple", type(value).__qualname__, tuple(_kind(item) for item in value))
-    if value is None:
-        return ("scalar", "none")
-    if isinstance(value, bool):  # before int: a bool is an int
-        return ("scalar", "bool")
-    if isinstance(value, int):
-        return ("scalar", "int64") if _INT64[0] <= value <= _INT64[1] else ("other", "int")
-    if isinstance(value, float):
-        return ("scalar", "float64")
-    if isinstance(value, np.generic):
-        return ("scalar", str(value.dtype))
-    return ("other", type(value).__qualname__)  # never built ahead of time
+    return lambda func: _lazily(func, lambda numba: numba.vectorize(signatures, **_with_cache(func, options))(func))
 
 
 def compiled_code() -> tuple[int, int, int]:

@@ -38,8 +38,6 @@ from pathlib import Path
 
 import numpy as np
 
-from evclust.jit import writable_folder
-
 PACKAGE = Path(__file__).resolve().parents[1]
 PREFIX = "_evclust_ahead_"
 DISABLE = "EVCLUST_AHEAD"  # "0": numba for everything
@@ -47,8 +45,12 @@ DISABLE = "EVCLUST_AHEAD"  # "0": numba for everything
 
 @functools.cache
 def source_key() -> str:
-    """The hash a build is valid for: every source file of the package, and the versions of what
-    compiles and runs it."""
+    """The hash a build is valid for, computed once per process (evclust.jit computes it when it
+    is imported): every source file of the package, and what compiles and runs them."""
+    return _key_now()
+
+
+def _key_now() -> str:
     digest = hashlib.sha256()
     numba_spec = importlib.util.find_spec("numba")  # its version without importing it
     numba_version = Path(numba_spec.origin).with_name("_version.py") if numba_spec and numba_spec.origin else None
@@ -70,6 +72,16 @@ def _cpu() -> str:
     except OSError:  # not Linux
         pass
     return f"{platform.machine()}|{platform.processor()}"
+
+
+def writable_folder(folder: str) -> bool:
+    """What numba's cache locators check: the folder can be created and a file written in it."""
+    try:
+        os.makedirs(folder, exist_ok=True)
+        tempfile.TemporaryFile(dir=folder).close()
+    except OSError:  # read-only, missing permissions, a file or a device on the path, ...
+        return False
+    return True
 
 
 def folders() -> list[Path]:
@@ -119,13 +131,54 @@ def exports_for(func) -> list:
 
 
 def location() -> Path | None:
-    """The build that serves this package's sources, if any."""
+    """The manifest of the build that serves this package's sources, if one is there whole."""
     key = source_key()
-    return next((path for folder in folders() for path in [_files(folder, key)[1]] if path.is_file()), None)
+    for folder in folders():
+        module_path, manifest_path = _files(folder, key)
+        if manifest_path.is_file() and module_path.is_file():
+            return manifest_path
+    return None
 
 
-def _kind_of_type(numba_type):
-    """`evclust.jit.argument_kinds`'s words for one of numba's argument types."""
+# The kinds of argument an export is built for, in the words numba's dispatch goes by: an array's
+# dtype, dimensions, layout and writability (numba's typeof ignores alignment); a record's dtype;
+# a tuple's class (module, name, fields) and its items' kinds; a scalar's numba type. Anything
+# else is never built ahead of time, and goes to numba.
+_INT64 = (-(1 << 63), (1 << 63) - 1)
+
+
+def argument_kinds(args) -> tuple:
+    """The kinds of a call's arguments. Calls of the same kinds run the same specialisation."""
+    return tuple(_kind(value) for value in args)
+
+
+def _tuple_class(cls) -> tuple:
+    return (cls.__module__, cls.__qualname__, getattr(cls, "_fields", None))
+
+
+def _kind(value):
+    if type(value) is np.ndarray:  # not a subclass: numba refuses a masked array, for one
+        layout = "C" if value.flags.c_contiguous else "F" if value.flags.f_contiguous else "A"  # numba's map_layout
+        return ("array", value.dtype, value.ndim, layout, value.flags.writeable)
+    if isinstance(value, np.void):
+        return ("record", value.dtype)
+    if isinstance(value, tuple):
+        return ("tuple", _tuple_class(type(value)), tuple(_kind(item) for item in value))
+    if value is None:
+        return ("scalar", "none")
+    if isinstance(value, bool):  # before int: a bool is an int
+        return ("scalar", "bool")
+    if isinstance(value, int):
+        return ("scalar", "int64") if _INT64[0] <= value <= _INT64[1] else ("other", "int")
+    if isinstance(value, float):
+        return ("scalar", "float64")
+    if isinstance(value, np.generic):
+        return ("scalar", str(value.dtype))
+    return ("other", type(value).__qualname__)
+
+
+def kind_of_type(numba_type):
+    """The kind of argument numba types as `numba_type` (what a build records for each export)."""
     from numba.core import types
     from numba.np.numpy_support import as_dtype
 
@@ -134,7 +187,8 @@ def _kind_of_type(numba_type):
     if isinstance(numba_type, types.Record):
         return ("record", as_dtype(numba_type))
     if isinstance(numba_type, types.BaseTuple):
-        return ("tuple", getattr(numba_type, "instance_class", tuple).__qualname__, tuple(_kind_of_type(t) for t in numba_type.types))
+        cls = getattr(numba_type, "instance_class", tuple)
+        return ("tuple", _tuple_class(cls), tuple(kind_of_type(t) for t in numba_type.types))
     if isinstance(numba_type, (types.Boolean, types.Integer, types.Float, types.NoneType)):
         return ("scalar", str(numba_type))
     raise TypeError(f"no ahead-of-time export for arguments of type {numba_type}")
@@ -156,6 +210,9 @@ def build(functions, out=sys.stderr) -> Path | None:
         print(f"evclust: numba.pycc is not available ({error}): runs load numba's cache", file=out)
         return None
     key = source_key()
+    if _key_now() != key:  # the compiled code came from the sources as imported
+        print("evclust: the package's sources changed since they were imported: nothing built; build again", file=out)
+        return None
     module_path, manifest_path = _files(folder, key)
     entries = []
     with tempfile.TemporaryDirectory(dir=folder, prefix=".build-") as scratch:
@@ -167,7 +224,7 @@ def build(functions, out=sys.stderr) -> Path | None:
             py_func = dispatcher.py_func
             for number, signature in enumerate(dispatcher.nopython_signatures):
                 export = f"{py_func.__module__}.{py_func.__qualname__}".replace(".", "_") + f"__{number}"
-                kinds = tuple(_kind_of_type(t) for t in signature.args)
+                kinds = tuple(kind_of_type(t) for t in signature.args)
                 cc.export(export, signature)(py_func)
                 entries.append({"module": py_func.__module__, "qualname": py_func.__qualname__, "export": export, "kinds": kinds})
         if not entries:
