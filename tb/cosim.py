@@ -19,18 +19,29 @@ from evclust.rtl.configurations import (  # noqa: F401  (the testbenches' API)
 )  # fmt: skip
 
 
-def selected_simulators(icarus_in_make_test: bool = True) -> tuple[str, ...]:
-    """Both simulators, or the one `SIM` names (`make cosim SIM=...`). With
-    `icarus_in_make_test=False`, `make test` runs the test under Verilator alone and leaves its
-    Icarus run to `make test-full` (or to `SIM=icarus`): the checks of the core's timing and
-    handshakes (back-pressure, sparse input, cycles per sweep and per merge, registers between
-    streams, the pipelined core through gaps and stalls), the scoreboard's message, the
-    switch-cover rows, the paper's configuration and a team's own events, which Icarus took 25 to
-    85 s each to repeat. The golden vectors (the pipelined ones among them), a random stream, a
-    reset, the built-in constants and the leaf benches stay under both."""
+# What `make test` runs under each simulator, where it does not run both; `make test-full` (or
+# `SIM=...`) runs both. docs/RTL.md, "What make test shares", has the times behind each choice.
+# - TIMING_SIMULATORS: the checks of the core's timing and handshakes (back-pressure, sparse input,
+#   cycles per sweep and per merge, registers between streams, the pipelined core through gaps and
+#   stalls), the scoreboard's message, the switch-cover rows, the paper's configuration and a
+#   team's own events, which Icarus took 25 to 85 s each to repeat.
+# - LEAF_SIMULATORS: the leaf modules' benches and the AXI4-Stream wrapper's, whose Verilator
+#   builds (12 to 57 s each, most of the bench) Icarus does without; the golden vectors, a random
+#   stream, a reset and the built-in constants run the core under both in make test, and
+#   Verilator lints every module.
+# - PALETTE_SIMULATORS: the palette's bench, whose sweeps Icarus took 46 to 112 s over against
+#   Verilator's 23 to 39 s with its build.
+TIMING_SIMULATORS = ("verilator",)
+LEAF_SIMULATORS = ("icarus",)
+PALETTE_SIMULATORS = ("verilator",)
+
+
+def selected_simulators(in_make_test: tuple[str, ...] = SIMULATORS) -> tuple[str, ...]:
+    """The simulators a test runs under: `in_make_test` in `make test`, both in `make test-full`,
+    the one `SIM` names (`make cosim SIM=...`) if it is set."""
     sim = os.environ.get("SIM")
     if not sim:
-        return SIMULATORS if icarus_in_make_test or full() else tuple(s for s in SIMULATORS if s != "icarus")
+        return SIMULATORS if full() else tuple(s for s in SIMULATORS if s in in_make_test)
     if sim not in SIMULATORS:
         raise SystemExit(f"SIM={sim}: expected one of {', '.join(SIMULATORS)}")
     return (sim,)

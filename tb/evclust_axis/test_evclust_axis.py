@@ -122,10 +122,10 @@ if cocotb is not None:
 # ------------------------------------------------------------------------------------------
 # pytest: build, launch, check.
 
-from cosim import ICARUS_EVENTS, random_config, run, selected_simulators, short_icarus  # noqa: E402
+from cosim import ICARUS_EVENTS, LEAF_SIMULATORS, random_config, run, selected_simulators, short_icarus  # noqa: E402
 
 
-@pytest.mark.parametrize("sim", selected_simulators())
+@pytest.mark.parametrize("sim", selected_simulators(LEAF_SIMULATORS))
 def test_events_and_records_over_axi4_stream_with_random_pauses_match_the_model(sim):
     count = ICARUS_EVENTS if short_icarus(sim) else 3000
     header, config = random_config("small", 4, seed=31, count=count, pause=0.3)

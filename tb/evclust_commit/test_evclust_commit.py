@@ -143,11 +143,11 @@ if cocotb is not None:
 # ------------------------------------------------------------------------------------------
 # pytest: build, launch, check.
 
-from cosim import LEAF_BUILDS, header_width, leaf_model, run, selected_simulators  # noqa: E402
+from cosim import LEAF_BUILDS, LEAF_SIMULATORS, header_width, leaf_model, run, selected_simulators  # noqa: E402
 
 
 @pytest.mark.parametrize("build", sorted(LEAF_BUILDS))
-@pytest.mark.parametrize("sim", selected_simulators())
+@pytest.mark.parametrize("sim", selected_simulators(LEAF_SIMULATORS))
 def test_the_commit_lands_an_update_as_the_model_does(sim, build):
     from evclust.fixed.header import verilog_header
 

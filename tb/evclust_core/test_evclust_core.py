@@ -18,14 +18,25 @@ import pytest
 # ------------------------------------------------------------------------------------------
 # pytest: build per parameter set, launch, check.
 
-from cosim import CONFIGURATIONS, FORMAT_VARIANTS, ICARUS_EVENTS, cosim_share, full, random_config, run, selected_simulators, short_icarus
+from cosim import (
+    CONFIGURATIONS,
+    FORMAT_VARIANTS,
+    ICARUS_EVENTS,
+    TIMING_SIMULATORS,
+    cosim_share,
+    full,
+    random_config,
+    run,
+    selected_simulators,
+    short_icarus,
+)
 
 from evclust.vectors import CASES
 
 ROOT = Path(__file__).resolve().parents[2]
 VECTORS = ROOT / "vectors"
 SIMS = selected_simulators()
-SIMS_TIMING = selected_simulators(icarus_in_make_test=False)  # Icarus in make test-full only
+SIMS_TIMING = selected_simulators(TIMING_SIMULATORS)  # Icarus in make test-full only
 GAP, STALL = 64, 96  # random input gaps 25 % of cycles, output stalls 37.5 %
 
 

@@ -16,12 +16,12 @@ import numpy as np
 import pytest
 
 
-from cosim import cosim_share, random_config, run, selected_simulators
+from cosim import TIMING_SIMULATORS, cosim_share, random_config, run, selected_simulators
 from switch_cover import (
     COUNT, HEIGHT, ROTATING, SWITCHES, T_FRAME_US, WIDTH, all_pairs, cover, cover_stream, full, live_stream, pairs, row_params, selected_rows,
 )  # fmt: skip
 
-SIMS = selected_simulators(icarus_in_make_test=False)  # Icarus in make test-full only
+SIMS = selected_simulators(TIMING_SIMULATORS)  # Icarus in make test-full only
 GAP, STALL = 64, 96  # random input gaps 25 % of cycles, output stalls 37.5 %, as in test_evclust_core.py
 ROWS, _ = selected_rows()
 

@@ -97,7 +97,7 @@ if cocotb is not None:
 # ------------------------------------------------------------------------------------------
 # pytest: build, launch, check.
 
-from cosim import configuration_params, run, selected_simulators  # noqa: E402
+from cosim import LEAF_SIMULATORS, configuration_params, run, selected_simulators  # noqa: E402
 
 # Two builds whose decay widths differ: the traffic preset's T_half and a small sensor's.
 BUILDS = {"traffic": (480, 270, 50000.0), "small": (64, 48, 10000.0)}
@@ -120,7 +120,7 @@ def decay_build(name: str) -> tuple[str, dict, dict]:
 
 
 @pytest.mark.parametrize("build", sorted(BUILDS))
-@pytest.mark.parametrize("sim", selected_simulators())
+@pytest.mark.parametrize("sim", selected_simulators(LEAF_SIMULATORS))
 def test_the_decay_matches_the_models_functions_over_every_step_count_and_random_inputs(sim, build):
     header, parameters, config = decay_build(build)
     result = run(sim, header, "decay_vectors", config | {"seed": 7}, toplevel="evclust_decay", parameters=parameters)

@@ -121,7 +121,7 @@ if cocotb is not None:
 # ------------------------------------------------------------------------------------------
 # pytest: build, launch, check.
 
-from cosim import run, selected_simulators  # noqa: E402
+from cosim import LEAF_SIMULATORS, run, selected_simulators  # noqa: E402
 
 
 def widths(model) -> dict:
@@ -134,7 +134,7 @@ def widths(model) -> dict:
 
 
 @pytest.mark.parametrize("n", [4, 16])
-@pytest.mark.parametrize("sim", selected_simulators())
+@pytest.mark.parametrize("sim", selected_simulators(LEAF_SIMULATORS))
 def test_the_search_finds_the_lowest_slot_the_model_merges(sim, n):
     from evclust.rtl.sources import params_header
     from evclust.clusterer import ClustererParams

@@ -169,7 +169,7 @@ if cocotb is not None:
 # ------------------------------------------------------------------------------------------
 # pytest: build, launch, check.
 
-from cosim import configuration_params, cosim_share, run, selected_simulators  # noqa: E402
+from cosim import PALETTE_SIMULATORS, configuration_params, cosim_share, run, selected_simulators  # noqa: E402
 
 # Builds whose palette widths differ: the traffic preset (8 entries), and the defaults (every
 # addition on, the mixing rule's formats) on a suite-sized sensor.
@@ -206,7 +206,7 @@ LEAF_CASES = [("traffic", 1), ("defaults", 1), ("defaults", 2)]
 @pytest.mark.rotating
 @pytest.mark.parametrize(
     "sim, build, stages",
-    [(sim, *case) for sim in selected_simulators() for case in cosim_share(LEAF_CASES, 1, "palette", sim)],
+    [(sim, *case) for sim in selected_simulators(PALETTE_SIMULATORS) for case in cosim_share(LEAF_CASES, 1, "palette", sim)],
 )
 def test_the_palette_class_and_vote_match_the_models_functions(sim, build, stages):
     header, parameters, config = palette_build(build)

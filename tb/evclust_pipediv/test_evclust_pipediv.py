@@ -89,13 +89,13 @@ if cocotb is not None:
 # ------------------------------------------------------------------------------------------
 # pytest: build, launch, check.
 
-from cosim import configuration_params, run, selected_simulators  # noqa: E402
+from cosim import LEAF_SIMULATORS, configuration_params, run, selected_simulators  # noqa: E402
 
 SHAPES = {"core": (38, 21, 4), "short_first_stage": (10, 5, 3)}
 
 
 @pytest.mark.parametrize("shape", list(SHAPES))
-@pytest.mark.parametrize("sim", selected_simulators())
+@pytest.mark.parametrize("sim", selected_simulators(LEAF_SIMULATORS))
 def test_each_quotient_leaves_with_its_tag_after_the_stages(sim, shape):
     from evclust.fixed.formats import build_formats
     from evclust.fixed.header import verilog_header

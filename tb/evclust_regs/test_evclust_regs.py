@@ -256,7 +256,7 @@ if cocotb is not None:
 # ------------------------------------------------------------------------------------------
 # pytest: build, launch, check.
 
-from cosim import RTL, configuration_params, run, selected_simulators  # noqa: E402
+from cosim import LEAF_SIMULATORS, RTL, configuration_params, run, selected_simulators  # noqa: E402
 
 RDL = RTL / "evclust_regs.rdl"
 
@@ -303,7 +303,7 @@ def test_the_rdl_model_is_the_register_tables():
 
 
 @pytest.mark.parametrize("runtime", [1, 0], ids=["runtime_registers", "constants_built_in"])
-@pytest.mark.parametrize("sim", selected_simulators())
+@pytest.mark.parametrize("sim", selected_simulators(LEAF_SIMULATORS))
 def test_every_register_reads_as_the_rdl_says(sim, runtime):
     result = run(sim, _header(), "regs_vectors", {"runtime": runtime, "seed": 5 + runtime, "rdl": str(RDL)}, toplevel="evclust_regs",
                  parameters={"RUNTIME_CONFIG": runtime})  # fmt: skip

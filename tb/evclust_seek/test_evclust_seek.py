@@ -130,7 +130,7 @@ if cocotb is not None:
 # ------------------------------------------------------------------------------------------
 # pytest: build, launch, check.
 
-from cosim import run, selected_simulators  # noqa: E402
+from cosim import LEAF_SIMULATORS, run, selected_simulators  # noqa: E402
 
 
 def widths(name: str) -> dict:
@@ -153,7 +153,7 @@ def widths(name: str) -> dict:
 
 
 @pytest.mark.parametrize("build", sorted(BUILDS))
-@pytest.mark.parametrize("sim", selected_simulators())
+@pytest.mark.parametrize("sim", selected_simulators(LEAF_SIMULATORS))
 def test_the_seek_chooses_the_models_slot_and_the_lowest_free_one(sim, build):
     w = widths(build)
     parameters = {"N": w["n"], "XY_BITS": w["xy_w"], "CENTRE_BITS": w["centre_w"], "REACH_BITS": w["reach_w"], "SLOT_BITS": w["slot_w"],

@@ -70,11 +70,11 @@ if cocotb is not None:
 # ------------------------------------------------------------------------------------------
 # pytest: build, launch, check.
 
-from cosim import configuration_params, run, selected_simulators  # noqa: E402
+from cosim import LEAF_SIMULATORS, configuration_params, run, selected_simulators  # noqa: E402
 
 
 @pytest.mark.parametrize("depth", [4, 16, 64])
-@pytest.mark.parametrize("sim", selected_simulators())
+@pytest.mark.parametrize("sim", selected_simulators(LEAF_SIMULATORS))
 def test_each_read_port_shows_the_row_last_written_to_its_slot(sim, depth):
     from evclust.fixed.formats import build_formats
     from evclust.fixed.header import verilog_header

@@ -60,11 +60,11 @@ if cocotb is not None:
 # ------------------------------------------------------------------------------------------
 # pytest: build, launch, check.
 
-from cosim import configuration_params, run, selected_simulators  # noqa: E402
+from cosim import LEAF_SIMULATORS, configuration_params, run, selected_simulators  # noqa: E402
 
 
 @pytest.mark.parametrize("stages", [1, 2])
-@pytest.mark.parametrize("sim", selected_simulators())
+@pytest.mark.parametrize("sim", selected_simulators(LEAF_SIMULATORS))
 def test_the_output_is_the_word_of_the_last_advance(sim, stages):
     from evclust.fixed.formats import build_formats
     from evclust.fixed.header import verilog_header

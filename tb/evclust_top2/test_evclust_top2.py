@@ -72,11 +72,11 @@ if cocotb is not None:
 # ------------------------------------------------------------------------------------------
 # pytest: build, launch, check.
 
-from cosim import configuration_params, run, selected_simulators  # noqa: E402
+from cosim import LEAF_SIMULATORS, configuration_params, run, selected_simulators  # noqa: E402
 
 
 @pytest.mark.parametrize("n", [1, 3, 16, 64])
-@pytest.mark.parametrize("sim", selected_simulators())
+@pytest.mark.parametrize("sim", selected_simulators(LEAF_SIMULATORS))
 def test_the_tree_gives_the_smallest_key_and_the_smallest_of_the_others(sim, n):
     from evclust.fixed.formats import build_formats
     from evclust.fixed.header import verilog_header

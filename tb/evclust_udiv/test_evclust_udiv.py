@@ -86,13 +86,13 @@ if cocotb is not None:
 # ------------------------------------------------------------------------------------------
 # pytest: build, launch, check.
 
-from cosim import configuration_params, run, selected_simulators  # noqa: E402
+from cosim import LEAF_SIMULATORS, configuration_params, run, selected_simulators  # noqa: E402
 
 SHAPES = {"merge": (32, 16), "narrow": (5, 3)}
 
 
 @pytest.mark.parametrize("shape", list(SHAPES))
-@pytest.mark.parametrize("sim", selected_simulators())
+@pytest.mark.parametrize("sim", selected_simulators(LEAF_SIMULATORS))
 def test_done_rises_num_w_cycles_after_start_with_the_quotient_and_remainder(sim, shape):
     from evclust.fixed.formats import build_formats
     from evclust.fixed.header import verilog_header

@@ -163,7 +163,7 @@ if cocotb is not None:
 # ------------------------------------------------------------------------------------------
 # pytest: build, launch, check.
 
-from cosim import cosim_share, header_width, leaf_model, run, selected_simulators  # noqa: E402
+from cosim import LEAF_SIMULATORS, cosim_share, header_width, leaf_model, run, selected_simulators  # noqa: E402
 
 # One build a simulator in `make test`, drawn from the commit hash (all three in `make test-full`).
 LEAF_CASES = [("traffic", 1), ("defaults", 1), ("defaults", 2)]
@@ -171,7 +171,8 @@ LEAF_CASES = [("traffic", 1), ("defaults", 1), ("defaults", 2)]
 
 @pytest.mark.rotating
 @pytest.mark.parametrize(
-    "sim, build, stages", [(sim, *case) for sim in selected_simulators() for case in cosim_share(LEAF_CASES, 1, "update", sim)]
+    "sim, build, stages",
+    [(sim, *case) for sim in selected_simulators(LEAF_SIMULATORS) for case in cosim_share(LEAF_CASES, 1, "update", sim)],
 )
 def test_the_update_gives_the_models_increments_and_new_values(sim, build, stages):
     from evclust.fixed.header import verilog_header

@@ -15,7 +15,7 @@ from evclust.vectors import event_fields
 from evclust.vectors.pack import unpack
 from evclust.vectors.read import load_case
 
-from cosim import selected_simulators
+from cosim import TIMING_SIMULATORS, selected_simulators
 from testkit import assert_one_line_error, run_cli
 
 N = 6000
@@ -29,7 +29,7 @@ def recording(tmp_path_factory):
     return folder
 
 
-@pytest.mark.parametrize("sim", selected_simulators(icarus_in_make_test=False))  # Icarus: make test-full
+@pytest.mark.parametrize("sim", selected_simulators(TIMING_SIMULATORS))  # Icarus: make test-full
 def test_own_events_become_a_case_the_rtl_replays_bit_exact(recording, capsys, sim):
     out = recording / f"vec_{sim}"
     code, stdout, err = run_cli(
