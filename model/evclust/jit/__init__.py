@@ -184,11 +184,6 @@ def _materialise() -> None:
         _ready = True
 
 
-def numba_loaded() -> bool:
-    """Whether this process has needed numba so far."""
-    return _numba is not None
-
-
 def _lazily(func, make):
     """`make(numba)` now if numba is in use already (callers compiled later expect the dispatcher
     itself), else a `Compiled` that makes it when first needed."""

@@ -245,11 +245,3 @@ def build(functions, out=sys.stderr) -> Path | None:
             stale.unlink(missing_ok=True)
     loaded.cache_clear()
     return manifest_path
-
-
-def remove() -> None:
-    """Remove every ahead-of-time build from every folder (tests; `make clean` removes the package's)."""
-    for folder in folders():
-        for path in folder.glob(PREFIX + "*") if folder.is_dir() else ():
-            path.unlink(missing_ok=True)
-    loaded.cache_clear()
