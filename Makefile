@@ -34,8 +34,9 @@ demo: $(STAMP)
 # A real recording end to end: a DAVIS346 looking down on a street (2.4 s, 78,830 events, from
 # faery's test data; `make recordings`), tracked with the defaults and drawn, 1.23 s into the clip
 # where three cars are tracked. A camera has no frame period: 33,333 µs is given here. `track`'s
-# entry points are built ahead of time first (evclust.jit.ahead; about 20 s, a minute more on a
-# first run), so that the run itself loads no numba: under a second on this clip.
+# entry points are built ahead of time first (evclust.jit.ahead; about 20 s, 73 to 83 s in a fresh
+# clone, where numba compiles the loops first), so that the run itself loads no numba: 0.95 s
+# on this clip (docs/BENCHMARKS.md, "Real recordings").
 REAL := $(BUILD)/real/davis346
 REAL_EVENTS := $(BUILD)/recordings/davis346/davis346.aedat4
 demo-real: $(STAMP)

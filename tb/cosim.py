@@ -25,9 +25,9 @@ from evclust.rtl.configurations import (  # noqa: F401  (the testbenches' API)
 #   cycles per sweep and per merge, registers between streams, the pipelined core through gaps and
 #   stalls), the scoreboard's message, the switch-cover rows, the paper's configuration and a
 #   team's own events, which Icarus took 25 to 85 s each to repeat.
-# - LEAF_SIMULATORS: the leaf modules' benches and the AXI4-Stream wrapper's, whose Verilator
-#   builds (12 to 57 s each, most of the bench) Icarus does without; the golden vectors, a random
-#   stream, a reset and the built-in constants run the core under both in make test, and
+# - LEAF_SIMULATORS: the leaf modules' benches and the AXI4-Stream wrapper's, 160 s in all under
+#   Icarus and 306 s under Verilator, its builds included (a fresh CI run); the golden vectors, a
+#   random stream, a reset and the built-in constants run the core under both in make test, and
 #   Verilator lints every module.
 # - PALETTE_SIMULATORS: the palette's bench, whose sweeps Icarus took 46 to 112 s over against
 #   Verilator's 23 to 39 s with its build.

@@ -132,7 +132,7 @@ def test_a_stale_or_broken_build_is_ignored(monkeypatch, tmp_path):
     monkeypatch.setattr(ahead, "folders", lambda: [tmp_path])
     module, manifest = ahead._files(tmp_path, "somekey")
     export = {"module": "evclust.clusterer.float_model", "qualname": "run_events", "export": "run_events__0", "kinds": ()}
-    manifest.write_bytes(pickle.dumps({"key": "somekey", "exports": [export]}))
+    manifest.write_bytes(pickle.dumps({"exports": [export]}))
     try:
         ahead.loaded.cache_clear()
         monkeypatch.setattr(ahead, "source_key", lambda: "otherkey")  # the sources changed since

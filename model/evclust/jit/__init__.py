@@ -13,7 +13,8 @@ replaced by their dispatchers, so numba compiles calls between them, and inlines
 **Ahead of time.** `evclust.jit.ahead` loads a build of `track`'s entry points (one extension
 module, made by `python -m evclust.warm`) whose key matches the package's sources as they were
 when this module was imported. A call whose arguments are of the kinds an export was built for
-runs that export, without numba; any other call goes to numba. docs/DESIGN.md, "Compiled code
+runs that export, without numba; any other call goes to numba, and once numba is in use in a
+process (its dispatchers in the modules' names), every call does. docs/DESIGN.md, "Compiled code
 ahead of time".
 
 **The disk cache where it can be written.** Call sites keep ``cache=True``: it asks for the

@@ -100,23 +100,30 @@ def _files(folder: Path, key: str) -> tuple[Path, Path]:
     return folder / (name + sysconfig.get_config_var("EXT_SUFFIX")), folder / (name + ".manifest")
 
 
-@functools.cache
-def loaded() -> dict:
-    """{(module, qualified name): [(argument kinds, export)]} of the fresh build, if one is found."""
-    if os.environ.get(DISABLE) == "0":
-        return {}
+def _whole_builds():
+    """(module, manifest) of each build for this package's sources that has both files, in the
+    order of `folders()`."""
     key = source_key()
     for folder in folders():
         module_path, manifest_path = _files(folder, key)
-        if not manifest_path.is_file():
-            continue
+        if manifest_path.is_file() and module_path.is_file():
+            yield module_path, manifest_path
+
+
+@functools.cache
+def loaded() -> dict:
+    """{(module, qualified name): [(argument kinds, export)]} of the first build that loads."""
+    if os.environ.get(DISABLE) == "0":
+        return {}
+    for module_path, manifest_path in _whole_builds():
+        name = module_path.name.split(".")[0]
         try:
             manifest = pickle.loads(manifest_path.read_bytes())
-            loader = importlib.machinery.ExtensionFileLoader(PREFIX + key, str(module_path))
-            spec = importlib.util.spec_from_file_location(PREFIX + key, module_path, loader=loader)
+            loader = importlib.machinery.ExtensionFileLoader(name, str(module_path))
+            spec = importlib.util.spec_from_file_location(name, module_path, loader=loader)
             module = importlib.util.module_from_spec(spec)
             loader.exec_module(module)
-        except Exception:  # a broken or half-deleted build: numba serves
+        except Exception:  # a broken build: the next one, or numba
             continue
         exports = {}
         for entry in manifest["exports"]:
@@ -132,12 +139,7 @@ def exports_for(func) -> list:
 
 def location() -> Path | None:
     """The manifest of the build that serves this package's sources, if one is there whole."""
-    key = source_key()
-    for folder in folders():
-        module_path, manifest_path = _files(folder, key)
-        if manifest_path.is_file() and module_path.is_file():
-            return manifest_path
-    return None
+    return next((manifest for _, manifest in _whole_builds()), None)
 
 
 # The kinds of argument an export is built for, in the words numba's dispatch goes by: an array's
@@ -238,7 +240,7 @@ def build(functions, out=sys.stderr) -> Path | None:
         built = next(Path(scratch).glob(PREFIX + key + "*"))
         os.replace(built, module_path)
     staged = manifest_path.with_suffix(".manifest.tmp")
-    staged.write_bytes(pickle.dumps({"key": key, "exports": entries}))
+    staged.write_bytes(pickle.dumps({"exports": entries}))  # the key is in the file's name
     os.replace(staged, manifest_path)  # last: a manifest means its module is whole
     for stale in folder.glob(PREFIX + "*"):
         if not stale.name.startswith(PREFIX + key):
