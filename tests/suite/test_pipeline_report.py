@@ -5,18 +5,31 @@ from __future__ import annotations
 import numpy as np
 
 from evclust.cli import main
-from evclust.suite.pipeline import PERTURBATIONS, TARGET_POINTS, configurations, section
+from evclust.suite.pipeline import PERTURBATIONS, REFERENCE_VARIANTS, TARGET_POINTS, configurations, section
 
 
 def test_every_delay_is_paired_with_the_sequential_update_on_every_perturbation():
-    runs = configurations(delays=(2, 5))
+    runs = [c for c in configurations(delays=(2, 5)) if c.name.split("|")[1].isdigit()]
     names = {(c.name.split("|")[0], int(c.name.split("|")[1])) for c in runs}
     assert names == {(p, d) for p in PERTURBATIONS for d in (0, 2, 5)}
     for c in runs:
         perturbation, delay = c.name.split("|")
-        assert c.params.update_delay == int(delay) and c.model == "float"
+        assert c.params.update_delay == int(delay) and c.model == "float" and not c.params.activity_reference
         for key, value in PERTURBATIONS[perturbation].items():
             assert getattr(c.params, key) == value
+
+
+def test_the_activity_reference_is_paired_with_the_papers_activity_in_each_model():
+    by_name = {c.name: c for c in configurations(delays=(2,))}
+    for perturbation, update in PERTURBATIONS.items():
+        for model, (before, after) in REFERENCE_VARIANTS.items():
+            a, b = by_name[f"{perturbation}|{before}"], by_name[f"{perturbation}|{after}"]
+            assert (a.model, b.model) == (model, model)
+            assert not a.params.activity_reference and b.params.activity_reference
+            assert a.params.update_delay == b.params.update_delay == 0
+            assert a.params.model_copy(update={"activity_reference": True}) == b.params  # the one switch apart
+            for key, value in update.items():
+                assert getattr(b.params, key) == value
 
 
 def test_the_page_gives_the_mean_change_and_its_standard_error_and_judges_the_target():

@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 
-from evclust.clusterer.params import GAMMA_MODES
+from evclust.clusterer.params import GAMMA_MODES, REFERENCE_HALVINGS
 from evclust.jit import named_record
 
 FIELDS = (
@@ -16,7 +16,7 @@ FIELDS = (
     "gamma", "gamma_mode", "tau_us", "t_frame_us", "p_correction", "background_fixed", "luma_weight", "hist_max",
     "v_min", "exit_margin", "v_exit", "cos_exit", "width", "height", "has_colour", "warm_start", "mcm_correct",
     "vote_contrast", "mixing", "mixing_tolerance", "merge", "merge_scale", "merge_v_tol", "merge_v_rel", "noise_gate",
-    "create_support", "support_cell_bits", "support_window_us", "interval_warmup",
+    "create_support", "support_cell_bits", "support_window_us", "interval_warmup", "activity_reference", "reference_halvings",
 )  # fmt: skip
 DTYPE = np.dtype([(name, np.float64) for name in FIELDS])
 
@@ -42,5 +42,7 @@ def param_vector(p, width: int, height: int, t_frame_us: float, has_colour: bool
         "vote_contrast": p.palette_vote == "contrast",
         "mixing": p.palette_assign == "mixing",
         "interval_warmup": p.interval_warmup(),
+        "activity_reference": p.activity_reference,
+        "reference_halvings": REFERENCE_HALVINGS,
     }
     return named_record(DTYPE, values)

@@ -54,6 +54,36 @@ def _decayed(activity, dt_us, t_half_us, precision=None):
 
 
 @njit(cache=True, nogil=True, inline="always")
+def _weight(G, t, k):
+    """Activity against a reference time: an event's weight 2^((t - t_ref)/T_half). The reference
+    is the background activity's time G[BG_T], which every slot shares in this mode."""
+    return math.exp2((t - G[BG_T]) / k.t_half_us)
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _q_referenced(x, precision, k):
+    """Ã rounded as the activity is, and saturated reference_halvings integer bits above its top."""
+    if precision is None or precision[Q_ACT, P_FRAC] < 0:
+        return x
+    scale = 2.0 ** precision[Q_ACT, P_FRAC]
+    v = math.floor(x * scale + 0.5 * precision[Q_ACT, P_NEAREST]) / scale
+    return min(max(v, precision[Q_ACT, P_LO]), precision[Q_ACT, P_HI] * 2.0**k.reference_halvings)
+
+
+@njit(cache=True, nogil=True)
+def _move_reference(S, G, t, k, precision):
+    """Activity against a reference time: every activity (the slots' Ã and the background's) decayed
+    from the reference to t, which becomes the reference (a filter step, or an event
+    reference_halvings half-lives after it)."""
+    dt = t - G[BG_T]
+    for s in range(S.shape[0]):
+        if S[s, VALID] != 0.0:
+            S[s, ACT] = _q(_decayed(S[s, ACT], dt, k.t_half_us, precision), Q_ACT, precision)
+    G[BG_ACT] = _q(_decayed(G[BG_ACT], dt, k.t_half_us, precision), Q_ACT, precision)
+    G[BG_T] = t
+
+
+@njit(cache=True, nogil=True, inline="always")
 def _gamma(activity, k):
     """γ of eq. (5) from the activity: the paper's global constant, or the cluster's events per
     frame, A·ln2·T_frame/T_half (also the count mode's guess until its first full interval).
@@ -127,11 +157,20 @@ def _slot_for_new(S, G, t, k, precision):
         if S[s, VALID] == 0.0:
             return s
     weakest, weakest_a = -1, np.inf
-    for s in range(S.shape[0]):
-        a = _q(_decayed(S[s, ACT], t - S[s, T_LAST], k.t_half_us, precision), Q_ACT, precision)
-        if a < weakest_a:
-            weakest, weakest_a = s, a
-    if weakest_a < k.a_valid:
+    if k.activity_reference != 0.0:
+        # Every Ã has the one reference: the weakest now has the least Ã, and A < A_valid is
+        # Ã < A_valid·w with the event's weight w.
+        for s in range(S.shape[0]):
+            if S[s, ACT] < weakest_a:
+                weakest, weakest_a = s, S[s, ACT]
+        limit = k.a_valid * _weight(G, t, k)
+    else:
+        for s in range(S.shape[0]):
+            a = _q(_decayed(S[s, ACT], t - S[s, T_LAST], k.t_half_us, precision), Q_ACT, precision)
+            if a < weakest_a:
+                weakest, weakest_a = s, a
+        limit = k.a_valid
+    if weakest_a < limit:
         G[EVICTED] += 1
         return weakest
     return -1
@@ -146,7 +185,7 @@ def _create(S, H, G, s, t, x, y, lum, cb, cr, k, precision):
     S[s, PX], S[s, PY] = x, y
     S[s, PPX], S[s, PPY] = x, y
     S[s, RX], S[s, RY] = k.r_init, k.r_init
-    S[s, ACT] = 1.0
+    S[s, ACT] = _q_referenced(_weight(G, t, k), precision, k) if k.activity_reference != 0.0 else 1.0
     S[s, GAMMA] = _q(_gamma(1.0, k), Q_GAMMA, precision)
     S[s, T_LAST] = t
     S[s, CY], S[s, CCB], S[s, CCR] = lum, cb, cr
@@ -197,8 +236,11 @@ def _commit(S, H, G, row, k, precision):
     paper's update exactly. Then the event's background-colour update (step 4)."""
     if row[PD_LIVE] != 0.0:
         s, t = int(row[PD_SLOT]), row[PD_T]
-        a = _q(_decayed(S[s, ACT], t - S[s, T_LAST], k.t_half_us, precision), Q_ACT, precision) + 1.0
-        S[s, ACT] = _q(a, Q_ACT, precision)
+        if k.activity_reference != 0.0:  # an addition: the event's weight
+            S[s, ACT] = _q_referenced(S[s, ACT] + _weight(G, t, k), precision, k)
+        else:  # decayed from the slot's own time, plus one
+            a = _q(_decayed(S[s, ACT], t - S[s, T_LAST], k.t_half_us, precision), Q_ACT, precision) + 1.0
+            S[s, ACT] = _q(a, Q_ACT, precision)
         S[s, RX] = min(max(_q(S[s, RX] + row[PD_RX], Q_HALF, precision), k.r_min), k.r_max)
         S[s, RY] = min(max(_q(S[s, RY] + row[PD_RY], Q_HALF, precision), k.r_min), k.r_max)
         S[s, VMX] = _q(S[s, VMX] + row[PD_VMX], Q_VM, precision)
@@ -333,12 +375,16 @@ def _filter_step(S, H, G, t, k, palette, background_mask, out, n_out, precision)
     interval_due = boundaries > 0
     per_frame = k.t_frame_us / (max(boundaries, 1) * k.tau_us)  # T_frame over the time measured
     v_min = k.v_min
-    G[BG_ACT] = _q(_decayed(G[BG_ACT], t - G[BG_T], k.t_half_us, precision), Q_ACT, precision)
-    G[BG_T] = t
+    if k.activity_reference != 0.0:
+        _move_reference(S, G, t, k, precision)  # every activity decayed to t at once
+    else:
+        G[BG_ACT] = _q(_decayed(G[BG_ACT], t - G[BG_T], k.t_half_us, precision), Q_ACT, precision)
+        G[BG_T] = t
     for s in range(S.shape[0]):
         if S[s, VALID] == 0.0:
             continue
-        S[s, ACT] = _q(_decayed(S[s, ACT], t - S[s, T_LAST], k.t_half_us, precision), Q_ACT, precision)
+        if k.activity_reference == 0.0:
+            S[s, ACT] = _q(_decayed(S[s, ACT], t - S[s, T_LAST], k.t_half_us, precision), Q_ACT, precision)
         S[s, T_LAST] = t
         if S[s, ACT] < k.a_min:
             S[s, VALID] = 0.0
@@ -456,6 +502,10 @@ def run_events(S, H, G, k, palette, background_mask, support, line, t_us, xs, ys
         if G[EVENTS] == 0:
             G[T_FILTER] = t  # the filter-step clock and the τ boundaries start at the first event
             G[T_FIRST] = t
+        if k.activity_reference != 0.0 and t - G[BG_T] > k.reference_halvings * k.t_half_us:
+            # Ã would outgrow its headroom: commit what is in flight and move the reference to t.
+            _drain(S, H, G, line, k, precision)
+            _move_reference(S, G, t, k, precision)
         G[EVENTS] += 1
         row = line[int(G[EVENTS]) % (delay + 1)]  # it holds event n - D - 1: its turn to commit
         if delay > 0:
@@ -480,8 +530,11 @@ def run_events(S, H, G, k, palette, background_mask, support, line, t_us, xs, ys
             support[cy, cx] = t
         # Step 4: events that do not update a reported cluster track the background colour.
         if not updated_reported and k.noise_gate > 0.0:  # the activity of the events no reported cluster takes
-            G[BG_ACT] = _q(_decayed(G[BG_ACT], t - G[BG_T], k.t_half_us, precision), Q_ACT, precision) + 1.0
-            G[BG_T] = t
+            if k.activity_reference != 0.0:
+                G[BG_ACT] = _q_referenced(G[BG_ACT] + _weight(G, t, k), precision, k)
+            else:
+                G[BG_ACT] = _q(_decayed(G[BG_ACT], t - G[BG_T], k.t_half_us, precision), Q_ACT, precision) + 1.0
+                G[BG_T] = t
         if k.has_colour != 0.0 and k.background_fixed == 0.0 and not updated_reported:
             row[PD_BG] = 1.0
             row[PD_BG_Y] = k.beta_bg * (lum - G[BG_Y])

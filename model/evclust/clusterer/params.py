@@ -35,6 +35,12 @@ class PaletteEntry(BaseModel):
 # γ's modes, in the order of their codes in both models and the RTL (GAMMA_MODE_* in the header).
 GAMMA_MODES = ("global", "activity", "count")
 
+# The activity against a reference time (activity_reference) holds Ã = A·2^((t - t_ref)/T_half),
+# which grows by up to 2^REFERENCE_HALVINGS before the reference moves (at a filter step, or first
+# at an event this many half-lives after it): the fixed model gives Ã that many integer bits more
+# than the activity. The RTL does not implement the mode yet, so its header does not carry them.
+REFERENCE_HALVINGS = 4
+
 MAX_WARMUP = 64  # the interval filter's running mean covers at most this many measurements
 
 DEFAULT_PALETTE = tuple(PaletteEntry(name=c.name, rgb=c.rgb) for c in NAMED_COLOURS)
@@ -51,6 +57,13 @@ class ClustererParams(BaseModel):
     # each update is committed as increments added to the slot as it then is (docs/DESIGN.md,
     # "Pipeline semantics"). 0: the paper's sequential update.
     update_delay: Annotated[int, Field(ge=0, le=64)] = 0
+    # Beyond the paper: the activity against a reference time (docs/DESIGN.md, "Activity against a
+    # reference time"). Between filter steps each slot keeps Ã = A·2^((t - t_ref)/T_half), t_ref the
+    # last step's time, so an event adds its weight 2^((t - t_ref)/T_half), one value per event and
+    # the same for every slot: the per-event update of the activity is an addition, with no decay
+    # in its recurrence. The step decays every slot by the same 2^-((t - t_ref)/T_half). False: the
+    # paper's decay-then-add at every event.
+    activity_reference: bool = False
     # The defaults hold across the generalization suite: they were tuned on its tuning split
     # (evclust tune --suite tuning, docs/TUNING.md), never on its test split.
     seek_margin: NonNegative = 2.7  # S, px: a cluster catches events within its box grown by S (+ seek_scale·max R)

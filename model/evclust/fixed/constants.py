@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from evclust.clusterer.params import GAMMA_MODES
+from evclust.clusterer.params import GAMMA_MODES, REFERENCE_HALVINGS
 from evclust.fixed.formats import NOISE_GATE_FRAC_BITS, SCALE_FRAC_BITS
 from evclust.jit import named_record
 
@@ -30,6 +30,8 @@ FIELDS = (
     # Parameters as integers: counts, switches, the sensor.
     "filter_every", "tau_us", "gamma_mode", "background_fixed", "hist_max", "width", "height", "has_colour", "warm_start",
     "mcm_correct", "vote_contrast", "mixing", "merge", "create_support", "support_cell_bits", "interval_warmup",
+    # The activity against a reference time: the switch, Ã's halvings of headroom and its raw top.
+    "activity_reference", "reference_halvings", "activity_reference_max",
 )  # fmt: skip
 DTYPE = np.dtype([(name, np.int64) for name in FIELDS])
 
@@ -86,5 +88,8 @@ def constant_vector(table, params, has_colour: bool) -> np.record:
         "create_support": params.create_support,
         "support_cell_bits": params.support_cell_bits,
         "interval_warmup": params.interval_warmup(),
+        "activity_reference": params.activity_reference,
+        "reference_halvings": REFERENCE_HALVINGS,
+        "activity_reference_max": ((f["activity"].raw_max + 1) << REFERENCE_HALVINGS) - 1,
     }
     return named_record(DTYPE, values)

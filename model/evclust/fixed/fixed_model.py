@@ -102,6 +102,40 @@ def _decay_background(G, t, k, table):
 
 
 @njit(cache=True, nogil=True, inline="always")
+def _reference_steps(G, t, k):
+    """Activity against a reference time: Δt/T_half from the reference to t in decay-table steps,
+    the reference's residual included. The reference is the background activity's time G[BG_T],
+    which every slot shares in this mode."""
+    m, _ = decay_steps_nb((t - G[BG_T]) & TIME_MASK, G[BG_RESIDUAL], k.inv_t_half, k.inv_t_half_frac, DECAY_TABLE_BITS)
+    return m
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _weight(G, t, k, table):
+    """An event's weight 2^(m/64) in the activity's format, m its steps since the reference (at most
+    reference_halvings·64): 2^reference_halvings decayed by the steps left to that top, so the
+    decay's own table and shift make it. Exactly 1 at the reference, 2^reference_halvings at the top."""
+    top = k.reference_halvings << DECAY_TABLE_BITS
+    highest = (np.int64(1) << k.activity_frac) << k.reference_halvings
+    return decay_apply_nb(highest, top - _reference_steps(G, t, k), table, DECAY_TABLE_BITS, DECAY_FRAC_BITS, FLOOR)
+
+
+@njit(cache=True, nogil=True)
+def _move_reference(S, G, t, k, table, log, ranges):
+    """Every activity (the slots' Ã and the background's) decayed from the reference to t by the
+    same steps (one multiply by inv_t_half, one residual) and saturated to the activity's format; t
+    becomes the reference. At a filter step, or first at an event reference_halvings half-lives on."""
+    m, G[BG_RESIDUAL] = decay_steps_nb((t - G[BG_T]) & TIME_MASK, G[BG_RESIDUAL], k.inv_t_half, k.inv_t_half_frac, DECAY_TABLE_BITS)
+    for s in range(S.shape[0]):
+        if S[s, VALID] != 0:
+            a = decay_apply_nb(S[s, ACT], m, table, DECAY_TABLE_BITS, DECAY_FRAC_BITS, FLOOR)
+            S[s, ACT] = _store(a, 0, k.activity_max, S_ACT, log, ranges)
+    a = decay_apply_nb(G[BG_ACT], m, table, DECAY_TABLE_BITS, DECAY_FRAC_BITS, FLOOR)
+    G[BG_ACT] = _store(a, 0, k.activity_max, S_ACT, log, ranges)
+    G[BG_T] = t
+
+
+@njit(cache=True, nogil=True, inline="always")
 def _gamma_from_activity(a, k):
     if k.gamma_mode == 0:
         return k.gamma_global
@@ -192,7 +226,7 @@ def refresh_mixing(G, palette, inv_ww, k):
 
 
 @njit(cache=True, nogil=True)
-def _create(S, H, G, s, t, ex, ey, lum, cb, cr, k):
+def _create(S, H, G, s, t, ex, ey, lum, cb, cr, k, table):
     S[s, :] = 0
     S[s, VALID] = 1
     S[s, ID] = G[NEXT_ID]
@@ -200,8 +234,9 @@ def _create(S, H, G, s, t, ex, ey, lum, cb, cr, k):
     x, y = ex << k.centre_frac, ey << k.centre_frac
     S[s, PX], S[s, PY], S[s, PPX], S[s, PPY] = x, y, x, y
     S[s, RX], S[s, RY] = k.r_init, k.r_init
-    S[s, ACT] = np.int64(1) << k.activity_frac
-    S[s, GAMMA] = _gamma_from_activity(S[s, ACT], k)
+    one = np.int64(1) << k.activity_frac
+    S[s, ACT] = _weight(G, t, k, table) if k.activity_reference != 0 else one
+    S[s, GAMMA] = _gamma_from_activity(one, k)
     S[s, T_LAST] = t
     S[s, CY], S[s, CCB], S[s, CCR] = lum << k.colour_frac, cb << k.colour_frac, cr << k.colour_frac
     H[s, :] = 0
@@ -257,11 +292,16 @@ def _commit(S, H, G, row, k, table, log, ranges):
     """Step 3, write half: the increments added to the slot as it is now, each saturated to its
     format (with no delay the state read is the state now, and no saturation can act: the paper's
     update exactly). 3a, the activity: decayed from the slot's own reference time, plus one (in
-    event order, so exact whatever the delay). Then the event's background-colour update."""
+    event order, so exact whatever the delay); against a reference time, plus the event's weight.
+    Then the event's background-colour update."""
     if row[PD_LIVE] != 0:
         s, t = row[PD_SLOT], row[PD_T]
-        _decay_slot(S, s, t, k, table)
-        S[s, ACT] = _store(S[s, ACT] + (np.int64(1) << k.activity_frac), 0, k.activity_max, S_ACT, log, ranges)
+        if k.activity_reference != 0:  # an addition: the event's weight
+            S[s, ACT] = _store(S[s, ACT] + _weight(G, t, k, table), 0, k.activity_reference_max, S_ACT, log, ranges)
+            S[s, T_LAST] = t
+        else:  # decayed from the slot's own time, plus one
+            _decay_slot(S, s, t, k, table)
+            S[s, ACT] = _store(S[s, ACT] + (np.int64(1) << k.activity_frac), 0, k.activity_max, S_ACT, log, ranges)
         S[s, RX] = _seen(min(max(S[s, RX] + row[PD_RX], k.r_min), k.r_max), S_HALF, ranges)
         S[s, RY] = _seen(min(max(S[s, RY] + row[PD_RY], k.r_min), k.r_max), S_HALF, ranges)
         S[s, VMX] = _store(S[s, VMX] + row[PD_VMX], k.v_mcm_min, k.v_mcm_max, S_VM, log, ranges)
@@ -310,11 +350,20 @@ def _slot_for_new(S, G, t, k, table):
         if S[s, VALID] == 0:
             return s
     weakest, weakest_a = -1, np.int64(1) << 62
-    for s in range(S.shape[0]):
-        a = _decayed(S[s, ACT], (t - S[s, T_LAST]) & TIME_MASK, k, table)
-        if a < weakest_a:
-            weakest, weakest_a = s, a
-    if weakest_a < k.a_valid:
+    if k.activity_reference != 0:
+        # Every Ã has the one reference: the weakest now has the least Ã (no multiply per slot),
+        # and A < A_valid is Ã < A_valid·w, compared with the activity's fraction bits twice.
+        for s in range(S.shape[0]):
+            if S[s, ACT] < weakest_a:
+                weakest, weakest_a = s, S[s, ACT]
+        evict = (weakest_a << k.activity_frac) < k.a_valid * _weight(G, t, k, table)
+    else:
+        for s in range(S.shape[0]):
+            a = _decayed(S[s, ACT], (t - S[s, T_LAST]) & TIME_MASK, k, table)
+            if a < weakest_a:
+                weakest, weakest_a = s, a
+        evict = weakest_a < k.a_valid
+    if evict:
         G[EVICTED] += 1
         return weakest
     return -1
@@ -415,12 +464,18 @@ def _filter_step(S, H, G, t, k, table, gains, palette, inv_ww, background_mask, 
     G[TAU_PHASE] = phase - boundaries * k.tau_us
     per_frame = k.frame_per_tau // max(boundaries, 1)  # T_frame/(n·τ), Q?.F_fpt
     fp, fv, fw, fi, fc = k.centre_frac, k.v_mcm_frac, k.mcm_norm_frac, k.v_int_frac, k.colour_frac
-    _decay_background(G, t, k, table)
+    if k.activity_reference != 0:
+        _move_reference(S, G, t, k, table, log, ranges)  # every activity decayed to t at once
+    else:
+        _decay_background(G, t, k, table)
     sensor = k.width * k.height
     for s in range(S.shape[0]):
         if S[s, VALID] == 0:
             continue
-        _decay_slot(S, s, t, k, table)
+        if k.activity_reference != 0:
+            S[s, T_LAST] = t
+        else:
+            _decay_slot(S, s, t, k, table)
         if S[s, ACT] < k.a_min:
             S[s, VALID] = 0
             G[EXPIRED] += 1
@@ -558,6 +613,10 @@ def run_events(S, H, G, k, table, gains, palette, inv_ww, background_mask, suppo
             G[T_FILTER] = t
             G[T_FIRST] = t
             G[TAU_PHASE] = 0  # τ boundaries count from the first event, as in the float model
+        if k.activity_reference != 0 and _reference_steps(G, t, k) > (k.reference_halvings << DECAY_TABLE_BITS):
+            # Ã would outgrow its headroom: commit what is in flight and move the reference to t.
+            _drain(S, H, G, line, k, table, log, ranges)
+            _move_reference(S, G, t, k, table, log, ranges)
         G[EVENTS] += 1
         row = line[G[EVENTS] % (delay + 1)]  # it holds event n - D - 1: its turn to commit
         if delay > 0:
@@ -574,7 +633,7 @@ def run_events(S, H, G, k, table, gains, palette, inv_ww, background_mask, suppo
             s = _slot_for_new(S, G, t, k, table)
             if s >= 0:
                 _cancel(line, s)
-                _create(S, H, G, s, t, ex, ey, lum, cb, cr, k)
+                _create(S, H, G, s, t, ex, ey, lum, cb, cr, k, table)
                 action = TRACE_EVICT if G[EVICTED] > evicted_before else TRACE_CREATE
             else:
                 G[DROPPED] += 1
@@ -588,8 +647,11 @@ def run_events(S, H, G, k, table, gains, palette, inv_ww, background_mask, suppo
             support[cy, cx] = t
             seen[cy, cx] = True
         if not updated_reported and k.noise_gate != 0:  # the background's activity: read by the noise gate only
-            _decay_background(G, t, k, table)
-            G[BG_ACT] = _store(G[BG_ACT] + (np.int64(1) << k.activity_frac), 0, k.activity_max, S_ACT, log, ranges)
+            if k.activity_reference != 0:
+                G[BG_ACT] = _store(G[BG_ACT] + _weight(G, t, k, table), 0, k.activity_reference_max, S_ACT, log, ranges)
+            else:
+                _decay_background(G, t, k, table)
+                G[BG_ACT] = _store(G[BG_ACT] + (np.int64(1) << k.activity_frac), 0, k.activity_max, S_ACT, log, ranges)
         if k.has_colour != 0 and k.background_fixed == 0 and not updated_reported:
             row[PD_BG] = 1
             row[PD_BG_Y] = alpha_increment_nb(G[BG_Y], lum, k.beta_bg, k.beta_bg_frac, fb, FLOOR)

@@ -66,6 +66,9 @@ def require_rtl_semantics(params) -> None:
     if params.update_delay not in RTL_UPDATE_DELAYS:
         raise EvclustError(f"clusterer: update_delay = {params.update_delay}, but the RTL implements update_delay "
                            f"{' or '.join(map(str, RTL_UPDATE_DELAYS))}; the float and fixed models run any delay")  # fmt: skip
+    if params.activity_reference:
+        raise EvclustError("clusterer: activity_reference = true, but the RTL keeps the activity against each slot's own time; "
+                           "the float and fixed models run either")  # fmt: skip
 
 
 def params_header(params, width: int, height: int, t_frame_us: float, **formats) -> str:

@@ -1,5 +1,6 @@
-"""`evclust generalize --pipeline`: what the pipeline semantics (ClustererParams.update_delay) cost
-in accuracy, written as docs/PIPELINE.md.
+"""`evclust generalize --pipeline`: what the pipeline semantics (ClustererParams.update_delay, and
+the activity against a reference time, activity_reference) cost in accuracy, written as
+docs/PIPELINE.md.
 
 One run says little: a change of 10^-4 in one α moves the object records' HOTA by up to a point,
 because a scene's few identity decisions flip. So each delay is compared pairwise, on the
@@ -33,30 +34,49 @@ TARGET_POINTS = 0.5  # at most this many HOTA points lost on the test split
 LEVELS = (("objects", "what the defaults report (object records)"), ("clusters", "the cluster records below them"))
 
 
+# The activity against a reference time, against the paper's decay-then-add, in each model: the
+# float model shows the rule (equal in exact arithmetic but at merges), the fixed model its roundings.
+REFERENCE_VARIANTS = {"float": ("0", "reference"), "fixed": ("0~fixed", "reference~fixed")}
+
+
 def configurations(delays=DELAYS) -> list[Configuration]:
     base = ClustererParams()
-    return [Configuration(f"{name}|{d}", base.model_copy(update={**update, "update_delay": d}), "float")
-            for name, update in PERTURBATIONS.items() for d in (0, *delays)]  # fmt: skip
+    delayed = [Configuration(f"{name}|{d}", base.model_copy(update={**update, "update_delay": d}), "float")
+               for name, update in PERTURBATIONS.items() for d in (0, *delays)]  # fmt: skip
+    referenced = [
+        Configuration(f"{name}|{variant}", base.model_copy(update={**update, "activity_reference": variant.startswith("reference")}), model)
+        for name, update in PERTURBATIONS.items()
+        for model, variants in REFERENCE_VARIANTS.items()
+        for variant in variants
+        if variant != "0"  # the float model's D = 0 run is the delays' own
+    ]
+    return delayed + referenced
+
+
+def _pooled(runs: list[SuiteRun]) -> dict:
+    """{(perturbation, variant): {level: pooled figures}}."""
+    return {tuple(r.configuration.name.split("|")): {"objects": figures(r.results), "clusters": figures(r.cluster_results)}
+            for r in runs}  # fmt: skip
+
+
+def _pairs(pooled: dict, before: str, after: str, level: str) -> dict:
+    pairs = [(pooled[n, before][level], pooled[n, after][level]) for n in PERTURBATIONS]
+    out = {key: np.array([100.0 * ((b[key] or 0.0) - (a[key] or 0.0)) for a, b in pairs]) for key in ("HOTA", "recall", "precision")}
+    out["base"] = pairs[0]
+    return out
 
 
 def paired_changes(runs: list[SuiteRun]) -> dict:
-    """{(delay, level): {"hota": per-perturbation HOTA change in points, "d0": HOTA at D = 0, ...}}."""
-    pooled = {}
-    for r in runs:
-        name, delay = r.configuration.name.split("|")
-        objects = figures(r.results)
-        clusters = figures(r.cluster_results)
-        pooled[name, int(delay)] = {"objects": objects, "clusters": clusters}
-    out = {}
-    delays = sorted({d for _, d in pooled if d})
-    for d in delays:
-        for level, _ in LEVELS:
-            pairs = [(pooled[n, 0][level], pooled[n, d][level]) for n in PERTURBATIONS]
-            out[d, level] = {
-                key: np.array([100.0 * ((b[key] or 0.0) - (a[key] or 0.0)) for a, b in pairs]) for key in ("HOTA", "recall", "precision")
-            }
-            out[d, level]["base"] = pairs[0]
-    return out
+    """{(delay, level): {"HOTA": per-perturbation HOTA change in points, ..., "base": the defaults' (D = 0, D) figures}}."""
+    pooled = _pooled(runs)
+    delays = sorted({int(v) for _, v in pooled if v.isdigit() and v != "0"})
+    return {(d, level): _pairs(pooled, "0", str(d), level) for d in delays for level, _ in LEVELS}
+
+
+def reference_changes(runs: list[SuiteRun]) -> dict:
+    """{(model, level): the same, the activity against a reference time against the paper's activity}."""
+    pooled = _pooled(runs)
+    return {(model, level): _pairs(pooled, *variants, level) for model, variants in REFERENCE_VARIANTS.items() for level, _ in LEVELS}
 
 
 def _mean_se(values: np.ndarray) -> str:
@@ -80,8 +100,25 @@ def section(split: str, changes: dict, held_out: bool) -> list[str]:
     return lines
 
 
-def write_page(by_split: dict, out: Path, command: str, machine: str, scenes: dict) -> str:
-    """`by_split`: {split: paired_changes(...)}, the test split first."""
+def reference_section(changes: dict, held_out: bool) -> list[str]:
+    head = "| model | records | HOTA, paper's activity → referenced (defaults) | HOTA change, mean ± s.e. (points) | per parameter set | recall change | precision change |"
+    lines = [head, "|" + "---|" * (head.count("|") - 1)]
+    for (model, level), c in changes.items():
+        a, b = c["base"]
+        lines.append(f"| {model} | {level} | {100 * a['HOTA']:.1f} → {100 * b['HOTA']:.1f} % | {_mean_se(c['HOTA'])} | "
+                     f"{', '.join(f'{x:+.2f}' for x in c['HOTA'])} | {_mean_se(c['recall'])} | {_mean_se(c['precision'])} |")  # fmt: skip
+    if held_out:
+        lines += ["", f"Target: at most {TARGET_POINTS:g} HOTA points of what the defaults report on this split.", "",
+                  "| model | mean change | met |", "|---|---|---|"]  # fmt: skip
+        for (model, level), c in changes.items():
+            if level == "objects":
+                lines.append(f"| {model} | {c['HOTA'].mean():+.2f} points | {'yes' if c['HOTA'].mean() >= -TARGET_POINTS else 'no'} |")
+    return lines
+
+
+def write_page(by_split: dict, out: Path, command: str, machine: str, scenes: dict, reference_by_split: dict) -> str:
+    """`by_split`: {split: paired_changes(...)}, the test split first; `reference_by_split`:
+    {split: reference_changes(...)}."""
     lines = [
         "# Pipeline semantics: what the delayed update costs",
         "",
@@ -105,6 +142,23 @@ def write_page(by_split: dict, out: Path, command: str, machine: str, scenes: di
         what = ("held out: no parameter, threshold or design rule was chosen on it" if held_out else
                 "the split the defaults were tuned on, with the sequential update: not a held-out measure")  # fmt: skip
         lines += [f"## {split} split ({scenes[split]} scenes; {what})", "", *section(split, changes, held_out), ""]
+    lines += [
+        "## The activity against a reference time",
+        "",
+        "With `activity_reference` each slot keeps, between filter steps, Ã = A·2^((t − t_ref)/T_half) against the last "
+        "step's time t_ref: an event adds its weight 2^((t − t_ref)/T_half), one value per event and the same for every "
+        "slot, so the update of the activity is an addition and the decay leaves the per-event recurrence; the step "
+        'decays every activity by one factor (docs/DESIGN.md, "Activity against a reference time"). In exact arithmetic '
+        "the activity is the paper's, except at merges, where the paper's sweep adds a later slot's activity before it "
+        "has decayed it to the step. Each row compares the mode with the paper's activity at D = 0, paired over the same "
+        "parameter sets, in the float model and in the fixed model (whose roundings differ: a floored weight per event "
+        "and one decay per step, instead of a decay per event).",
+        "",
+    ]
+    for split, changes in reference_by_split.items():
+        held_out = split == "test"
+        lines += [f"### {split} split{' (held out)' if held_out else ' (the defaults were tuned on it: not a held-out measure)'}", "",
+                  *reference_section(changes, held_out), ""]  # fmt: skip
     lines += commands_section(("make generalize          # this page, with docs/GENERALIZATION.md",
                                "evclust generalize --pipeline -o docs/PIPELINE.md"))  # fmt: skip
     return save_page(out, lines, "PIPELINE")
