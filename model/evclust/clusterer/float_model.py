@@ -502,6 +502,8 @@ def run_events(S, H, G, k, palette, background_mask, support, line, t_us, xs, ys
         if G[EVENTS] == 0:
             G[T_FILTER] = t  # the filter-step clock and the τ boundaries start at the first event
             G[T_FIRST] = t
+            if k.activity_reference != 0.0:  # so does the activity's reference
+                G[BG_T] = t
         if k.activity_reference != 0.0 and t - G[BG_T] > k.reference_halvings * k.t_half_us:
             # Ã would outgrow its headroom: commit what is in flight and move the reference to t.
             _drain(S, H, G, line, k, precision)

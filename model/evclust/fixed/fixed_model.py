@@ -613,6 +613,8 @@ def run_events(S, H, G, k, table, gains, palette, inv_ww, background_mask, suppo
             G[T_FILTER] = t
             G[T_FIRST] = t
             G[TAU_PHASE] = 0  # τ boundaries count from the first event, as in the float model
+            if k.activity_reference != 0:  # so does the activity's reference
+                G[BG_T], G[BG_RESIDUAL] = t, 0
         if k.activity_reference != 0 and _reference_steps(G, t, k) > (k.reference_halvings << DECAY_TABLE_BITS):
             # Ã would outgrow its headroom: commit what is in flight and move the reference to t.
             _drain(S, H, G, line, k, table, log, ranges)

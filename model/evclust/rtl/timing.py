@@ -51,17 +51,18 @@ def tool_identity() -> str:
         raise EvclustError(f"{exc.name} is not installed: pip install -e '.[synth]'") from None
 
 
-def yosys_script(src: Path, out: Path, static: bool = False) -> str:
-    """`static`: the core with the header's constants built in (RUNTIME_CONFIG = 0), not read from its cfg port."""
-    reads = " ".join(str(src / f) for f in RTL_SOURCES)
+def yosys_script(src: Path, out: Path, static: bool = False, top: str = TOP, extra: tuple[str, ...] = ()) -> str:
+    """`static`: the core with the header's constants built in (RUNTIME_CONFIG = 0), not read from its cfg port.
+    `top` and `extra`: another top module, from extra source files beside the RTL's (a measurement harness)."""
+    reads = " ".join(str(src / f) for f in (*RTL_SOURCES, *extra))
     # ABC9's &mfs and &verify off, as for synth_xilinx (evclust.rtl.synth: &mfs runs for tens of minutes here).
     return "\n".join(ABC9_KNOBS + [
         # -defer: each module is elaborated with the parameters it is instantiated with, not with
         # its defaults first (those need not match this header, and a mismatch stops elaboration).
         f"read_verilog -defer -I{src} {reads}",
-        *([f"chparam -set RUNTIME_CONFIG 0 {TOP}"] if static else []),  # the header's constants built in
-        f"hierarchy -top {TOP}",  # (hierarchy -chparam on deferred modules trips an assertion in Yosys 0.4x)
-        f"synth_ecp5 -top {TOP} -json {out / 'netlist.json'}",
+        *([f"chparam -set RUNTIME_CONFIG 0 {top}"] if static else []),  # the header's constants built in
+        f"hierarchy -top {top}",  # (hierarchy -chparam on deferred modules trips an assertion in Yosys 0.4x)
+        f"synth_ecp5 -top {top} -json {out / 'netlist.json'}",
         f"tee -o {out / 'stat.txt'} stat",
     ]) + "\n"  # fmt: skip
 
@@ -76,8 +77,9 @@ def nextpnr_args(out: Path, route: bool) -> list[str]:
     ] + ([] if route else ["--no-route"])  # fmt: skip
 
 
-def cache_key(header: str, sources: dict[str, str], route: bool, identity: str, static: bool = False) -> str:
-    key = f"{FLOW_VERSION}\n{identity}\n{yosys_script(Path('SRC'), Path('OUT'), static)}\n{nextpnr_args(Path('OUT'), route)}\n{header}"
+def cache_key(header: str, sources: dict[str, str], route: bool, identity: str, static: bool = False, top: str = TOP,
+              extra: tuple[str, ...] = ()) -> str:  # fmt: skip
+    key = f"{FLOW_VERSION}\n{identity}\n{yosys_script(Path('SRC'), Path('OUT'), static, top, extra)}\n{nextpnr_args(Path('OUT'), route)}\n{header}"
     digest = hashlib.sha256(key.encode())
     for name in sorted(sources):
         digest.update(f"\n{name}\n{sources[name]}".encode())
@@ -153,14 +155,18 @@ def _run(tool: str, args: list[str], out: Path, log: Path, heartbeat) -> float:
     return seconds
 
 
-def place_and_route(header: str, label: str, route: bool = True, heartbeat=None, snapshot=None, static: bool = False) -> dict:
+def place_and_route(header: str, label: str, route: bool = True, heartbeat=None, snapshot=None, static: bool = False,
+                    top: str = TOP, extra: dict[str, str] | None = None) -> dict:  # fmt: skip
     """Fmax, critical path and resources of the RTL built with `header` on the LFE5U-85F.
     `heartbeat(step, seconds, detail)` is called every minute; the result has "cached": True
-    when an identical earlier run was reused."""
+    when an identical earlier run was reused. `top` and `extra` ({file name: text}): another top
+    module from sources beside the RTL's, as a harness that times one datapath alone."""
     require_repository()
     sources, rtl = snapshot or rtl_snapshot()
+    extra = extra or {}
+    sources = {**sources, **extra}
     identity = tool_identity()
-    out = BUILD / "timing" / f"{label}-{cache_key(header, sources, route, identity, static)}"
+    out = BUILD / "timing" / f"{label}-{cache_key(header, sources, route, identity, static, top, tuple(extra))}"
     done = out / "figures.json"
     if done.exists():
         return json.loads(done.read_text()) | {"cached": True}
@@ -170,7 +176,7 @@ def place_and_route(header: str, label: str, route: bool = True, heartbeat=None,
     # The tools run in `out` and see it by relative paths only: yowasp maps its own temporary
     # folder over /tmp, so an absolute path into a clone under /tmp would not be the clone's.
     here = Path(".")
-    (out / "synth.ys").write_text(yosys_script(here / "src", here, static))
+    (out / "synth.ys").write_text(yosys_script(here / "src", here, static, top, tuple(extra)))
     synth_s = _run("yosys", ["-q", "-l", "yosys.log", "synth.ys"], out, out / "yosys.log", heartbeat)
     try:
         pnr_s = _run("nextpnr-ecp5", nextpnr_args(here, route), out, out / "nextpnr.log", heartbeat)
