@@ -16,6 +16,9 @@ the behaviour keeps the stamps (as the golden vectors' staleness check compares 
            the float model with the configurations the documents use (the defaults, each preset,
            the defaults at update_delay 1 and 2), object layer included; its records (as float32,
            so that another machine's last-place rounding does not count) hashed with the events.
+  reference  the activity against a reference time (ClustererParams.activity_reference), which
+           neither probe above runs: the float and fixed models' records on the float probe's
+           events with the mode on, at update_delay 0 and 2.
 
     python -m evclust.stamps                       # the current fingerprints and every document's state
     python -m evclust.stamps --stamp NAME --made-at COMMIT
@@ -23,7 +26,7 @@ the behaviour keeps the stamps (as the golden vectors' staleness check compares 
         fingerprints at COMMIT equals today's (the probes run on COMMIT's model in a
         subprocess); otherwise it refuses and names the input that changed.
 
-This module runs the float model, so it sits above evclust.clusterer and evclust.simulator; the
+This module runs the float and fixed models, so it sits above evclust.fixed and evclust.simulator; the
 RTL's coverage table (evclust.rtl.coverage) writes its stamp, so it sits below evclust.rtl. It
 reads the RTL and the vectors as files and imports neither evclust.rtl nor evclust.vectors.
 """
@@ -46,7 +49,7 @@ from evclust.errors import EvclustError
 
 REPO = Path(__file__).resolve().parents[2]
 HEADER = "rtl/evclust_params.vh"
-INPUTS = ("formats", "rtl", "fixed", "simulator", "float")
+INPUTS = ("formats", "rtl", "fixed", "simulator", "float", "reference")
 DIGITS = 12  # hex digits of each fingerprint in a stamp
 STAMP_RE = re.compile(r"<!-- inputs: ((?:[a-z]+=[0-9a-f]+ ?)+) -->")
 
@@ -81,7 +84,7 @@ DOCUMENTS = (
     Document("RESULTS:video", "docs/RESULTS.md", "<!-- results:video:start -->", "<!-- results:video:end -->", ("float",),
              "make results-video"),
     Document("GENERALIZATION", "docs/GENERALIZATION.md", None, None, ("formats", "fixed", "float"), "make generalize"),
-    Document("PIPELINE", "docs/PIPELINE.md", None, None, ("float",), "make generalize"),
+    Document("PIPELINE", "docs/PIPELINE.md", None, None, ("float", "fixed", "reference"), "make generalize"),
     Document("ABLATION", "docs/ABLATION.md", None, None, ("float",),
              "evclust generalize --split tuning --ablation -o docs/ABLATION.md"),
     _bench("simulator", ("simulator",), "make bench (bench/simulator.py)"),
@@ -90,7 +93,7 @@ DOCUMENTS = (
     _bench("synth", ("formats", "rtl"), "make synth"),
     _bench("synth-defaults", ("formats", "rtl"), "synth/synth.py --defaults --write docs/BENCHMARKS.md"),
     _bench("timing", ("formats", "rtl"), "make timing"),
-    _bench("activity-reference", ("formats", "rtl"), "synth/activity_reference.py --write docs/BENCHMARKS.md"),
+    _bench("activity-reference", ("formats", "rtl", "reference"), "synth/activity_reference.py --write docs/BENCHMARKS.md"),
     _bench("peers", ("simulator",), "make bench-peers"),
     _bench("recordings", ("float",), "make bench (bench/recordings.py)"),
     Document("RTL:datasheet", "docs/RTL.md", "<!-- datasheet:timing:start -->", "<!-- datasheet:timing:end -->", ("formats", "rtl"),
@@ -260,6 +263,34 @@ def _hash(parts) -> str:
     return _sha(part for label, data in parts for part in (label, data))
 
 
+def probe_reference_records() -> list[tuple[str, bytes]]:
+    """The activity against a reference time (ClustererParams.activity_reference), which no other
+    probe runs: the float and fixed models' records on the probe's events, at D = 0 and 2."""
+    import numpy as np
+
+    from evclust.clusterer import ClustererParams, FloatClusterer
+    from evclust.events import EVENT_DTYPE
+    from evclust.fixed.model import FixedClusterer
+
+    events = {label.split(" ", 1)[1]: data for label, data in probe_events() if label.startswith("events ")}
+    out = []
+    for label, scene in _probe_scenes():
+        src = scene.source
+        for delay in (0, 2):
+            params = ClustererParams(activity_reference=True, update_delay=delay, objects=False)
+            for name, model in (("float", FloatClusterer), ("fixed", FixedClusterer)):
+                rows = model(params, src.width, src.height, src.t_frame_us).feed(np.frombuffer(events[label], dtype=EVENT_DTYPE))
+                out.append((f"{label} D={delay} {name}", _rounded(rows) if name == "float" else np.ascontiguousarray(rows).tobytes()))
+    return out
+
+
+def reference_fingerprint(files: Files | None = None) -> str:
+    """The activity-reference probe's hash, run here, or (files at a commit) on that commit's models."""
+    if files is None or files.commit is None:
+        return _hash(probe_reference_records())
+    return _at_commit(files, "reference_fingerprint", "reference")
+
+
 def simulator_fingerprint(files: Files | None = None) -> str:
     """The simulator probe's hash, run here, or (files at a commit) on that commit's simulator."""
     if files is None or files.commit is None:
@@ -300,6 +331,7 @@ FINGERPRINTS = {
     "fixed": fixed_fingerprint,
     "simulator": simulator_fingerprint,
     "float": float_fingerprint,
+    "reference": reference_fingerprint,
 }
 
 

@@ -4,7 +4,7 @@
 // - activity_reference_weight, once per event and outside every slot's recurrence (it may be
 //   pipelined freely): m = (t - t_ref)·(1/T_half) + residual in steps of 1/64 half-life; the
 //   weight 2^(m/64) = 2^4 decayed by 256 - m (the table and a shift: the constant 2^4 makes the
-//   decay's product a shift); whether the reference must move (m > 256);
+//   decay's product a shift); whether the reference must move (more than 4 half-lives, unfloored);
 // - activity_reference_commit, the slot's recurrence: Ã + weight, saturated;
 // - activity_reference_sweep, per slot in the filter step's sweep: Ã·2^-f >> i with the step's
 //   one table entry and shift in registers, saturated to the activity's format.
@@ -35,8 +35,9 @@ module activity_reference_weight (clk, t, t_ref, residual, inv_t_half, weight, m
     // (2^(F_A + 4) · T[left mod 64]) >> (16 + left / 64), left = 256 - m.
     wire [DT_W-1:0] dt = t_q - t_ref_q;
     wire [63:0] steps = {{(64 - DT_W){1'b0}}, dt} * {{(64 - INV_T_HALF_W){1'b0}}, inv_q} + {{(64 - DECAY_RESIDUAL_W){1'b0}}, r_q};
+    localparam [63:0] SPAN_TOP = 64'd4 << INV_T_HALF_FRAC;  // HEADROOM half-lives, unfloored
     wire [63:0] m = steps >> DROP;
-    wire        over = m > TOP;
+    wire        over = steps > SPAN_TOP;
     wire [8:0]  left = TOP[8:0] - m[8:0];  // m <= 256 where used
     reg  [DECAY_TABLE_W-1:0] entry;
     integer e;

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from evclust.clusterer import ClustererParams
-from evclust.clusterer.layout import ACT, BG_T, EVICTED, VALID
+from evclust.clusterer.layout import ACT, BG_T, EVICTED, PX, VALID
 from evclust.clusterer.run import FloatClusterer
 from evclust.errors import EvclustError
 from evclust.events import EVENT_DTYPE
@@ -102,7 +102,10 @@ def test_with_merges_off_the_records_equal_the_paper_decay_in_exact_arithmetic(m
     if model is FloatClusterer:
         np.testing.assert_allclose(referenced[:, others], paper[:, others], rtol=0, atol=1e-9)
         np.testing.assert_allclose(referenced[:, activity], paper[:, activity], rtol=1e-12)
-    else:  # two roundings of one quantity: within a few LSBs and the table's 1/64 of a half-life
+    else:  # the same decisions (time, step, slot, id, class, flags), the activity rounded two ways:
+        # within a few LSBs and the table's 1/64 of a half-life
+        decisions = [0, 1, 2, 3, 16, 17]
+        np.testing.assert_array_equal(referenced[:, decisions], paper[:, decisions])
         lsb = 2.0 ** -c.table["activity"].frac_bits
         assert np.all(np.abs(referenced[:, activity] - paper[:, activity]) <= 0.011 * paper[:, activity] + 8 * lsb)
 
@@ -138,7 +141,25 @@ def test_the_fixed_weight_is_exact_at_whole_half_lives(halves):
     """The fixed weight 2^(m/64) is the decay datapath run back from 2^4: exactly 1 at the reference
     and 2^h after h whole half-lives (a power-of-two T_half makes 1/T_half exact)."""
     c = FixedClusterer(params(filter_every=1000, t_half_us=4096.0), W, H, T_FRAME)
-    c.feed(events([(0, 20, 20), (halves * 4096, 20, 20)]))  # the reference is at 0, where the state starts
+    c.feed(events([(0, 20, 20), (halves * 4096, 20, 20)]))  # the reference is the first event's time, 0
     one = 1 << c.table["activity"].frac_bits
     s = np.flatnonzero(c.slots[:, VALID])[0]
     assert int(c.slots[s, ACT]) == one + (one << halves)
+
+
+@pytest.mark.parametrize("gap", [4 * 4096 - 10, 4 * 4096 + 10])
+def test_float_and_fixed_move_the_reference_at_the_same_event(gap):
+    """Just below and just past the headroom (4 half-lives, 1/T_half exact), at D = 2: moving drains
+    the delay line, which changes what the next events read, so both models must move at the same
+    event (the fixed one compares Δt/T_half unfloored, as the float one does)."""
+    centres = []
+    for model in (FloatClusterer, FixedClusterer):
+        c = model(params(update_delay=2, alpha_pos=0.5, filter_every=4, t_half_us=4096.0), W, H, T_FRAME)
+        c.feed(events([(0, 20, 20), (0, 22, 20), (gap, 24, 20)]))
+        moved = c.globals[BG_T] == gap
+        c.feed(events([(gap + 1, 24, 20)]))  # the step
+        s = np.flatnonzero(c.slots[:, VALID])[0]
+        scale = 1.0 if model is FloatClusterer else 2.0 ** c.table["centre"].frac_bits
+        centres.append((moved, c.slots[s, PX] / scale))
+    assert centres[0][0] == (gap > 4 * 4096)
+    assert centres[0] == centres[1]

@@ -78,7 +78,8 @@ def test_random_streams_keep_every_invariant(ev):
 @settings(max_examples=EXAMPLES // 4, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(streams())
 def test_random_streams_keep_every_invariant_with_the_activity_against_a_reference_time(ev):
-    # Hours between events included: Ã never outgrows its 2^4 of headroom, so nothing saturates.
+    # Hours between events included (the reference moves, 32-bit wraps): every invariant holds and
+    # nothing saturates. (Ã's headroom itself is checked in tests/clusterer/test_activity_reference.py.)
     check_invariants(fresh(REFERENCED), ev)
 
 

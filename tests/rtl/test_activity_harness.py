@@ -21,8 +21,8 @@ def harness(monkeypatch):
     return activity_reference
 
 
-def test_the_reference_harness_computes_the_fixed_models_weight_commit_and_sweep(harness):
-    harness.check_against_the_model(*harness._header_formats())
+def test_the_reference_harness_computes_the_fixed_models_weight_commit_and_sweep(harness, tmp_path):
+    harness.check_against_the_model(*harness._header_formats(), out=tmp_path)
 
 
 def test_a_harness_that_rounds_one_table_index_differently_is_caught(harness, tmp_path, monkeypatch):
@@ -32,4 +32,18 @@ def test_a_harness_that_rounds_one_table_index_differently_is_caught(harness, tm
     (tmp_path / "activity_reference.v").write_text(broken)
     monkeypatch.setattr(harness, "HARNESS", tmp_path)
     with pytest.raises(EvclustError, match="differs from the fixed model"):
-        harness.check_against_the_model(*harness._header_formats())
+        harness.check_against_the_model(*harness._header_formats(), out=tmp_path / "check")
+
+
+def test_the_stored_product_harness_computes_the_fixed_models_paper_commit(harness, tmp_path):
+    harness.check_the_stored_product(*harness._header_formats(), out=tmp_path)
+
+
+def test_a_stored_product_that_forgets_the_clocks_wrap_is_caught(harness, tmp_path, monkeypatch):
+    text = (SYNTH / "activity" / "activity_paper.v").read_text()
+    broken = text.replace("(wrapped_q ?", "(1'b0 ?")
+    assert broken != text
+    (tmp_path / "activity_paper.v").write_text(broken)
+    monkeypatch.setattr(harness, "HARNESS", tmp_path)
+    with pytest.raises(EvclustError, match="differs from the fixed model"):
+        harness.check_the_stored_product(*harness._header_formats(), out=tmp_path / "check")

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from evclust.cli import main
-from evclust.suite.pipeline import PERTURBATIONS, REFERENCE_VARIANTS, TARGET_POINTS, configurations, section
+from evclust.suite.pipeline import PERTURBATIONS, REFERENCE_VARIANTS, TARGET_POINTS, configurations, reference_section, section
 
 
 def test_every_delay_is_paired_with_the_sequential_update_on_every_perturbation():
@@ -22,14 +22,28 @@ def test_every_delay_is_paired_with_the_sequential_update_on_every_perturbation(
 def test_the_activity_reference_is_paired_with_the_papers_activity_in_each_model():
     by_name = {c.name: c for c in configurations(delays=(2,))}
     for perturbation, update in PERTURBATIONS.items():
-        for model, (before, after) in REFERENCE_VARIANTS.items():
+        for model, before, after in REFERENCE_VARIANTS.values():
             a, b = by_name[f"{perturbation}|{before}"], by_name[f"{perturbation}|{after}"]
             assert (a.model, b.model) == (model, model)
             assert not a.params.activity_reference and b.params.activity_reference
-            assert a.params.update_delay == b.params.update_delay == 0
             assert a.params.model_copy(update={"activity_reference": True}) == b.params  # the one switch apart
             for key, value in update.items():
                 assert getattr(b.params, key) == value
+    assert {by_name[f"defaults|{after}"].params.update_delay for _, _, after in REFERENCE_VARIANTS.values()} == {0, 2}
+
+
+def test_the_reference_section_gives_each_rows_mean_change_and_judges_it_on_the_held_out_split():
+    base = ({"HOTA": 0.5}, {"HOTA": 0.51})
+    zeros = np.zeros(2)
+    changes = {
+        ("float", "objects"): {"HOTA": np.array([0.1, 0.3]), "recall": zeros, "precision": zeros, "base": base},
+        ("fixed", "objects"): {"HOTA": np.array([-0.6, -0.8]), "recall": zeros, "precision": zeros, "base": base},
+    }
+    text = "\n".join(reference_section(changes, held_out=True))
+    # mean +0.20, s.e. std([0.1, 0.3], ddof=1) / sqrt(2) = 0.1414 / 1.414 = 0.10
+    assert "| float | objects | 50.0 → 51.0 % | +0.20 ± 0.10 |" in text
+    assert "| float | +0.20 points | yes |" in text and "| fixed | -0.70 points | no |" in text
+    assert "Target:" not in "\n".join(reference_section(changes, held_out=False))
 
 
 def test_the_page_gives_the_mean_change_and_its_standard_error_and_judges_the_target():

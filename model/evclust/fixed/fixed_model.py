@@ -102,12 +102,17 @@ def _decay_background(G, t, k, table):
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _reference_steps(G, t, k):
-    """Activity against a reference time: Δt/T_half from the reference to t in decay-table steps,
-    the reference's residual included. The reference is the background activity's time G[BG_T],
-    which every slot shares in this mode."""
-    m, _ = decay_steps_nb((t - G[BG_T]) & TIME_MASK, G[BG_RESIDUAL], k.inv_t_half, k.inv_t_half_frac, DECAY_TABLE_BITS)
-    return m
+def _reference_span(G, t, k):
+    """Activity against a reference time: Δt/T_half from the reference to t, the reference's residual
+    included, unfloored (in 1/T_half's fraction bits). The reference is the background activity's
+    time G[BG_T], which every slot shares in this mode."""
+    return ((t - G[BG_T]) & TIME_MASK) * k.inv_t_half + G[BG_RESIDUAL]
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _reference_passed(G, t, k):
+    """More than reference_halvings half-lives since the reference: Ã would outgrow its headroom."""
+    return _reference_span(G, t, k) > (k.reference_halvings << k.inv_t_half_frac)
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -117,7 +122,8 @@ def _weight(G, t, k, table):
     decay's own table and shift make it. Exactly 1 at the reference, 2^reference_halvings at the top."""
     top = k.reference_halvings << DECAY_TABLE_BITS
     highest = (np.int64(1) << k.activity_frac) << k.reference_halvings
-    return decay_apply_nb(highest, top - _reference_steps(G, t, k), table, DECAY_TABLE_BITS, DECAY_FRAC_BITS, FLOOR)
+    m = _reference_span(G, t, k) >> (k.inv_t_half_frac - DECAY_TABLE_BITS)  # whole table steps
+    return decay_apply_nb(highest, top - m, table, DECAY_TABLE_BITS, DECAY_FRAC_BITS, FLOOR)
 
 
 @njit(cache=True, nogil=True)
@@ -615,7 +621,7 @@ def run_events(S, H, G, k, table, gains, palette, inv_ww, background_mask, suppo
             G[TAU_PHASE] = 0  # τ boundaries count from the first event, as in the float model
             if k.activity_reference != 0:  # so does the activity's reference
                 G[BG_T], G[BG_RESIDUAL] = t, 0
-        if k.activity_reference != 0 and _reference_steps(G, t, k) > (k.reference_halvings << DECAY_TABLE_BITS):
+        if k.activity_reference != 0 and _reference_passed(G, t, k):
             # Ã would outgrow its headroom: commit what is in flight and move the reference to t.
             _drain(S, H, G, line, k, table, log, ranges)
             _move_reference(S, G, t, k, table, log, ranges)
