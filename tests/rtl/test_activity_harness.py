@@ -25,25 +25,27 @@ def test_the_reference_harness_computes_the_fixed_models_weight_commit_and_sweep
     harness.check_against_the_model(*harness._header_formats(), out=tmp_path)
 
 
-def test_a_harness_that_rounds_one_table_index_differently_is_caught(harness, tmp_path, monkeypatch):
-    text = (SYNTH / "activity" / "activity_reference.v").read_text()
-    broken = text.replace("(DECAY_TABLE_FRAC + left[8:6])", "(DECAY_TABLE_FRAC + left[8:6] + (left[5:0] == 6'd7))")
-    assert broken != text
-    (tmp_path / "activity_reference.v").write_text(broken)
-    monkeypatch.setattr(harness, "HARNESS", tmp_path)
-    with pytest.raises(EvclustError, match="differs from the fixed model"):
-        harness.check_against_the_model(*harness._header_formats(), out=tmp_path / "check")
-
-
 def test_the_stored_product_harness_computes_the_fixed_models_paper_commit(harness, tmp_path):
     harness.check_the_stored_product(*harness._header_formats(), out=tmp_path)
 
 
-def test_a_stored_product_that_forgets_the_clocks_wrap_is_caught(harness, tmp_path, monkeypatch):
-    text = (SYNTH / "activity" / "activity_paper.v").read_text()
-    broken = text.replace("(wrapped_q ?", "(1'b0 ?")
+# A harness one step away from the model, and the check that must catch it.
+MUTATIONS = {
+    "a table index rounded differently": (
+        "activity_reference.v", "(DECAY_TABLE_FRAC + left[8:6])", "(DECAY_TABLE_FRAC + left[8:6] + (left[5:0] == 6'd7))",
+        "check_against_the_model",
+    ),
+    "a stored product that forgets the clock's wrap": ("activity_paper.v", "(wrapped_q ?", "(1'b0 ?", "check_the_stored_product"),
+}  # fmt: skip
+
+
+@pytest.mark.parametrize("mutation", MUTATIONS)
+def test_a_harness_one_step_from_the_model_is_caught(harness, tmp_path, monkeypatch, mutation):
+    file, old, new, check = MUTATIONS[mutation]
+    text = (SYNTH / "activity" / file).read_text()
+    broken = text.replace(old, new)
     assert broken != text
-    (tmp_path / "activity_paper.v").write_text(broken)
+    (tmp_path / file).write_text(broken)
     monkeypatch.setattr(harness, "HARNESS", tmp_path)
     with pytest.raises(EvclustError, match="differs from the fixed model"):
-        harness.check_the_stored_product(*harness._header_formats(), out=tmp_path / "check")
+        getattr(harness, check)(*harness._header_formats(), out=tmp_path / "check")

@@ -94,36 +94,31 @@ def _mean_se(values: np.ndarray) -> str:
     return f"{values.mean():+.2f} ± {se:.2f}"
 
 
-def section(split: str, changes: dict, held_out: bool) -> list[str]:
-    head = "| D (events in flight) | records | HOTA, D = 0 → D (defaults) | HOTA change, mean ± s.e. (points) | per parameter set | recall change | precision change |"
+def _paired_table(changes: dict, label: str, short: str, pair: str, target: str | None) -> list[str]:
+    """The paired changes keyed (row, records) as a table, and with `target` (the held-out split
+    only) each row's verdict on the object records."""
+    head = f"| {label} | records | HOTA, {pair} (defaults) | HOTA change, mean ± s.e. (points) | per parameter set | recall change | precision change |"
     lines = [head, "|" + "---|" * (head.count("|") - 1)]
-    for (d, level), c in changes.items():
+    for (row, level), c in changes.items():
         a, b = c["base"]
-        lines.append(f"| {d} | {level} | {100 * a['HOTA']:.1f} → {100 * b['HOTA']:.1f} % | {_mean_se(c['HOTA'])} | "
+        lines.append(f"| {row} | {level} | {100 * a['HOTA']:.1f} → {100 * b['HOTA']:.1f} % | {_mean_se(c['HOTA'])} | "
                      f"{', '.join(f'{x:+.2f}' for x in c['HOTA'])} | {_mean_se(c['recall'])} | {_mean_se(c['precision'])} |")  # fmt: skip
-    if held_out:
-        lines += ["", f"Target: the pipeline costs at most {TARGET_POINTS:g} HOTA points of what the defaults report on this split.", "",
-                  "| D | mean change | met |", "|---|---|---|"]  # fmt: skip
-        for (d, level), c in changes.items():
+    if target:
+        lines += ["", target, "", f"| {short} | mean change | met |", "|---|---|---|"]
+        for (row, level), c in changes.items():
             if level == "objects":
-                lines.append(f"| {d} | {c['HOTA'].mean():+.2f} points | {'yes' if c['HOTA'].mean() >= -TARGET_POINTS else 'no'} |")
+                lines.append(f"| {row} | {c['HOTA'].mean():+.2f} points | {'yes' if c['HOTA'].mean() >= -TARGET_POINTS else 'no'} |")
     return lines
+
+
+def section(split: str, changes: dict, held_out: bool) -> list[str]:
+    target = f"Target: the pipeline costs at most {TARGET_POINTS:g} HOTA points of what the defaults report on this split."
+    return _paired_table(changes, "D (events in flight)", "D", "D = 0 → D", target if held_out else None)
 
 
 def reference_section(changes: dict, held_out: bool) -> list[str]:
-    head = "| model | records | HOTA, paper's activity → referenced (defaults) | HOTA change, mean ± s.e. (points) | per parameter set | recall change | precision change |"
-    lines = [head, "|" + "---|" * (head.count("|") - 1)]
-    for (model, level), c in changes.items():
-        a, b = c["base"]
-        lines.append(f"| {model} | {level} | {100 * a['HOTA']:.1f} → {100 * b['HOTA']:.1f} % | {_mean_se(c['HOTA'])} | "
-                     f"{', '.join(f'{x:+.2f}' for x in c['HOTA'])} | {_mean_se(c['recall'])} | {_mean_se(c['precision'])} |")  # fmt: skip
-    if held_out:
-        lines += ["", f"Target: at most {TARGET_POINTS:g} HOTA points of what the defaults report on this split.", "",
-                  "| model | mean change | met |", "|---|---|---|"]  # fmt: skip
-        for (model, level), c in changes.items():
-            if level == "objects":
-                lines.append(f"| {model} | {c['HOTA'].mean():+.2f} points | {'yes' if c['HOTA'].mean() >= -TARGET_POINTS else 'no'} |")
-    return lines
+    target = f"Target: at most {TARGET_POINTS:g} HOTA points of what the defaults report on this split."
+    return _paired_table(changes, "model", "model", "paper's activity → referenced", target if held_out else None)
 
 
 def write_page(by_split: dict, out: Path, command: str, machine: str, scenes: dict, reference_by_split: dict) -> str:
