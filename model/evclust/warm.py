@@ -115,7 +115,7 @@ AHEAD_JOB = "float model, and track's entry points ahead of time"
 # Longest first, so that two cores finish together.
 JOBS = {
     "fixed model": lambda: _track("fixed"),
-    "fixed model, traced (vectors, co-simulation)": _traced,
+    "fixed model, traced or range-instrumented (vectors, co-simulation, report)": _traced,
     AHEAD_JOB: _track_ahead,
     "float model, emulating formats (report)": _emulate,
     "simulator": _simulator,

@@ -22,6 +22,16 @@ SIGNAL_FORMATS = {
 }  # fmt: skip
 
 
+def _instrumentation(ranges: np.ndarray | None, trace: np.ndarray | None) -> tuple:
+    """(ranges, trace) for the loop: both None for a plain run (its own, fast compiled loop);
+    otherwise both arrays, the one not asked for empty, so that a traced run and a range-
+    instrumented one share the other compiled loop (fixed_model._store)."""
+    if ranges is None and trace is None:
+        return None, None
+    empty = lambda *shape: np.zeros(shape, dtype=np.int64)
+    return (empty(0, 2) if ranges is None else ranges), (empty(0) if trace is None else trace)
+
+
 class FixedClusterer:
     """The bit-accurate model: the same interface as the float one, integer arithmetic inside."""
 
@@ -60,7 +70,7 @@ class FixedClusterer:
         self.inv_ww = np.zeros(len(params.palette), dtype=np.int64)
         fixed_model.refresh_mixing(self.globals, self.palette, self.inv_ww, self.k)
         self.overflow = np.zeros(len(fixed_model.SIGNALS), dtype=np.int64)
-        # Range instrumentation on request only: None compiles a loop without it.
+        # Range instrumentation on request only (the loop skips it when given no rows).
         self.ranges = None
         if ranges:
             self.ranges = np.zeros((len(fixed_model.SIGNALS), 2), dtype=np.int64)
@@ -77,7 +87,7 @@ class FixedClusterer:
         n = fixed_model.run_events(
             self.slots, self.hist, self.globals, self.k, self.decay, self.gains, self.palette, self.inv_ww, self.background_mask,
             self.support, self.seen, self.delay_line, *loop_columns(events), out, steps,
-            self.overflow, self.ranges, trace,
+            self.overflow, *_instrumentation(self.ranges, trace),
         )  # fmt: skip
         self.steps = steps[: int(self.globals[STEP] - first)]
         return out[:n]
