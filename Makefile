@@ -10,10 +10,12 @@ BUILD  := build
 
 setup: $(STAMP)
 
+# uv installs the packages (pip installs uv first): the same versions as pip, in 9 s on this
+# machine against pip's 95 s (docs/DESIGN.md, "Setup").
 $(STAMP): pyproject.toml
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
-	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet -e '.[test]'
+	$(PY) -m pip install --quiet --upgrade pip uv
+	$(VENV)/bin/uv pip install --quiet --python $(PY) -e '.[test]'
 	touch $(STAMP)
 
 # The main job on a built-in scene: simulate it, track it, score the tracks against the ground
@@ -112,7 +114,7 @@ formal: $(STAMP)
 # Area and logic depth for Xilinx 7-series (Yosys synth_xilinx) at N = 4 and N = 16.
 SYNTH_STAMP := $(VENV)/.synth-installed
 $(SYNTH_STAMP): $(STAMP)
-	$(PY) -m pip install --quiet -e '.[test,synth]'
+	$(VENV)/bin/uv pip install --quiet --python $(PY) -e '.[test,synth]'
 	touch $(SYNTH_STAMP)
 synth: $(SYNTH_STAMP)
 	$(PY) synth/synth.py --write docs/BENCHMARKS.md
