@@ -11,7 +11,7 @@ BUILD  := build
 setup: $(STAMP)
 
 # uv installs the packages (pip installs uv first): the same versions as pip, in 9 s on this
-# machine against pip's 95 s (docs/DESIGN.md, "Setup").
+# machine against pip's 95 s (docs/DESIGN.md, "Dependencies").
 $(STAMP): pyproject.toml
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip uv
@@ -63,7 +63,8 @@ warm: $(STAMP)
 # setup included; the last fresh-clone times are in docs/RTL.md, "What make test shares"):
 # of the runs marked `rotating` (vector cases, random streams, reset points, built-in-constants
 # cases, switch-cover rows, broken proofs) it runs the anchors and a share drawn from the commit
-# hash for each simulator (tb/cosim.py: cosim_share), so successive commits rotate through them.
+# hash for each simulator (tb/cosim.py: cosim_share), so successive commits rotate through them;
+# the core's groups take turns, one a simulator per commit (tb/cosim.py: turn_share).
 # `make test-full` runs every one of them, whole, under both simulators. --durations: the
 # slowest tests at the end of a CI log, where the budget goes.
 test: $(STAMP) recordings warm

@@ -18,6 +18,9 @@ def pytest_terminal_summary(terminalreporter):
         rows, how = selected_rows()
         terminalreporter.write_line(f"switch cover: {len(rows)} of {len(cover())} rows ({how})")
     if not full():
+        from cosim import group_on_turn
+
+        turns = ", ".join(f"{sim}: {group_on_turn(sim)}" for sim in ("icarus", "verilator"))
         terminalreporter.write_line(f"rotating shares (vector cases, streams, resets, built-in constants, pipelined streams, palette and update builds, "
-                                    f"broken proofs) drawn from "
-                                    f"{rotation_key()[:12]}; make test-full runs them all")  # fmt: skip
+                                    f"broken proofs) drawn from {rotation_key()[:12]}, the core's groups on turn {turns}; "
+                                    f"make test-full runs them all")  # fmt: skip

@@ -92,6 +92,30 @@ def cosim_share(items, size: int, salt: str, sim: str = "") -> list:
     return items if full() else [items[i] for i in rotating_subset(len(items), size, f"{salt}:{sim}" if sim else salt)]
 
 
+# The core's rotating groups take turns in `make test`: under each simulator one group per commit
+# (drawn from the commit hash) takes its share, the others none, so that a commit pays for one
+# long co-simulation a simulator rather than one a group (their draws cost 5 to 85 s each; docs/RTL.md,
+# "What make test shares"). The switch cover, the leaf builds and the broken proofs keep their own.
+TAKING_TURNS = {
+    "icarus": ("vectors", "built-in", "streams", "reset"),
+    "verilator": ("vectors", "built-in", "reset", "pipelined"),  # its streams are pinned, not drawn
+}
+
+
+def group_on_turn(sim: str) -> str:
+    """The group of TAKING_TURNS[sim] whose share this commit runs under `sim`."""
+    groups = TAKING_TURNS[sim]
+    return groups[rotating_subset(len(groups), 1, f"turn:{sim}")[0]]
+
+
+def turn_share(items, size: int, group: str, sim: str) -> list:
+    """`cosim_share` for a group of TAKING_TURNS: its share when the group is on turn under `sim`
+    (or under `make test-full`, everything), else nothing."""
+    if not full() and group_on_turn(sim) != group:
+        return []
+    return cosim_share(items, size, group, sim)
+
+
 # The builds the step-3 leaf benches (tb/evclust_update, tb/evclust_commit) run: the traffic
 # preset and the defaults on a suite-sized sensor, N = 4 (the modules are per slot).
 LEAF_BUILDS = {"traffic": (480, 270, 50000.0), "defaults": (160, 120, 16666.0)}

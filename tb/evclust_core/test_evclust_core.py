@@ -23,7 +23,7 @@ from cosim import (
     FORMAT_VARIANTS,
     ICARUS_EVENTS,
     TIMING_SIMULATORS,
-    cosim_share,
+    turn_share,
     full,
     random_config,
     run,
@@ -69,7 +69,7 @@ def replayed_cases() -> list[tuple[str, str]]:
     return [
         (sim, case)
         for sim in SIMS
-        for case in (*_replayable(sim, ANCHOR_CASES), *cosim_share(_replayable(sim, others), ROTATING_CASES, "vectors", sim))
+        for case in (*_replayable(sim, ANCHOR_CASES), *turn_share(_replayable(sim, others), ROTATING_CASES, "vectors", sim))
     ]
 
 
@@ -85,7 +85,7 @@ BUILT_IN_CASES = ("traffic_clip", "table_full", "merge_edges")  # one a simulato
 
 
 @pytest.mark.rotating
-@pytest.mark.parametrize("sim, case", [(sim, c) for sim in SIMS for c in cosim_share(_replayable(sim, BUILT_IN_CASES), 1, "built-in", sim)])
+@pytest.mark.parametrize("sim, case", [(sim, c) for sim in SIMS for c in turn_share(_replayable(sim, BUILT_IN_CASES), 1, "built-in", sim)])
 def test_the_core_with_its_constants_built_in_replays_bit_exact(sim, case):
     # RUNTIME_CONFIG = 0: the header's constants folded into the datapath, the cfg port unread.
     config = {"cases": [str(VECTORS / case)], "seed": 2, "gap": GAP, "stall": STALL}
@@ -120,7 +120,7 @@ def streams(sim: str) -> list[tuple[str, int]]:
         return STREAMS
     if sim == "verilator":
         return PINNED_STREAMS
-    return cosim_share([s for s in STREAMS if s[0] in SHORT_SENSORS], 1, "streams", sim)
+    return turn_share([s for s in STREAMS if s[0] in SHORT_SENSORS], 1, "streams", sim)
 
 
 @pytest.mark.rotating
@@ -139,9 +139,7 @@ PIPELINED = [("small", 2), ("defaults", 1), ("defaults", 2)]  # one a simulator 
 
 
 @pytest.mark.rotating
-@pytest.mark.parametrize(
-    "sim, preset, delay", [(sim, *case) for sim in SIMS_TIMING for case in cosim_share(PIPELINED, 1, "pipelined", sim)]
-)
+@pytest.mark.parametrize("sim, preset, delay", [(sim, *case) for sim in SIMS_TIMING for case in turn_share(PIPELINED, 1, "pipelined", sim)])
 def test_the_pipelined_core_matches_the_model_in_the_loop_through_gaps_and_stalls(sim, preset, delay):
     # update_delay = 1: each update commits as the next event finishes; 2: as the one after
     # finishes, its second half computed a stage later. The pipeline is event-clocked, so the
@@ -225,7 +223,7 @@ RESET_CYCLES = (5, 1501, 4003)  # in the mixing table's fill, early, late: one a
 
 def _reset_cycles(sim: str) -> list[int]:
     # Icarus in make test: a stream of 2,500 events before the reset, which lasts past cycle 1501.
-    return cosim_share([c for c in RESET_CYCLES if not short_icarus(sim) or c < 2500], 1, "reset", sim)
+    return turn_share([c for c in RESET_CYCLES if not short_icarus(sim) or c < 2500], 1, "reset", sim)
 
 
 @pytest.mark.rotating

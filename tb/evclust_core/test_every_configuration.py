@@ -98,6 +98,26 @@ def test_the_share_is_a_stable_subset_drawn_apart_per_simulator_and_everything_u
     assert cosim_share(items, 4, "vectors", "icarus") == items
 
 
+def test_the_core_groups_take_turns_one_a_simulator_per_commit_and_all_under_test_full(monkeypatch):
+    import cosim
+
+    items = [f"case{i}" for i in range(5)]
+    monkeypatch.delenv("EVCLUST_COVER", raising=False)
+    turns = {sim: set() for sim in cosim.TAKING_TURNS}
+    for commit in range(60):  # commits, as the rotation key
+        monkeypatch.setattr(cosim, "rotation_key", lambda commit=commit: f"{commit:040x}")
+        for sim, groups in cosim.TAKING_TURNS.items():
+            shares = {group: cosim.turn_share(items, 1, group, sim) for group in groups}
+            on_turn = [group for group, share in shares.items() if share]
+            assert on_turn == [cosim.group_on_turn(sim)], (commit, sim, shares)
+            assert shares[on_turn[0]] == cosim.cosim_share(items, 1, on_turn[0], sim)
+            turns[sim].add(on_turn[0])
+    # Over 60 commits every group has its turn (the chance that one of 4 misses is 4 * 0.75^60).
+    assert turns == {sim: set(groups) for sim, groups in cosim.TAKING_TURNS.items()}
+    monkeypatch.setenv("EVCLUST_COVER", "all")
+    assert all(cosim.turn_share(items, 1, g, sim) == items for sim, groups in cosim.TAKING_TURNS.items() for g in groups)
+
+
 def test_the_rotating_subset_follows_the_environment(monkeypatch):
     monkeypatch.setenv("EVCLUST_COVER", "all")
     assert selected_rows()[0] == cover()

@@ -37,3 +37,27 @@ def test_simulate_writes_the_stream_to_the_file_unchanged(tmp_path):
     assert main(["simulate", "crossing", "-o", str(out), "-q"]) == 0
     reader = EventReader(out)
     assert np.array_equal(reader.read(), simulate_scene(load_scene("crossing")).events)
+
+
+def test_a_frame_reader_left_suspended_is_stopped_by_the_interrupt_cleanup():
+    # An interrupted run may leave the prefetching generator suspended and still referenced (from
+    # the interrupt's traceback), so its own cleanup never runs; the CLI's cleanup must still end
+    # its thread, which the interpreter's exit would kill inside OpenCV (exit -6).
+    import threading
+    import time
+
+    from evclust.simulator.pipeline import _prefetched
+    from evclust.threads import stop_background_threads
+
+    def frames():
+        for k in range(10_000):
+            time.sleep(0.001)
+            yield k
+
+    reader = _prefetched(frames())
+    assert next(reader) == 0  # suspended, its thread reading ahead
+    running = [t for t in threading.enumerate() if t.name == "evclust-frames"]
+    assert len(running) == 1 and running[0].is_alive()
+    stop_background_threads()
+    assert not running[0].is_alive()
+    reader.close()  # its own cleanup afterwards finds the thread gone

@@ -52,12 +52,18 @@ def _terminate(signum, frame):
 
 
 def _stop_readers() -> None:
-    """Finish now the generators an interrupted run left suspended (the simulator's frame reader
-    among them): their cleanup stops their threads, which the interpreter's exit would otherwise
-    kill inside OpenCV ("terminate called without an active exception", exit -6, not 130)."""
+    """Finish now the generators an interrupted run left suspended, and stop the background
+    threads still running (the simulator's frame reader among them), which the interpreter's exit
+    would otherwise kill inside OpenCV ("terminate called without an active exception", exit -6,
+    not 130). Collecting the generators alone was not enough: one still referenced from the
+    interrupt's traceback is not collected, and its reader ran on (a fresh-clone CI run at
+    089ed178 ended so)."""
     import gc
 
+    from evclust.threads import stop_background_threads
+
     gc.collect()
+    stop_background_threads()
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -315,14 +315,14 @@ def alpha_step(x, u, beta_raw, beta_frac_bits, guard_bits, mode):
     return x + shift_round(((u << guard_bits) - x) * beta_raw, beta_frac_bits, mode)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def alpha_increment_nb(x, u, beta_raw, beta_frac_bits, guard_bits, mode):
     """What `alpha_step` adds to x: ``round(((u << g) - x) · β)``. A pipelined core computes it
     from the state an event read and adds it to the state as it is when the event commits."""
     return shift_round_nb(((u << guard_bits) - x) * beta_raw, beta_frac_bits, mode)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def alpha_step_nb(x, u, beta_raw, beta_frac_bits, guard_bits, mode):
     """numba twin of `alpha_step`."""
     return x + alpha_increment_nb(x, u, beta_raw, beta_frac_bits, guard_bits, mode)
@@ -457,7 +457,7 @@ def decay_nb(a_raw, dt, inv_t_half_raw, inv_frac_bits, table, table_bits, table_
     return decay_apply_nb(a_raw, m, table, table_bits, table_frac_bits, mode)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def decay_apply_nb(a_raw, m, table, table_bits, table_frac_bits, mode):
     """numba twin of `decay_apply`; ``table`` an int64 array."""
     total = (m >> table_bits) + table_frac_bits
@@ -466,7 +466,7 @@ def decay_apply_nb(a_raw, m, table, table_bits, table_frac_bits, mode):
     return shift_round_nb(a_raw * table[m & ((1 << table_bits) - 1)], total, mode)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def decay_steps_nb(dt, residual, inv_t_half_raw, inv_frac_bits, table_bits):
     """numba twin of `decay_steps`."""
     n = dt * inv_t_half_raw + residual

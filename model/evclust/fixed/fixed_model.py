@@ -38,7 +38,7 @@ SIGNALS = (
 ) = range(len(SIGNALS))  # fmt: skip
 
 
-@njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True)
 def _store(value, lo, hi, signal, log, ranges):
     """Saturate to [lo, hi] and count a saturation; with range instrumentation on (`ranges` a row
     per signal), also keep the value's range before saturation. None compiles a loop without
@@ -59,7 +59,7 @@ def _store(value, lo, hi, signal, log, ranges):
     return value
 
 
-@njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True)
 def _seen(value, signal, ranges):
     """Range instrumentation of a value that cannot leave its format (an α filter's result lies
     between its state and its input, both in range): no saturation logic, just min/max."""
@@ -71,7 +71,7 @@ def _seen(value, signal, ranges):
     return value
 
 
-@njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True)
 def _align(raw, from_frac, to_frac):
     """Change the fraction bits of a raw value (floor when dropping)."""
     if to_frac >= from_frac:
@@ -79,7 +79,7 @@ def _align(raw, from_frac, to_frac):
     return raw >> (from_frac - to_frac)
 
 
-@njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True)
 def _decayed(a, dt, k, table):
     """For comparisons only (eviction): the activity decayed to now, the slot left unchanged."""
     return decay_nb(a, dt, k.inv_t_half, k.inv_t_half_frac, table, DECAY_TABLE_BITS, DECAY_FRAC_BITS, FLOOR)
@@ -103,7 +103,7 @@ def _decay_background(G, t, k, table):
     G[BG_T] = t
 
 
-@njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True)
 def _reference_span(G, t, k):
     """Activity against a reference time: Δt/T_half from the reference to t, the reference's residual
     included, unfloored (in 1/T_half's fraction bits). The reference is the background activity's
@@ -111,7 +111,7 @@ def _reference_span(G, t, k):
     return ((t - G[BG_T]) & TIME_MASK) * k.inv_t_half + G[BG_RESIDUAL]
 
 
-@njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True)
 def _reference_passed(G, t, k):
     """More than reference_halvings half-lives since the reference: Ã would outgrow its headroom."""
     return _reference_span(G, t, k) > (k.reference_halvings << k.inv_t_half_frac)
@@ -143,7 +143,7 @@ def _move_reference(S, G, t, k, table, log, ranges):
     G[BG_T] = t
 
 
-@njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True)
 def _gamma_from_activity(a, k):
     if k.gamma_mode == 0:
         return k.gamma_global
@@ -152,7 +152,7 @@ def _gamma_from_activity(a, k):
     )  # A · ln2·T_frame/T_half, in γ's format
 
 
-@njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True)
 def _margin(S, s, k):
     """The seek margin in P's format: S + seek_scale·max(Rx, Ry), the product floored."""
     return k.seek_margin + _align(k.seek_scale * max(S[s, RX], S[s, RY]), k.scale_frac + k.half_size_frac, k.centre_frac)

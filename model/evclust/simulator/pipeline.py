@@ -19,7 +19,7 @@ from evclust.events.format import EVENT_DTYPE, EventMeta, concat_events, empty_e
 from evclust.scenes.schema import SensorSpec
 from evclust.simulator.effects import Effect, Interval, SensorGeometry
 from evclust.simulator.kernel import EventBuffer, detect_interval
-from evclust.threads import worker_threads
+from evclust.threads import stopped_on_interrupt, worker_threads
 
 
 @dataclasses.dataclass
@@ -360,20 +360,25 @@ def _prefetched(frames: Iterable[np.ndarray], depth: int = 3):
         except BaseException as exc:  # handed to the consumer, which raises it
             slots.put(exc)
 
-    reader = threading.Thread(target=read, daemon=True, name="evclust-frames")
-    reader.start()
-    try:
-        while (item := slots.get()) is not done:
-            if isinstance(item, BaseException):
-                raise item
-            yield item
-    finally:
+    def halt():
         stop.set()
         while reader.is_alive():  # let a reader blocked on a full queue finish
             try:
                 slots.get_nowait()
             except queue.Empty:
                 reader.join(0.01)
+
+    reader = threading.Thread(target=read, daemon=True, name="evclust-frames")
+    reader.start()
+    forget = stopped_on_interrupt(halt)  # in case this generator is left suspended
+    try:
+        while (item := slots.get()) is not done:
+            if isinstance(item, BaseException):
+                raise item
+            yield item
+    finally:
+        halt()
+        forget()
 
 
 def _joined(intervals) -> np.ndarray:
