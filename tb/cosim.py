@@ -92,28 +92,31 @@ def cosim_share(items, size: int, salt: str, sim: str = "") -> list:
     return items if full() else [items[i] for i in rotating_subset(len(items), size, f"{salt}:{sim}" if sim else salt)]
 
 
-# The core's rotating groups take turns in `make test`: under each simulator one group per commit
-# (drawn from the commit hash) takes its share, the others none, so that a commit pays for one
-# long co-simulation a simulator rather than one a group (their draws cost 5 to 85 s each; docs/RTL.md,
-# "What make test shares"). The switch cover, the leaf builds and the broken proofs keep their own.
+# Rotating groups take turns in `make test`: in each pool one group per commit (drawn from the
+# commit hash) takes its share, the others none, so that a commit pays for one long run a pool
+# rather than one a group (their draws cost 9 to 123 s each; docs/RTL.md, "What make test
+# shares"). The pools: the core's groups under each simulator, and the switch cover's row with
+# the broken proof. The leaf builds keep their own draws: they are their benches' only runs.
 TAKING_TURNS = {
     "icarus": ("vectors", "built-in", "streams", "reset"),
     "verilator": ("vectors", "built-in", "reset", "pipelined"),  # its streams are pinned, not drawn
+    "checks": ("switch-cover", "breakages"),
 }
 
 
-def group_on_turn(sim: str) -> str:
-    """The group of TAKING_TURNS[sim] whose share this commit runs under `sim`."""
-    groups = TAKING_TURNS[sim]
-    return groups[rotating_subset(len(groups), 1, f"turn:{sim}")[0]]
+def group_on_turn(pool: str) -> str:
+    """The group of TAKING_TURNS[pool] whose share this commit runs."""
+    groups = TAKING_TURNS[pool]
+    return groups[rotating_subset(len(groups), 1, f"turn:{pool}")[0]]
 
 
-def turn_share(items, size: int, group: str, sim: str) -> list:
-    """`cosim_share` for a group of TAKING_TURNS: its share when the group is on turn under `sim`
-    (or under `make test-full`, everything), else nothing."""
-    if not full() and group_on_turn(sim) != group:
+def turn_share(items, size: int, group: str, pool: str) -> list:
+    """`cosim_share` for a group of TAKING_TURNS[pool] (a simulator's pool draws apart for that
+    simulator): its share when the group is on turn (under `make test-full`, everything), else
+    nothing."""
+    if not full() and group_on_turn(pool) != group:
         return []
-    return cosim_share(items, size, group, sim)
+    return cosim_share(items, size, group, pool if pool in SIMULATORS else "")
 
 
 # The builds the step-3 leaf benches (tb/evclust_update, tb/evclust_commit) run: the traffic

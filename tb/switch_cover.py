@@ -21,7 +21,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from cosim import full, rotating_subset, rotation_key  # full: the tests' switch, imported from here
+from cosim import full, group_on_turn, rotating_subset, rotation_key  # full: the tests' switch, imported from here
 
 # The small sensor of tb/cosim.py's "small" configuration.
 WIDTH, HEIGHT, T_FRAME_US = 64, 48, 10000.0
@@ -189,7 +189,8 @@ ROTATING = 1  # rows per `make test` (11 rows: every one in 11 commits on averag
 
 def selected_rows() -> tuple[tuple[Row, ...], str]:
     """(the rows to co-simulate, how they were chosen). EVCLUST_COVER=all: every row;
-    EVCLUST_COVER_ROWS=3,7: those; else ROTATING rows drawn from the commit hash."""
+    EVCLUST_COVER_ROWS=3,7: those; else ROTATING rows drawn from the commit hash when the switch
+    cover is on turn (tb/cosim.py: TAKING_TURNS), none when the broken proof is."""
     rows = cover()
     if full():
         return rows, "EVCLUST_COVER=all"
@@ -200,5 +201,7 @@ def selected_rows() -> tuple[tuple[Row, ...], str]:
         except (ValueError, IndexError):
             raise SystemExit(f"EVCLUST_COVER_ROWS={chosen}: expected row numbers from 0 to {len(rows) - 1}, comma-separated") from None
         return picked, f"EVCLUST_COVER_ROWS={chosen}"
+    if group_on_turn("checks") != "switch-cover":
+        return (), f"not on turn in {rotation_key()[:12]}: the broken proof is (tb/cosim.py: TAKING_TURNS)"
     picked = rotating_subset(len(rows), ROTATING, "")
     return tuple(rows[i] for i in picked), f"rotating subset of {rotation_key()[:12]}: EVCLUST_COVER_ROWS={','.join(map(str, picked))}"

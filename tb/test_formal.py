@@ -9,7 +9,7 @@ import pytest
 
 from evclust.rtl.formal import FORMAL_DIR, jobs, prove
 from evclust.rtl.sources import RTL_DIR
-from cosim import cosim_share  # tb/, on the path as this file's folder (pytest's prepend import mode)
+from cosim import turn_share  # tb/, on the path as this file's folder (pytest's prepend import mode)
 
 
 @pytest.mark.parametrize("sby", jobs(), ids=lambda p: p.stem)
@@ -121,12 +121,13 @@ BREAKAGES = {
 JOB = {"core's merge never finishes (its dividers restart in every MERGE cycle)": "evclust_core_merge"}
 
 
-# `make test` breaks ROTATING_BREAKAGES of them, drawn from the commit hash; `make test-full` all.
+# `make test` breaks ROTATING_BREAKAGES of them, drawn from the commit hash, on the turn of the
+# "checks" pool (tb/cosim.py: TAKING_TURNS, with the switch cover's row); `make test-full` all.
 ROTATING_BREAKAGES = 1
 
 
 @pytest.mark.rotating
-@pytest.mark.parametrize("breakage", cosim_share(sorted(BREAKAGES), ROTATING_BREAKAGES, "breakages"))
+@pytest.mark.parametrize("breakage", turn_share(sorted(BREAKAGES), ROTATING_BREAKAGES, "breakages", "checks"))
 def test_a_broken_interface_fails_its_proof(breakage, tmp_path):
     module, old, new, properties = BREAKAGES[breakage]
     (tmp_path / "rtl").mkdir()

@@ -114,9 +114,9 @@ def _simulator() -> None:
 AHEAD_JOB = "float model, and track's entry points ahead of time"
 # Longest first, so that two cores finish together.
 JOBS = {
+    AHEAD_JOB: _track_ahead,
     "fixed model": lambda: _track("fixed"),
     "fixed model, traced or range-instrumented (vectors, co-simulation, report)": _traced,
-    AHEAD_JOB: _track_ahead,
     "float model, emulating formats (report)": _emulate,
     "simulator": _simulator,
 }

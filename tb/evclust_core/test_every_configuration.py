@@ -98,7 +98,7 @@ def test_the_share_is_a_stable_subset_drawn_apart_per_simulator_and_everything_u
     assert cosim_share(items, 4, "vectors", "icarus") == items
 
 
-def test_the_core_groups_take_turns_one_a_simulator_per_commit_and_all_under_test_full(monkeypatch):
+def test_the_groups_of_a_pool_take_turns_one_per_commit_and_all_under_test_full(monkeypatch):
     import cosim
 
     items = [f"case{i}" for i in range(5)]
@@ -110,7 +110,7 @@ def test_the_core_groups_take_turns_one_a_simulator_per_commit_and_all_under_tes
             shares = {group: cosim.turn_share(items, 1, group, sim) for group in groups}
             on_turn = [group for group, share in shares.items() if share]
             assert on_turn == [cosim.group_on_turn(sim)], (commit, sim, shares)
-            assert shares[on_turn[0]] == cosim.cosim_share(items, 1, on_turn[0], sim)
+            assert shares[on_turn[0]] == cosim.cosim_share(items, 1, on_turn[0], sim if sim in cosim.SIMULATORS else "")
             turns[sim].add(on_turn[0])
     # Over 60 commits every group has its turn (the chance that one of 4 misses is 4 * 0.75^60).
     assert turns == {sim: set(groups) for sim, groups in cosim.TAKING_TURNS.items()}
@@ -128,6 +128,11 @@ def test_the_rotating_subset_follows_the_environment(monkeypatch):
     with pytest.raises(SystemExit, match="EVCLUST_COVER_ROWS=3,99"):
         selected_rows()
     monkeypatch.delenv("EVCLUST_COVER_ROWS")
+    import switch_cover
+
+    monkeypatch.setattr(switch_cover, "group_on_turn", lambda pool: "breakages")
+    assert selected_rows()[0] == ()  # the broken proof's turn
+    monkeypatch.setattr(switch_cover, "group_on_turn", lambda pool: "switch-cover")
     rows, how = selected_rows()
     assert len(rows) == ROTATING and len(set(rows)) == ROTATING
     assert how.endswith("EVCLUST_COVER_ROWS=" + ",".join(str(row.index) for row in rows))
