@@ -9,7 +9,7 @@ import pytest
 
 from evclust.rtl.formal import FORMAL_DIR, jobs, prove
 from evclust.rtl.sources import RTL_DIR
-from cosim import turn_share  # tb/, on the path as this file's folder (pytest's prepend import mode)
+from cosim import full, turn_share  # tb/, on the path as this file's folder (pytest's prepend import mode)
 
 
 @pytest.mark.parametrize("sby", jobs(), ids=lambda p: p.stem)
@@ -123,11 +123,18 @@ JOB = {"core's merge never finishes (its dividers restart in every MERGE cycle)"
 
 # `make test` breaks ROTATING_BREAKAGES of them, drawn from the commit hash, on the turn of the
 # "checks" pool (tb/cosim.py: TAKING_TURNS, with the switch cover's row); `make test-full` all.
+# The merge job's breakage is left to `make test-full`: its failing proof took 123 s of a CI run
+# (d822ae1), the two others drawn in recent runs 44 and 52 s.
 ROTATING_BREAKAGES = 1
+FULL_ONLY_BREAKAGES = set(JOB)
+
+
+def _breakages() -> list[str]:
+    return sorted(b for b in BREAKAGES if full() or b not in FULL_ONLY_BREAKAGES)
 
 
 @pytest.mark.rotating
-@pytest.mark.parametrize("breakage", turn_share(sorted(BREAKAGES), ROTATING_BREAKAGES, "breakages", "checks"))
+@pytest.mark.parametrize("breakage", turn_share(_breakages(), ROTATING_BREAKAGES, "breakages", "checks"))
 def test_a_broken_interface_fails_its_proof(breakage, tmp_path):
     module, old, new, properties = BREAKAGES[breakage]
     (tmp_path / "rtl").mkdir()
