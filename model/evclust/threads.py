@@ -10,7 +10,7 @@ import os
 import threading
 from collections.abc import Callable
 
-_HALTS: dict[int, Callable[[], None]] = {}
+_HALTS: set[Callable[[], None]] = set()
 _LOCK = threading.Lock()
 
 
@@ -21,10 +21,9 @@ def worker_threads() -> int:
 def stopped_on_interrupt(halt: Callable[[], None]) -> Callable[[], None]:
     """Register `halt`, which stops a background thread and returns once it has ended, to be
     called by `stop_background_threads`; returns the function that unregisters it."""
-    key = id(halt)
     with _LOCK:
-        _HALTS[key] = halt
-    return lambda: _HALTS.pop(key, None)
+        _HALTS.add(halt)
+    return lambda: _HALTS.discard(halt)
 
 
 def stop_background_threads() -> None:
@@ -34,6 +33,6 @@ def stop_background_threads() -> None:
     frame reader of a simulation whose generator is left suspended is one (its own cleanup runs
     only when the generator is closed or collected)."""
     with _LOCK:
-        halts = list(_HALTS.values())
+        halts = list(_HALTS)
     for halt in halts:
         halt()
