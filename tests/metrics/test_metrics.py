@@ -11,6 +11,7 @@ import pytest
 from evclust.cli import main
 from evclust.errors import EvclustError
 from evclust.metrics import MATCH_DTYPE, format_tables, match, nearest_palette_class, score
+from evclust.metrics.match import gated_assignment
 from evclust.scenes import TRUTH_COLUMNS, scene_from_toml, write_truth
 from evclust.scenes.truth import read_truth, truth_array
 from evclust.tracks import TRACK_DTYPE, TrackMeta, write_tracks
@@ -306,6 +307,58 @@ def test_out_of_gate_pairs_do_not_steal_an_in_gate_match():
     tracks = make_tracks(dict(t_us=0, step=0, id=1, x=1, y=50), dict(t_us=0, step=0, id=2, slot=1, x=-9, y=50))
     m = match(tracks, make_meta(), truth, gate_px=10)
     assert list(zip(m["gt_id"].tolist(), m["track_id"].tolist())) == [(1, 1)]
+
+
+def _match_step_by_step(tracks, meta, truth, gate):
+    """The matching rule of docs/METRICS.md spelled out one filter step at a time: the oracle of
+    match()'s all-steps-at-once pairing."""
+    truth = truth_array(truth)
+    row_of = {(int(f), int(i)): r for r, (f, i) in enumerate(zip(truth["frame"], truth["id"]))}
+    pairs = []
+    for step in sorted(set(zip(tracks["t_us"].tolist(), tracks["step"].tolist()))):
+        records = np.flatnonzero((tracks["t_us"] == step[0]) & (tracks["step"] == step[1]))
+        k = math.floor(step[0] / meta.t_frame_us)
+        frac = step[0] / meta.t_frame_us - k
+        objs = np.flatnonzero(truth["frame"] == k)
+        centres = []
+        for o in objs:
+            nxt = row_of.get((k + 1, int(truth["id"][o])))
+            c = np.array([truth["cx"][o], truth["cy"][o]])
+            centres.append(c if nxt is None else c + frac * (np.array([truth["cx"][nxt], truth["cy"][nxt]]) - c))
+        if not objs.size:
+            continue
+        cost = np.array([[math.dist((float(tracks["x"][r]), float(tracks["y"][r])), c) for c in centres] for r in records])
+        rows, cols = gated_assignment(cost, gate)
+        pairs += [(int(tracks["id"][records[i]]), int(truth["id"][objs[j]]), step[0]) for i, j in zip(rows, cols)]
+    return pairs
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_all_steps_at_once_pair_as_step_by_step_does_on_crowded_random_scenes(seed):
+    # Objects close together and records scattered around them, so that many steps have a record
+    # within the gate of two objects (or an object with two records): the pairing must still be
+    # each step's own gated Hungarian assignment, step by step.
+    rng = np.random.default_rng(seed)
+    truth = [gt_row(k, i, 40 + 6 * i + k * rng.uniform(-1, 1), 50 + rng.uniform(-3, 3)) for k in range(12) for i in range(4)
+             if rng.uniform() < 0.85]  # fmt: skip
+    records, step = [], 0
+    for k in range(11):
+        for t in sorted(rng.uniform(k * T, (k + 1) * T, 2).round()):
+            for r in range(rng.integers(0, 6)):
+                records.append(dict(t_us=int(t), step=step, id=r + 1, slot=r, x=rng.uniform(35, 70), y=rng.uniform(44, 56)))
+            step += 1
+    tracks = make_tracks(*records)
+    m = match(tracks, make_meta(), truth, gate_px=5.0)
+    pairs = list(zip(m["track_id"].tolist(), m["gt_id"].tolist(), m["t_us"].tolist()))
+    assert pairs == _match_step_by_step(tracks, make_meta(), truth, 5.0)
+    assert len(m) > 20
+
+
+def test_an_object_twice_in_one_frame_is_named_where_it_first_repeats():
+    truth = [gt_row(0, 1, 10, 10), gt_row(1, 2, 20, 20), gt_row(1, 1, 11, 10), gt_row(1, 2, 21, 20), gt_row(0, 1, 12, 10)]
+    tracks = make_tracks(dict(t_us=0, step=0, x=10, y=10))
+    with pytest.raises(EvclustError, match="object 2 has two rows for frame 1"):
+        match(tracks, make_meta(), truth)
 
 
 def test_fully_visible_only_leaves_out_partly_visible_objects_from_every_count():

@@ -4,15 +4,17 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import pytest
 
 from evclust.clusterer import load_params
 from evclust.run import track_events
 from evclust.fixed.formats import build_formats, sweep_tail_cycles
-from evclust.report.budget import OUTPUTS, SOURCES, budget, emulate, noise_sum_ratio, record_errors
+from evclust.report.budget import OUTPUTS, PAIR_GATE_PX, SOURCES, budget, emulate, noise_sum_ratio, paired_records, record_errors
 from evclust.report.report import NOISE_SUM_TOLERANCE_DB, write_report
 from evclust.scenes import load_scene
 from evclust.simulator import simulate_scene
+from evclust.tracks import TRACK_DTYPE
 
 
 @pytest.fixture(scope="module")
@@ -40,6 +42,22 @@ def test_the_emulated_total_is_the_fixed_models_error(traffic_budget):
         emulated, fixed = rows["all"][group].rms, rows["fixed model"][group].rms
         assert fixed > 0
         assert abs(emulated - fixed) <= 0.25 * fixed, (group, emulated, fixed)
+
+
+def _records(*step_x):
+    out = np.zeros(len(step_x), TRACK_DTYPE)
+    out["step"], out["x"] = zip(*step_x)
+    out["y"] = 20.0
+    return out
+
+
+def test_records_pair_within_the_steps_both_runs_emit_nearest_first_and_within_the_gate():
+    reference = _records((0, 10.0), (1, 10.0), (1, 50.0), (3, 5.0), (4, 30.0), (4, 31.0))
+    run = _records((1, 51.0), (1, 11.0), (2, 10.0), (3, 5.0 + PAIR_GATE_PX + 0.5), (4, 30.8))
+    ia, ib = paired_records(reference, run)
+    # Step 0 and 2 are one run's only; step 3's pair is beyond the gate; in step 4 the run's one
+    # record goes to the nearer of the two (0.2 px against 0.8 px).
+    assert list(zip(ia.tolist(), ib.tolist())) == [(1, 1), (2, 0), (5, 4)]
 
 
 def test_a_source_touches_only_the_outputs_it_feeds(traffic_budget):

@@ -131,10 +131,60 @@ def gated_assignment(cost: np.ndarray, gate: float) -> tuple[np.ndarray, np.ndar
     allowed = cost <= gate
     if not allowed.any():
         return np.empty(0, np.int64), np.empty(0, np.int64)
+    if allowed.sum(axis=0).max() == 1 and allowed.sum(axis=1).max() == 1:
+        # No two in-gate pairs share a row or a column: every optimum holds them all (swapping one
+        # in for the two forced pairs it crosses lowers the cost), so the solver's answer is known,
+        # rows ascending as it returns them.
+        rows, cols = np.nonzero(allowed)
+        return rows.astype(np.int64), cols.astype(np.int64)
     big = gate * (min(cost.shape) + 1) + 1.0
     rows, cols = linear_sum_assignment(np.where(allowed, cost, big))
     keep = allowed[rows, cols]
     return rows[keep], cols[keep]
+
+
+def gated_pairs(a_xy: np.ndarray, a_first: np.ndarray, b_xy: np.ndarray, b_first: np.ndarray, gate: float) -> tuple[np.ndarray, np.ndarray]:
+    """gated_assignment in every group at once, on the centre distance: group g pairs the points
+    a_xy[a_first[g]:a_first[g + 1]] with b_xy[b_first[g]:b_first[g + 1]] (a_first and b_first end
+    with the points' count). Returns the chosen pairs' indices into a_xy and b_xy, group by group,
+    each group's as gated_assignment gives them (a ascending).
+
+    All groups' distances come from one vectorised pass; a group where no two in-gate pairs share
+    a point takes its in-gate pairs as they are (gated_assignment's own shortcut), and only the
+    others are solved one by one."""
+    n_a, n_b = np.diff(a_first), np.diff(b_first)
+    sizes = n_a * n_b
+    group = np.repeat(np.arange(n_a.size), sizes)  # each pair's group, the pairs a-major
+    first_pair = np.cumsum(sizes) - sizes
+    within = np.arange(group.size) - first_pair[group]
+    ia, ib = a_first[:-1][group] + within // n_b[group], b_first[:-1][group] + within % n_b[group]
+    cost = np.hypot(a_xy[ia, 0] - b_xy[ib, 0], a_xy[ia, 1] - b_xy[ib, 1])
+    allowed = cost <= gate
+    a_in, b_in = ia[allowed], ib[allowed]
+    crowded = (np.bincount(a_in, minlength=1)[a_in] > 1) | (np.bincount(b_in, minlength=1)[b_in] > 1)
+    hard = np.unique(group[allowed][crowded])
+    chosen = [np.flatnonzero(allowed & ~np.isin(group, hard))]
+    for g in hard.tolist():
+        n, m = int(n_a[g]), int(n_b[g])
+        rows, cols = gated_assignment(cost[first_pair[g] : first_pair[g] + n * m].reshape(n, m), gate)
+        chosen.append(first_pair[g] + rows * m + cols)
+    chosen = np.sort(np.concatenate(chosen))
+    return ia[chosen], ib[chosen]
+
+
+def _next_rows(truth: np.ndarray) -> np.ndarray:
+    """For each ground-truth row, the row of the same object in the next frame, or -1."""
+    order = np.lexsort((truth["frame"], truth["id"]))  # by object, then frame
+    frame, obj = truth["frame"][order], truth["id"][order]
+    same = obj[1:] == obj[:-1]
+    twice = same & (frame[1:] == frame[:-1])
+    if twice.any():  # name the first repeat in the file's order
+        i = int(np.min(np.maximum(order[:-1], order[1:])[twice]))
+        raise EvclustError(f"ground truth: object {int(truth['id'][i])} has two rows for frame {int(truth['frame'][i])}")
+    following = np.full(truth.size, -1, np.int64)
+    consecutive = same & (frame[1:] == frame[:-1] + 1)
+    following[order[:-1][consecutive]] = order[1:][consecutive]
+    return following
 
 
 def match_with_counts(
@@ -150,19 +200,7 @@ def match_with_counts(
     gate = float(gate_px)
     t_frame = float(meta.t_frame_us)
 
-    # Index the ground truth by frame, and by (frame, id) for the next frame's centre.
-    by_frame: dict[int, np.ndarray] = {}
-    if truth.size:
-        order = np.argsort(truth["frame"], kind="stable")
-        frames = truth["frame"][order]
-        starts = np.flatnonzero(np.r_[True, frames[1:] != frames[:-1]])
-        for a, b in zip(starts, np.r_[starts[1:], frames.size]):
-            by_frame[int(frames[a])] = order[a:b]
-    where: dict[tuple[int, int], int] = {}
-    for i, (frame, obj) in enumerate(zip(truth["frame"].tolist(), truth["id"].tolist())):
-        if (frame, obj) in where:
-            raise EvclustError(f"ground truth: object {obj} has two rows for frame {frame}")
-        where[(frame, obj)] = i
+    following = _next_rows(truth)
 
     # Group the records by filter step, in time order; a file thinned to one record per id per
     # frame (meta.per_frame) by frame, evaluated at the frame's last record time.
@@ -181,58 +219,45 @@ def match_with_counts(
         for a, b in zip(bounds[:-1], bounds[1:]):
             t_all[a:b] = t_all[b - 1]
 
-    rec_index: list[np.ndarray] = []  # matched track record (index into tracks)
-    gt_index: list[np.ndarray] = []  # matched truth row (frame k)
-    frame_of: list[np.ndarray] = []
-    gt_xy: list[np.ndarray] = []
-    n_gt = 0
+    # Each step's objects present, their centres interpolated; then every step's pairing at once.
+    starts = bounds[:-1]
+    t = t_all[starts].astype(np.float64)
+    k = np.floor(t / t_frame).astype(np.int64)
+    frac = t / t_frame - k
+    by_frame = np.argsort(truth["frame"], kind="stable")
+    frames = truth["frame"][by_frame]
+    lo, hi = np.searchsorted(frames, k, "left"), np.searchsorted(frames, k, "right")
+    counted = truth["fully_visible"][by_frame] if fully_visible_only else np.ones(frames.size, np.int64)
+    counted_before = np.r_[0, np.cumsum(counted, dtype=np.int64)]
+    n_gt = int(np.sum(counted_before[hi] - counted_before[lo]))
+    present = np.repeat(np.arange(starts.size), hi - lo)  # each (step, object present)'s step
+    obj = by_frame[lo[present] + np.arange(present.size) - (np.cumsum(hi - lo) - (hi - lo))[present]]
+    centre = np.stack([truth["cx"][obj], truth["cy"][obj]], axis=1)
+    nxt = following[obj]
+    moves = nxt >= 0
+    move = frac[present][moves]
+    centre[moves, 0] += move * (truth["cx"][nxt[moves]] - centre[moves, 0])
+    centre[moves, 1] += move * (truth["cy"][nxt[moves]] - centre[moves, 1])
+    est = np.stack([tracks["x"][order], tracks["y"][order]], axis=1).astype(np.float64)
+    ia, ib = gated_pairs(est, bounds, centre, np.r_[0, np.cumsum(hi - lo)], gate)
     n_excluded = 0
-    empty = np.empty(0, np.int64)
-    for a, b in zip(bounds[:-1], bounds[1:]):
-        records = order[a:b]
-        t = float(t_all[a])
-        k = math.floor(t / t_frame)
-        frac = t / t_frame - k
-        objs = by_frame.get(k, empty)
-        if fully_visible_only:
-            n_gt += int(truth["fully_visible"][objs].sum())
-        else:
-            n_gt += objs.size
-        if objs.size == 0:
-            continue
-        centre = np.stack([truth["cx"][objs], truth["cy"][objs]], axis=1)
-        for j, row in enumerate(objs.tolist()):
-            nxt = where.get((k + 1, int(truth["id"][row])))
-            if nxt is not None:
-                centre[j, 0] += frac * (truth["cx"][nxt] - centre[j, 0])
-                centre[j, 1] += frac * (truth["cy"][nxt] - centre[j, 1])
-        est = np.stack([tracks["x"][records], tracks["y"][records]], axis=1).astype(np.float64)
-        cost = np.hypot(est[:, None, 0] - centre[None, :, 0], est[:, None, 1] - centre[None, :, 1])
-        r, c = gated_assignment(cost, gate)
-        if fully_visible_only:
-            visible = truth["fully_visible"][objs[c]]
-            n_excluded += int((~visible).sum())
-            r, c = r[visible], c[visible]
-        rec_index.append(records[r])
-        gt_index.append(objs[c])
-        frame_of.append(np.full(r.size, k, np.int64))
-        gt_xy.append(centre[c])
+    if fully_visible_only:
+        visible = truth["fully_visible"][obj[ib]]
+        n_excluded = int((~visible).sum())
+        ia, ib = ia[visible], ib[visible]
 
-    rec = np.concatenate(rec_index) if rec_index else empty
-    gti = np.concatenate(gt_index) if gt_index else empty
+    rec, gti = order[ia], obj[ib]
     kind = record_kind(tracks)
     out = np.zeros(rec.size, dtype=match_dtype(kind))
     out["step"] = tracks["step"][rec]
     out["t_us"] = tracks["t_us"][rec]
-    out["frame"] = np.concatenate(frame_of) if frame_of else empty
+    out["frame"] = k[present[ib]]
     out["gt_id"] = truth["id"][gti]
     out["track_id"] = tracks["id"][rec]
     out["slot"] = tracks["slot"][rec]
     for name in ("x", "y", *velocity_fields(kind), "Y", "Cb", "Cr"):
         out[name] = tracks[name][rec]
-    if gt_xy:
-        xy = np.concatenate(gt_xy)
-        out["gt_x"], out["gt_y"] = xy[:, 0], xy[:, 1]
+    out["gt_x"], out["gt_y"] = centre[ib, 0], centre[ib, 1]
     out["gt_vx"], out["gt_vy"] = truth["vx"][gti], truth["vy"][gti]
     out["gt_Y"], out["gt_Cb"], out["gt_Cr"] = truth["Y"][gti], truth["Cb"][gti], truth["Cr"][gti]
     out["class_palette"] = tracks["class"][rec]

@@ -81,35 +81,49 @@ def emulate(events, meta, params: ClustererParams, table: FormatTable, sources, 
 
 def record_errors(reference: np.ndarray, tracks: np.ndarray, table: FormatTable, outputs: dict = OUTPUTS) -> dict[str, Error]:
     """Each output group's error of `tracks` against `reference`, over the records both emit."""
-    pairs = paired_records(reference, tracks)
+    ia, ib = paired_records(reference, tracks)
     out = {}
     for group, (columns, fmt) in outputs.items():
-        if not pairs:
+        if ia.size == 0:
             out[group] = Error(math.nan, math.nan, math.nan, math.nan, math.nan, 0)
             continue
-        a = np.array([[p[0][c] for c in columns] for p in pairs], dtype=np.float64).ravel()
-        b = np.array([[p[1][c] for c in columns] for p in pairs], dtype=np.float64).ravel()
+        a = np.stack([reference[c][ia].astype(np.float64) for c in columns], axis=1).ravel()  # pair by pair, column by column
+        b = np.stack([tracks[c][ib].astype(np.float64) for c in columns], axis=1).ravel()
         e = b - a
         power = float(np.mean(e * e))
         signal = float(np.mean(a * a))
         sqnr = math.inf if power == 0 else 10 * math.log10(signal / power) if signal > 0 else -math.inf
-        out[group] = Error(float(np.max(np.abs(e))) / table[fmt].lsb, math.sqrt(power), float(np.mean(e)), power, sqnr, len(pairs))
+        out[group] = Error(float(np.max(np.abs(e))) / table[fmt].lsb, math.sqrt(power), float(np.mean(e)), power, sqnr, int(ia.size))
     return out
 
 
-def paired_records(reference: np.ndarray, tracks: np.ndarray) -> list[tuple]:
-    """(reference record, record) pairs: per filter step, Hungarian on the centre distance
-    within PAIR_GATE_PX (the metrics' gated assignment)."""
-    from evclust.metrics.match import gated_assignment
+def _by_step(records: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The records' indices by step (each step's in file order), the steps, and where each step's
+    indices begin (and where the last ends)."""
+    order = np.argsort(records["step"], kind="stable")
+    steps, first = np.unique(records["step"][order], return_index=True)
+    return order, steps, np.r_[first, order.size]
 
-    pairs = []
-    ref_steps, steps = reference["step"], tracks["step"]
-    for step in np.intersect1d(ref_steps, steps):
-        a, b = reference[ref_steps == step], tracks[steps == step]
-        cost = np.hypot(a["x"][:, None] - b["x"][None], a["y"][:, None] - b["y"][None])
-        rows, cols = gated_assignment(cost, PAIR_GATE_PX)
-        pairs += [(a[i], b[j]) for i, j in zip(rows, cols)]
-    return pairs
+
+def _steps_taken(order: np.ndarray, first: np.ndarray, taken: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The indices of the taken steps, step after step, and where each step's begin (and the end)."""
+    picked = [order[first[g] : first[g + 1]] for g in taken.tolist()]
+    return np.concatenate(picked or [np.empty(0, np.int64)]), np.r_[0, np.cumsum(first[taken + 1] - first[taken])]
+
+
+def paired_records(reference: np.ndarray, tracks: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Indices of the paired (reference record, record): per filter step in step order, Hungarian
+    on the centre distance within PAIR_GATE_PX (the metrics' gated assignment)."""
+    from evclust.metrics.match import gated_pairs
+
+    order_a, steps_a, first_a = _by_step(reference)
+    order_b, steps_b, first_b = _by_step(tracks)
+    _, taken_a, taken_b = np.intersect1d(steps_a, steps_b, assume_unique=True, return_indices=True)  # the steps both emit
+    ra, bounds_a = _steps_taken(order_a, first_a, taken_a)
+    rb, bounds_b = _steps_taken(order_b, first_b, taken_b)
+    xy_a, xy_b = (np.stack([r["x"][i], r["y"][i]], axis=1) for r, i in ((reference, ra), (tracks, rb)))
+    ia, ib = gated_pairs(xy_a, bounds_a, xy_b, bounds_b, PAIR_GATE_PX)
+    return ra[ia], rb[ib]
 
 
 def budget(events, meta, params: ClustererParams, progress=None) -> dict:
