@@ -114,8 +114,7 @@ def main() -> int:
     args = parser.parse_args()
     if not any(ESIM_PATH.glob("esim_py*.so")):
         raise SystemExit(f"esim_py is not built: `make bench-peers` builds it in {ESIM_PATH} (bench/build_peers.sh)")
-    sys.path.insert(0, str(Path(__file__).parent))
-    from simulator import VIDEO as PAN_DISKS, ensure_video
+    from simulator import VIDEO as PAN_DISKS, ensure_video  # bench/simulator.py: a script's folder is on its path
 
     ensure_video()
     videos = {"pan_disks": PAN_DISKS, "vtest": ROOT / "build" / "video" / "vtest.avi"}

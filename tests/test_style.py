@@ -55,3 +55,12 @@ def test_the_tests_mirror_the_packages():
     assert folders <= packages, f"test folders that name no package: {sorted(folders - packages)}"
     top = sorted(p.name for p in (ROOT / "tests").glob("test_*.py"))
     assert top == ["test_documents.py", "test_readonly_install.py", "test_style.py"], top
+
+
+def test_no_script_or_test_edits_the_import_path():
+    # The package is installed (editable or as a wheel) and a script's own folder is on its path,
+    # so nothing needs sys.path edited; an edit would hide an import the installed package lacks.
+    edits = [f"{p.relative_to(ROOT)}:{n}" for folder in ("model", "tb", "synth", "bench", "tests", "formal")
+             for p in sorted((ROOT / folder).rglob("*.py")) for n, line in enumerate(p.read_text().splitlines(), 1)
+             if "sys.path." + "insert" in line or "sys.path." + "append" in line]  # fmt: skip
+    assert edits == []
