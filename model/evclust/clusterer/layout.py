@@ -7,6 +7,8 @@ background colour, the filter-step clock) are one small vector.
 
 from __future__ import annotations
 
+from evclust.tracks.record import ObjectFlags, TrackFlags
+
 # Slot columns.
 (
     VALID, ID, PX, PY, RX, RY, ACT, T_LAST, VMX, VMY, VIX, VIY, PPX, PPY, CY, CCB, CCR, REPORTED,
@@ -49,8 +51,10 @@ PENDING_COLUMNS = (
 # Track-record columns as the models write them (the order of evclust.tracks.TRACK_DTYPE).
 RECORD_COLUMNS = 18
 
-# Flags of a record (evclust.tracks.TrackFlags).
-FLAG_NEW, FLAG_BORDER, FLAG_MOVING_MCM, FLAG_MOVING_INT = 1, 2, 4, 8
+# Flags of a record, as ints for the compiled loops.
+FLAG_NEW, FLAG_BORDER, FLAG_MOVING_MCM, FLAG_MOVING_INT = (
+    int(f) for f in (TrackFlags.NEW, TrackFlags.BORDER, TrackFlags.MOVING_MCM, TrackFlags.MOVING_INT)
+)
 
 
 def run_stats(g) -> dict:
@@ -108,5 +112,5 @@ OBJECT_GLOBAL_COLUMNS = ("next_id", "t_prev", "started", "steps", "created", "co
     OR_T, OR_STEP, OR_SLOT, OR_ID, OR_X, OR_Y, OR_RX, OR_RY, OR_VX, OR_VY, OR_LUM, OR_CB, OR_CR, OR_CLASS, OR_MEMBERS, OR_FLAGS,
 ) = range(16)  # fmt: skip
 OBJECT_RECORD_COLUMNS = 16
-# Flags of an object record (evclust.tracks.ObjectFlags).
-OFLAG_NEW, OFLAG_COASTING = 1, 2
+# Flags of an object record, as ints for the compiled loops.
+OFLAG_NEW, OFLAG_COASTING = int(ObjectFlags.NEW), int(ObjectFlags.COASTING)

@@ -20,6 +20,7 @@ from evclust.clusterer.layout import (
 )  # fmt: skip
 from evclust.fixed.arith import FLOOR, NEAREST, alpha_increment_nb, alpha_step_nb, decay_apply_nb, decay_nb, decay_steps_nb
 from evclust.fixed.formats import DECAY_FRAC_BITS, DECAY_TABLE_BITS
+from evclust.fixed.layouts import TRACE_ACTIONS
 from evclust.jit import njit
 
 TIME_MASK = (1 << 32) - 1
@@ -587,7 +588,9 @@ def _filter_step(S, H, G, t, k, table, gains, palette, inv_ww, background_mask, 
 
 # Trace actions (golden vectors): what each event did, and to which slot. An unsupported event
 # found no cluster and no support to create one.
-TRACE_UPDATE, TRACE_CREATE, TRACE_EVICT, TRACE_DROP, TRACE_UNSUPPORTED = range(5)
+TRACE_UPDATE, TRACE_CREATE, TRACE_EVICT, TRACE_DROP, TRACE_UNSUPPORTED = (
+    TRACE_ACTIONS.index(a) for a in ("update", "create", "evict", "drop", "unsupported")
+)
 
 
 @njit(cache=True, nogil=True, inline="always")

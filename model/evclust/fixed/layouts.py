@@ -10,7 +10,8 @@ import math
 from evclust.fixed.formats import FormatTable
 
 # (name, width, signed) per field; events and trace have fixed layouts apart from the coordinates.
-TRACE_FIELDS = (("action", 3, False), ("slot", 8, False))  # action: 0 update, 1 create, 2 evict, 3 drop, 4 unsupported
+TRACE_FIELDS = (("action", 3, False), ("slot", 8, False))
+TRACE_ACTIONS = ("update", "create", "evict", "drop", "unsupported")  # what an event did: the action field's codes, in order
 
 
 def event_fields(table: FormatTable):

@@ -3,15 +3,13 @@ mismatch field by field with the event index and the vector file lines that loca
 
 from __future__ import annotations
 
-from evclust.fixed.layouts import TRACE_FIELDS
+from evclust.fixed.layouts import TRACE_ACTIONS, TRACE_FIELDS
 from evclust.vectors.pack import unpack
-
-ACTIONS = ("update", "create", "evict", "drop", "unsupported")  # fixed_model.TRACE_*
 
 
 def describe_trace(word: int) -> str:
     action, slot = unpack(word, TRACE_FIELDS)
-    return f"{ACTIONS[action]} slot {slot}"
+    return f"{TRACE_ACTIONS[action]} slot {slot}"
 
 
 def describe_event(word: int, fields) -> str:
