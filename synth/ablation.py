@@ -23,7 +23,7 @@ from evclust.clusterer import ClustererParams
 from evclust.errors import EvclustError
 from evclust.paths import BUILD
 from evclust.rtl.sources import params_header as rtl_header
-from evclust.rtl.synth import rtl_snapshot, synthesise
+from evclust.rtl.synth import in_parallel, rtl_snapshot, synthesise
 
 ROOT = Path(__file__).resolve().parents[1]
 START, END = "<!-- ablation:start -->", "<!-- ablation:end -->"
@@ -155,16 +155,25 @@ def main():
     parser.add_argument("--write", type=Path, metavar="TUNING.md", help="rewrite this file's ablation section")
     args = parser.parse_args()
     snapshot = rtl_snapshot()
+    # Every build at once, a Yosys run per core, the largest first.
+    builds = {("all on", n): (f"ablation-all-on-n{n}", header(n), snapshot) for n in (N_LARGE, N_SMALL)}
+    for label, (_, update) in ADDITIONS.items():
+        slug = label.replace(" ", "-")
+        builds |= {(label, n): (f"ablation-no-{slug}-n{n}", header(n, **update), snapshot) for n in (N_LARGE, N_SMALL)}
+    builds[("objects", N_LARGE)] = (
+        f"objects-n{N_LARGE}",
+        header(N_LARGE, seek_scale=ClustererParams().seek_scale),
+        snapshot,
+        "evclust_objects",
+    )
+    order = sorted(builds, key=lambda key: -key[1])
     try:
-        defaults = {n: synth(f"ablation-all-on-n{n}", header(n), snapshot) for n in (N_SMALL, N_LARGE)}
-        costs = {}
-        for label, (_, update) in ADDITIONS.items():
-            slug = label.replace(" ", "-")
-            off = {n: synth(f"ablation-no-{slug}-n{n}", header(n, **update), snapshot) for n in (N_SMALL, N_LARGE)}
-            costs[label] = cost(defaults, off)
-        objects = synth(f"objects-n{N_LARGE}", header(N_LARGE, seek_scale=ClustererParams().seek_scale), snapshot, top="evclust_objects")
+        done = dict(zip(order, in_parallel(synth, [builds[key] for key in order])))
     except EvclustError as e:
         sys.exit(f"ablation: {e}")
+    defaults = {n: done[("all on", n)] for n in (N_SMALL, N_LARGE)}
+    costs = {label: cost(defaults, {n: done[(label, n)] for n in (N_SMALL, N_LARGE)}) for label in ADDITIONS}
+    objects = done[("objects", N_LARGE)]
     tracking = None
     if args.figures.exists():
         tracking = {row["name"]: row for row in json.loads(args.figures.read_text())}

@@ -20,7 +20,7 @@ from evclust.errors import EvclustError
 from evclust.paths import BUILD
 from evclust.rtl.sources import RTL_DIR
 from evclust.rtl.sources import params_header as rtl_header
-from evclust.rtl.synth import ABC9_KNOBS, rtl_snapshot, synthesise
+from evclust.rtl.synth import ABC9_KNOBS, in_parallel, rtl_snapshot, synthesise
 
 ROOT = Path(__file__).resolve().parents[1]
 START, END = "<!-- bench:synth:start -->", "<!-- bench:synth:end -->"
@@ -129,19 +129,22 @@ def main():
         help="evclust_core (configuration as free inputs) or evclust_axis (with its register file); default: %(default)s",
     )
     parser.add_argument("--static", action="store_true", help="the header's constants built in (RUNTIME_CONFIG = 0)")
+    parser.add_argument("--jobs", type=int, help="Yosys runs at a time (default: one per core)")
     args = parser.parse_args()
     # One snapshot of the RTL for every N: others may be editing rtl/ meanwhile.
     snapshot = rtl_snapshot()
-    rows = []
+
+    def run(n: int) -> dict:
+        print(f"synth: N={n} ...", file=sys.stderr)
+        beat = lambda s, step: print(f"  N={n}: {s:5.0f} s, {step}", file=sys.stderr)
+        header = defaults_header(n) if args.defaults else params_header(n)
+        label = f"{'defaults-' if args.defaults else ''}{'axis-' if args.top != 'evclust_core' else ''}n{n}{'-static' if args.static else ''}{'-hier' if args.hier else ''}"
+        figures = synthesise(header, label, args.hier, beat, snapshot, top=args.top, static=args.static)
+        print(f"synth: N={n} done in {figures['wall_s'] / 60:.1f} min{' (cached)' if figures['cached'] else ''}", file=sys.stderr)
+        return figures | {"n_clusters": n}
+
     try:
-        for n in args.n:
-            print(f"synth: N={n} ...", file=sys.stderr)
-            beat = lambda s, step, n=n: print(f"  N={n}: {s:5.0f} s, {step}", file=sys.stderr)
-            header = defaults_header(n) if args.defaults else params_header(n)
-            label = f"{'defaults-' if args.defaults else ''}{'axis-' if args.top != 'evclust_core' else ''}n{n}{'-static' if args.static else ''}{'-hier' if args.hier else ''}"
-            figures = synthesise(header, label, args.hier, beat, snapshot, top=args.top, static=args.static)
-            rows.append(figures | {"n_clusters": n})
-            print(f"synth: N={n} done in {figures['wall_s'] / 60:.1f} min{' (cached)' if figures['cached'] else ''}", file=sys.stderr)
+        rows = in_parallel(run, [(n,) for n in args.n], args.jobs)  # a Yosys run per core
     except EvclustError as e:
         sys.exit(f"synth: {e}")
     args.json.parent.mkdir(parents=True, exist_ok=True)

@@ -18,7 +18,7 @@ import sys
 from pathlib import Path
 
 from evclust.errors import EvclustError
-from evclust.rtl.synth import rtl_snapshot
+from evclust.rtl.synth import in_parallel, rtl_snapshot
 from evclust.rtl.timing import BUILD, PART, TARGET_MHZ, place_and_route
 
 from synth import defaults_header, params_header  # synth/synth.py: a script's folder is on its path
@@ -170,18 +170,21 @@ def main():
     parser.add_argument("--write", type=Path, metavar="BENCHMARKS.md", help="rewrite this file's timing section")
     parser.add_argument("--datasheet", type=Path, metavar="RTL.md", help="rewrite this file's place-and-route table")
     parser.add_argument("--static", action="store_true", help="the core with the build's constants built in (RUNTIME_CONFIG = 0)")
+    parser.add_argument("--jobs", type=int, help="runs at a time (default: one per core)")
     args = parser.parse_args()
     snapshot = rtl_snapshot()  # one snapshot of rtl/ for every N
-    rows = []
+
+    def run(name: str, n: int, placed: bool) -> dict:
+        print(f"timing: {name}, N={n} ...", file=sys.stderr)
+        beat = lambda step, s, detail: print(f"  {name}, N={n}: {step} {s:5.0f} s {detail}", file=sys.stderr)
+        label = f"{name}-n{n}{'-static' if args.static else ''}"
+        figures = place_and_route(HEADERS[name](n), label, not (args.no_route or placed), beat, snapshot, static=args.static)
+        fmax = f"{figures['fmax_mhz']:.1f} MHz" if figures["fmax_mhz"] is not None else "does not fit the part"
+        print(f"timing: {name}, N={n}: {fmax}{' (cached)' if figures['cached'] else ''}", file=sys.stderr)
+        return figures | {"configuration": name, "n_clusters": n, "static": args.static}
+
     try:
-        for name, n, placed in args.runs:
-            print(f"timing: {name}, N={n} ...", file=sys.stderr)
-            beat = lambda step, s, detail, n=n: print(f"  N={n}: {step} {s:5.0f} s {detail}", file=sys.stderr)
-            label = f"{name}-n{n}{'-static' if args.static else ''}"
-            figures = place_and_route(HEADERS[name](n), label, not (args.no_route or placed), beat, snapshot, static=args.static)
-            rows.append(figures | {"configuration": name, "n_clusters": n, "static": args.static})
-            fmax = f"{figures['fmax_mhz']:.1f} MHz" if figures["fmax_mhz"] is not None else "does not fit the part"
-            print(f"timing: {name}, N={n}: {fmax}{' (cached)' if figures['cached'] else ''}", file=sys.stderr)
+        rows = in_parallel(run, args.runs, args.jobs)
     except EvclustError as e:
         sys.exit(f"timing: {e}")
     args.json.parent.mkdir(parents=True, exist_ok=True)

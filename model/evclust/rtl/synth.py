@@ -19,10 +19,12 @@ from __future__ import annotations
 
 import hashlib
 import json
+import os
 import shutil
 import subprocess
 import sys
 import time
+from concurrent.futures import FIRST_EXCEPTION, ThreadPoolExecutor, wait
 from pathlib import Path
 
 from evclust.errors import EvclustError
@@ -285,3 +287,20 @@ def synthesise(header: str, label: str, hier: bool = False, heartbeat=None, snap
     figures = _figures(out, wall, hier, top) | {"label": label, "rtl": version, "yosys": identity}
     done.write_text(json.dumps(figures, indent=1) + "\n")
     return figures | {"cached": False}
+
+
+def in_parallel(run, jobs: list[tuple], workers: int | None = None) -> list:
+    """run(*job) for every job, `workers` at a time (default: a run per core this process may use),
+    the results in the jobs' order. A Yosys or nextpnr run is one single-threaded process, so two
+    cores halve a list's wall time. On a failure the runs not yet started are dropped, the
+    running ones finish, and the first failure is raised."""
+    workers = workers or len(os.sched_getaffinity(0))
+    with ThreadPoolExecutor(max_workers=max(1, min(workers, len(jobs)))) as pool:
+        futures = [pool.submit(run, *job) for job in jobs]
+        done, pending = wait(futures, return_when=FIRST_EXCEPTION)
+        for future in pending:
+            future.cancel()
+        failed = [f for f in futures if f in done and f.exception() is not None]
+        if failed:
+            raise failed[0].exception()
+        return [f.result() for f in futures]
