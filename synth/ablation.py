@@ -23,7 +23,7 @@ from evclust.clusterer import ClustererParams
 from evclust.errors import EvclustError
 from evclust.paths import BUILD
 from evclust.rtl.sources import params_header as rtl_header
-from evclust.rtl.synth import in_parallel, rtl_snapshot, synthesise
+from evclust.rtl.synth import in_parallel, rtl_snapshot, say, synthesise
 
 ROOT = Path(__file__).resolve().parents[1]
 START, END = "<!-- ablation:start -->", "<!-- ablation:end -->"
@@ -51,9 +51,9 @@ def header(n: int, **update) -> str:
 
 
 def synth(label: str, text: str, snapshot, top: str = "evclust_core") -> dict:
-    beat = lambda s, step: print(f"  {label}: {s:5.0f} s, {step}", file=sys.stderr)
+    beat = lambda s, step: say(f"  {label}: {s:5.0f} s, {step}")
     figures = synthesise(text, label, False, beat, snapshot, top=top, static=True)
-    print(f"synth: {label} done in {figures['wall_s'] / 60:.1f} min{' (cached)' if figures['cached'] else ''}", file=sys.stderr)
+    say(f"synth: {label} done in {figures['wall_s'] / 60:.1f} min{' (cached)' if figures['cached'] else ''}")
     return figures
 
 

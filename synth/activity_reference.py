@@ -26,7 +26,7 @@ from evclust.errors import EvclustError
 from evclust.fixed.arith import decay_table
 from evclust.fixed.formats import DECAY_FRAC_BITS, DECAY_TABLE_BITS, build_formats
 from evclust.paths import BUILD
-from evclust.rtl.synth import in_parallel, rtl_snapshot
+from evclust.rtl.synth import in_parallel, rtl_snapshot, say
 from evclust.rtl.timing import PART, TARGET_MHZ, place_and_route, tool_identity
 from synth import defaults_header  # synth/synth.py: a script's folder is on its path
 
@@ -196,9 +196,9 @@ def measure(header: str) -> list[dict]:
 
     def run(top: str, file: str) -> dict:
         extra = {file: (HARNESS / file).read_text()}
-        beat = lambda step, seconds, detail: print(f"  {top}: {step} {seconds:5.0f} s {detail}", file=sys.stderr)
+        beat = lambda step, seconds, detail: say(f"  {top}: {step} {seconds:5.0f} s {detail}")
         figures = place_and_route(header, top, True, beat, snapshot, top=top, extra=extra)
-        print(f"{top}: {figures['fmax_mhz']} MHz{' (cached)' if figures.get('cached') else ''}", file=sys.stderr)
+        say(f"{top}: {figures['fmax_mhz']} MHz{' (cached)' if figures.get('cached') else ''}")
         return {"top": top, **figures}
 
     return in_parallel(run, [(top, file) for top, (file, _) in TOPS.items()])  # a run per core

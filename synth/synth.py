@@ -20,7 +20,7 @@ from evclust.errors import EvclustError
 from evclust.paths import BUILD
 from evclust.rtl.sources import RTL_DIR
 from evclust.rtl.sources import params_header as rtl_header
-from evclust.rtl.synth import ABC9_KNOBS, in_parallel, rtl_snapshot, synthesise
+from evclust.rtl.synth import ABC9_KNOBS, in_parallel, rtl_snapshot, say, synthesise
 
 ROOT = Path(__file__).resolve().parents[1]
 START, END = "<!-- bench:synth:start -->", "<!-- bench:synth:end -->"
@@ -135,12 +135,12 @@ def main():
     snapshot = rtl_snapshot()
 
     def run(n: int) -> dict:
-        print(f"synth: N={n} ...", file=sys.stderr)
-        beat = lambda s, step: print(f"  N={n}: {s:5.0f} s, {step}", file=sys.stderr)
+        say(f"synth: N={n} ...")
+        beat = lambda s, step: say(f"  N={n}: {s:5.0f} s, {step}")
         header = defaults_header(n) if args.defaults else params_header(n)
         label = f"{'defaults-' if args.defaults else ''}{'axis-' if args.top != 'evclust_core' else ''}n{n}{'-static' if args.static else ''}{'-hier' if args.hier else ''}"
         figures = synthesise(header, label, args.hier, beat, snapshot, top=args.top, static=args.static)
-        print(f"synth: N={n} done in {figures['wall_s'] / 60:.1f} min{' (cached)' if figures['cached'] else ''}", file=sys.stderr)
+        say(f"synth: N={n} done in {figures['wall_s'] / 60:.1f} min{' (cached)' if figures['cached'] else ''}")
         return figures | {"n_clusters": n}
 
     try:

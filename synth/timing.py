@@ -18,7 +18,7 @@ import sys
 from pathlib import Path
 
 from evclust.errors import EvclustError
-from evclust.rtl.synth import in_parallel, rtl_snapshot
+from evclust.rtl.synth import in_parallel, rtl_snapshot, say
 from evclust.rtl.timing import BUILD, PART, TARGET_MHZ, place_and_route
 
 from synth import defaults_header, params_header  # synth/synth.py: a script's folder is on its path
@@ -175,12 +175,12 @@ def main():
     snapshot = rtl_snapshot()  # one snapshot of rtl/ for every N
 
     def run(name: str, n: int, placed: bool) -> dict:
-        print(f"timing: {name}, N={n} ...", file=sys.stderr)
-        beat = lambda step, s, detail: print(f"  {name}, N={n}: {step} {s:5.0f} s {detail}", file=sys.stderr)
+        say(f"timing: {name}, N={n} ...")
+        beat = lambda step, s, detail: say(f"  {name}, N={n}: {step} {s:5.0f} s {detail}")
         label = f"{name}-n{n}{'-static' if args.static else ''}"
         figures = place_and_route(HEADERS[name](n), label, not (args.no_route or placed), beat, snapshot, static=args.static)
         fmax = f"{figures['fmax_mhz']:.1f} MHz" if figures["fmax_mhz"] is not None else "does not fit the part"
-        print(f"timing: {name}, N={n}: {fmax}{' (cached)' if figures['cached'] else ''}", file=sys.stderr)
+        say(f"timing: {name}, N={n}: {fmax}{' (cached)' if figures['cached'] else ''}")
         return figures | {"configuration": name, "n_clusters": n, "static": args.static}
 
     try:

@@ -289,6 +289,11 @@ def synthesise(header: str, label: str, hier: bool = False, heartbeat=None, snap
     return figures | {"cached": False}
 
 
+def say(line: str) -> None:
+    """A progress line on stderr in one write, so that the lines of runs in parallel do not mix."""
+    sys.stderr.write(line + "\n")
+
+
 def in_parallel(run, jobs: list[tuple], workers: int | None = None) -> list:
     """run(*job) for every job, `workers` at a time (default: a run per core this process may use),
     the results in the jobs' order. A Yosys or nextpnr run is one single-threaded process, so two
