@@ -6,7 +6,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 BUILD  := build
 
-.PHONY: formal setup warm recordings demo-real demo demo-video results-video bench-peers test test-full cosim cosim-full coverage lint synth timing bench results report params registers-html vectors generalize clean
+.PHONY: formal setup warm recordings demo-real demo demo-video results-video bench-peers test test-full cosim cosim-full coverage lint synth timing ablation bench results report params registers-html vectors generalize clean
 
 setup: $(STAMP)
 
@@ -132,6 +132,13 @@ synth: $(SYNTH_STAMP)
 timing: $(SYNTH_STAMP)
 	$(PY) synth/timing.py --write docs/BENCHMARKS.md --datasheet docs/RTL.md
 	$(PY) synth/activity_reference.py --write docs/BENCHMARKS.md
+
+# What each event-rate addition costs in hardware beside what it buys: the tuning split with each
+# addition switched (docs/ABLATION.md, and its figures for the next step), then Yosys on every
+# build of synth/ablation.py, a run per core (docs/TUNING.md's section).
+ablation: $(SYNTH_STAMP)
+	$(VENV)/bin/evclust generalize --split tuning --ablation --json $(BUILD)/ablation.json -o docs/ABLATION.md
+	$(PY) synth/ablation.py --figures $(BUILD)/ablation.json --write docs/TUNING.md
 
 bench: $(STAMP)
 	$(PY) bench/simulator.py --write docs/BENCHMARKS.md

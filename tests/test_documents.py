@@ -7,6 +7,7 @@ from __future__ import annotations
 import pytest
 
 from evclust import stamps
+from evclust.errors import EvclustError
 from evclust.documents import write_section
 
 
@@ -95,3 +96,31 @@ def test_a_readme_table_is_its_sources_rows_and_columns_and_follows_it(tmp_path)
         readme.TABLES = old_tables
         stamps.BY_NAME.clear()
         stamps.BY_NAME.update(old_names)
+
+
+def test_the_plan_runs_each_stale_documents_command_once_in_the_tables_order_then_the_readme():
+    by_name = stamps.BY_NAME
+    # The datasheet and the timing section share `make timing`; the README's tables come last.
+    plan = stamps.regeneration_plan([by_name["RTL:datasheet"], by_name["VERIFICATION:coverage"], by_name["BENCHMARKS:timing"],
+                                     by_name["REPORT"]])  # fmt: skip
+    assert plan == ["make report", "make timing", "make coverage", stamps.README_TABLES]
+    assert stamps.regeneration_plan([]) == []
+
+
+def test_every_documents_command_is_a_make_target_or_a_script_of_the_repository():
+    targets = {line.split(":")[0] for line in (stamps.REPO / "Makefile").read_text().splitlines() if line[:1].isalpha() and ":" in line}
+    for doc in stamps.DOCUMENTS:
+        for command in doc.target.split(" && "):
+            words = command.split()
+            if words[0] == "make":
+                assert words[1] in targets, (doc.name, command)
+            else:
+                assert words[0] in (stamps.PY, ".venv/bin/evclust"), (doc.name, command)
+                assert words[0] == ".venv/bin/evclust" or (stamps.REPO / words[1]).is_file(), (doc.name, command)
+
+
+def test_regenerating_stops_at_the_first_failing_command(tmp_path):
+    commands = ["echo one > one.txt", "exit 3", "echo three > three.txt"]
+    with pytest.raises(EvclustError, match=r"`exit 3` failed \(exit status 3\); not run: echo three > three\.txt"):
+        stamps.regenerate(commands, tmp_path)
+    assert (tmp_path / "one.txt").exists() and not (tmp_path / "three.txt").exists()

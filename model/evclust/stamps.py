@@ -21,6 +21,8 @@ the behaviour keeps the stamps (as the golden vectors' staleness check compares 
            events with the mode on, at update_delay 0 and 2.
 
     python -m evclust.stamps                       # the current fingerprints and every document's state
+    python -m evclust.stamps --plan                # the commands that regenerate every stale document, each once
+    python -m evclust.stamps --regenerate          # run them, then the README's tables
     python -m evclust.stamps --stamp NAME --made-at COMMIT
         stamps a document made at COMMIT without regenerating it, only where each of its inputs'
         fingerprints at COMMIT equals today's (the probes run on COMMIT's model in a
@@ -63,7 +65,7 @@ class Document(NamedTuple):
     start: str | None
     end: str | None
     inputs: tuple[str, ...]
-    target: str  # what regenerates it
+    target: str  # the shell command, run at the repository's top, that regenerates it
 
 
 def _bench(name: str, inputs: tuple[str, ...], target: str) -> Document:
@@ -78,6 +80,7 @@ def _bench(name: str, inputs: tuple[str, ...], target: str) -> Document:
 # byte for byte by their own tests), the README's tables (copied from the documents here with their
 # stamps by evclust.readme, and checked against them).
 # fmt: off
+PY = ".venv/bin/python"
 DOCUMENTS = (
     Document("REPORT", "docs/report/REPORT.md", None, None, ("formats", "rtl", "fixed", "float"), "make report"),
     Document("RESULTS", "docs/RESULTS.md", None, None, ("formats", "fixed", "float"), "make results"),
@@ -85,23 +88,22 @@ DOCUMENTS = (
              "make results-video"),
     Document("GENERALIZATION", "docs/GENERALIZATION.md", None, None, ("formats", "fixed", "float"), "make generalize"),
     Document("PIPELINE", "docs/PIPELINE.md", None, None, ("float", "fixed", "reference"), "make generalize"),
-    Document("ABLATION", "docs/ABLATION.md", None, None, ("float",),
-             "evclust generalize --split tuning --ablation -o docs/ABLATION.md"),
-    _bench("simulator", ("simulator",), "make bench (bench/simulator.py)"),
-    _bench("clusterer", ("formats", "fixed", "float"), "make bench (bench/clusterer.py)"),
-    _bench("rtl", ("formats", "rtl", "fixed"), "make bench (bench/rtl.py)"),
+    Document("ABLATION", "docs/ABLATION.md", None, None, ("float",), "make ablation"),
+    _bench("simulator", ("simulator",), f"{PY} bench/simulator.py --write docs/BENCHMARKS.md"),
+    _bench("clusterer", ("formats", "fixed", "float"), f"{PY} bench/clusterer.py --write docs/BENCHMARKS.md"),
+    _bench("rtl", ("formats", "rtl", "fixed"), f"{PY} bench/rtl.py --write docs/BENCHMARKS.md"),
     _bench("synth", ("formats", "rtl"), "make synth"),
-    _bench("synth-defaults", ("formats", "rtl"), "synth/synth.py --defaults --write docs/BENCHMARKS.md"),
+    _bench("synth-defaults", ("formats", "rtl"), f"{PY} synth/synth.py --defaults --n 16 --write docs/BENCHMARKS.md"),
     _bench("timing", ("formats", "rtl"), "make timing"),
-    _bench("activity-reference", ("formats", "rtl", "reference"), "synth/activity_reference.py --write docs/BENCHMARKS.md"),
+    _bench("activity-reference", ("formats", "rtl", "reference"), f"{PY} synth/activity_reference.py --write docs/BENCHMARKS.md"),
     _bench("peers", ("simulator",), "make bench-peers"),
-    _bench("recordings", ("float",), "make bench (bench/recordings.py)"),
+    _bench("recordings", ("float",), f"make recordings && {PY} bench/recordings.py --write docs/BENCHMARKS.md"),
     Document("RTL:datasheet", "docs/RTL.md", "<!-- datasheet:timing:start -->", "<!-- datasheet:timing:end -->", ("formats", "rtl"),
              "make timing"),
     Document("VERIFICATION:coverage", "docs/VERIFICATION.md", "<!-- coverage:begin -->", "<!-- coverage:end -->",
              ("formats", "rtl", "fixed"), "make coverage"),
     Document("TUNING:ablation", "docs/TUNING.md", "<!-- ablation:start -->", "<!-- ablation:end -->", ("formats", "rtl", "float"),
-             "synth/ablation.py --write docs/TUNING.md"),
+             "make ablation"),
 )
 # fmt: on
 BY_NAME = {d.name: d for d in DOCUMENTS}
@@ -393,23 +395,48 @@ def read_stamp(doc: Document, text: str) -> dict[str, str] | None:
     return dict(pair.split("=") for pair in match.group(1).split()) if match else None
 
 
-def check(documents=DOCUMENTS, current: dict[str, str] | None = None, root: Path = REPO) -> list[str]:
-    """One line per document whose stamp is missing or records an input that has changed since."""
+def stale(documents=DOCUMENTS, current: dict[str, str] | None = None, root: Path = REPO) -> list[tuple[Document, str]]:
+    """(document, why) for each document whose stamp is missing or records an input that has changed since."""
     current = current if current is not None else fingerprints()
-    problems = []
+    found = []
     for doc in documents:
         path = root / doc.path
         if not path.is_file():
-            problems.append(f"{doc.path} ({doc.name}): missing; regenerate it with {doc.target}")
+            found.append((doc, "missing"))
             continue
         stamp = read_stamp(doc, path.read_text())
         if stamp is None:
-            problems.append(f"{doc.path} ({doc.name}): no input stamp; regenerate it with {doc.target}")
+            found.append((doc, "no input stamp"))
             continue
         changed = [name for name in doc.inputs if stamp.get(name) != current[name]]
         if changed:
-            problems.append(f"{doc.path} ({doc.name}): made from other {', '.join(changed)} than now; regenerate it with {doc.target}")
-    return problems
+            found.append((doc, f"made from other {', '.join(changed)} than now"))
+    return found
+
+
+def check(documents=DOCUMENTS, current: dict[str, str] | None = None, root: Path = REPO) -> list[str]:
+    """One line per stale document: what is wrong with it and what regenerates it."""
+    return [f"{doc.path} ({doc.name}): {why}; regenerate it with {doc.target}" for doc, why in stale(documents, current, root)]
+
+
+README_TABLES = f"{PY} -m evclust.readme --write README.md"  # the README's tables, copied from the documents
+
+
+def regeneration_plan(documents) -> list[str]:
+    """The commands that regenerate `documents`, each once, in DOCUMENTS' order, then the README's
+    tables (copied from them)."""
+    commands = list(dict.fromkeys(doc.target for doc in DOCUMENTS if doc in documents))
+    return [*commands, README_TABLES] if commands else []
+
+
+def regenerate(commands: list[str], root: Path = REPO) -> None:
+    """Run the commands one after the other at the repository's top; the first failure stops them."""
+    for k, command in enumerate(commands, 1):
+        print(f"evclust.stamps: [{k}/{len(commands)}] {command}", flush=True)
+        done = subprocess.run(command, shell=True, cwd=root)
+        if done.returncode != 0:
+            left = f"; not run: {', '.join(commands[k:])}" if commands[k:] else ""
+            raise EvclustError(f"`{command}` failed (exit status {done.returncode}){left}")
 
 
 def stamp_document(doc: Document, values: dict[str, str] | None = None, root: Path = REPO) -> None:
@@ -456,8 +483,22 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m evclust.stamps", description=__doc__.split("\n\n")[0])
     ap.add_argument("--stamp", metavar="NAME", choices=sorted(BY_NAME), help="stamp this document without regenerating it")
     ap.add_argument("--made-at", metavar="COMMIT", help="the commit at which the document was generated (required with --stamp)")
+    ap.add_argument("--plan", action="store_true", help="print the commands that regenerate every stale document, each once")
+    ap.add_argument("--regenerate", action="store_true", help="run them (an RTL change: about two and a half hours on 2 cores)")
     args = ap.parse_args(argv)
     try:
+        if args.plan or args.regenerate:
+            commands = regeneration_plan([doc for doc, _ in stale()])
+            if not commands:
+                print("every document is current")
+                return 0
+            if args.plan:
+                print("\n".join(commands))
+                return 0
+            regenerate(commands)
+            left = check()
+            print("\n".join(left or ["every document is current"]))
+            return 1 if left else 0
         if args.stamp:
             if not args.made_at:
                 ap.error("--stamp needs --made-at COMMIT: the commit whose inputs the document was made from")
