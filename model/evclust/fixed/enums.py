@@ -16,7 +16,6 @@ class VerilogEnum(NamedTuple):
     prefix: str  # the names' prefix in the RTL
     width: int  # bits of the localparam
     codes: dict[str, int]  # name (without the prefix) -> code, in declaration order
-    why: str  # what the codes are
 
     def names(self) -> dict[str, int]:
         return {self.prefix + name: code for name, code in self.codes.items()}
@@ -24,20 +23,15 @@ class VerilogEnum(NamedTuple):
 
 ENUMS = {
     "evclust_core": (
-        VerilogEnum(
-            "TRACE_", {f[0]: f[1] for f in TRACE_FIELDS}["action"], {a.upper(): i for i, a in enumerate(TRACE_ACTIONS)}, "what an event did"
-        ),
-        VerilogEnum("FLAG_", 4, {f.name: int(f) for f in TrackFlags}, "a track record's flags"),
-        VerilogEnum(
-            "ST_",
-            3,
-            {s: i for i, s in enumerate(("INIT", "IDLE", "EXEC", "SCAN", "EVICT", "SWEEP", "MERGE", "PHASE"))},
-            "the core's machine",
-        ),  # fmt: skip
-        VerilogEnum("PHASE_", 2, {"DECIDE": 0, "BY_TAU": 1, "FRAME": 2}, "the filter step's phase unit"),
+        # what an event did; a track record's flags; the core's machine; the filter step's phase unit
+        VerilogEnum("TRACE_", {f[0]: f[1] for f in TRACE_FIELDS}["action"], {a.upper(): i for i, a in enumerate(TRACE_ACTIONS)}),
+        VerilogEnum("FLAG_", 4, {f.name: int(f) for f in TrackFlags}),
+        VerilogEnum("ST_", 3, {s: i for i, s in enumerate(("INIT", "IDLE", "EXEC", "SCAN", "EVICT", "SWEEP", "MERGE", "PHASE"))}),
+        VerilogEnum("PHASE_", 2, {"DECIDE": 0, "BY_TAU": 1, "FRAME": 2}),
     ),
     "evclust_objects": (
-        # Code 2 is no longer used: the machine's codes are kept as they were built.
+        # the object unit's machine (code 2 is no longer used: the codes are kept as they were
+        # built); the association's scans
         VerilogEnum(
             "S_",
             4,
@@ -56,9 +50,8 @@ ENUMS = {
                 "MERGE": 12,
                 "OUT": 13,
             },
-            "the object unit's machine",
         ),  # fmt: skip
-        VerilogEnum("SCAN_", 2, {"INSIDE": 0, "GATE": 1, "FREE": 2, "TAKE": 3}, "the association's scans"),
+        VerilogEnum("SCAN_", 2, {"INSIDE": 0, "GATE": 1, "FREE": 2, "TAKE": 3}),
     ),
 }
 
