@@ -149,8 +149,9 @@ module evclust_core #(
     localparam [INTERVAL_UPDATES_W-1:0] VI_NONE = 0, VI_FIRST = 1, VI_MEASURED = 2;
     localparam integer W20_W = MCM_WEIGHT_W;  // w cut to mcm_weight's fraction bits: the divisor
 
-    localparam [2:0] TRACE_UPDATE = 3'd0, TRACE_CREATE = 3'd1, TRACE_EVICT = 3'd2, TRACE_DROP = 3'd3, TRACE_UNSUPPORTED = 3'd4;
-    localparam [3:0] FLAG_NEW = 4'd1, FLAG_BORDER = 4'd2, FLAG_MOVING_MCM = 4'd4, FLAG_MOVING_INT = 4'd8;
+    // The trace's actions, the record's flags, the FSM's states and the phase unit's steps
+    // (generated from model/evclust/fixed/enums.py).
+`include "evclust_core_enums.vh"
 
     // Words of the 64-bit datapath from unsigned and signed fields (u64: evclust_arith.vh).
 
@@ -343,7 +344,6 @@ module evclust_core #(
     reg [CELL_W-1:0]         init_cell;  // INIT: the cell being cleared
 
     // ---------------------------------------------------------------- control
-    localparam [2:0] ST_INIT = 3'd0, ST_IDLE = 3'd1, ST_EXEC = 3'd2, ST_SCAN = 3'd3, ST_EVICT = 3'd4, ST_SWEEP = 3'd5, ST_MERGE = 3'd6, ST_PHASE = 3'd7;
     reg [2:0]              state, state_next;  // the FSM: state_next below, one register
     reg [SWEEP_W-1:0]      index;        // INIT: palette entry; SCAN: slot; SWEEP: slot and palette entry
     reg [EV_T_W-1:0]       e_t;
@@ -917,7 +917,6 @@ module evclust_core #(
     // by comparison; more take two iterative divisions (phase / tau, then T_frame / count).
     reg  [32:0] phase_q;     // the phase at the filter step's event
     reg  [1:0]  phase_step;  // PHASE: deciding, dividing the phase, dividing the frame period
-    localparam [1:0] PHASE_DECIDE = 2'd0, PHASE_BY_TAU = 2'd1, PHASE_FRAME = 2'd2;
     wire        phase_start = state == ST_PHASE && phase_step == PHASE_DECIDE && !phase_hold && phase_q >= TAU[31:0] * 33'd2;
     wire        by_tau_done, frame_done;
     wire [32:0] by_tau_q;

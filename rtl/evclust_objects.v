@@ -106,9 +106,9 @@ module evclust_objects #(
     wire signed [63:0] product = mul_full[63:0];
 
     // ---------------------------------------------------------------- state
-    localparam [3:0] S_COLLECT = 4'd0, S_DT = 4'd1, S_PREDICT = 4'd3, S_PREP = 4'd4, S_LINK = 4'd5,
-                     S_GROUP = 4'd6, S_OWNER = 4'd7, S_CLAIM = 4'd8, S_ASSOC = 4'd9, S_JOIN = 4'd10, S_UPDATE = 4'd11,
-                     S_MERGE = 4'd12, S_OUT = 4'd13;
+    // The machine's states (S_*) and the association's scans (SCAN_*), generated from
+    // model/evclust/fixed/enums.py.
+`include "evclust_objects_enums.vh"
     reg [3:0]  state;
     reg [4:0]  sub;            // the operation within an item (a multiply per cycle)
     reg [8:0]  i, j;           // cluster indices, or an object slot and a scan position
@@ -315,7 +315,6 @@ module evclust_objects #(
     wire [31:0]        s_unseen = t - o_t_seen[oj];
     // ASSOC's scans: INSIDE (an object the group lies inside), GATE (the nearest unclaimed object
     // it meets), FREE (the first free slot, else the lost object unseen the longest), then TAKE.
-    localparam [1:0] SCAN_INSIDE = 2'd0, SCAN_GATE = 2'd1, SCAN_FREE = 2'd2, SCAN_TAKE = 2'd3;
     reg  [1:0]         scan;
     reg  [OIDX_W-1:0]  best;       // the object found so far (-1: none)
     reg  signed [63:0] best_d;     // its distance (INSIDE, GATE)

@@ -1,9 +1,10 @@
 """evclust formats [--params P.toml] [--width W --height H] [--verilog rtl/evclust_params.vh] [--rdl RDL] [--c-header H]
-[--registers MD] [--ipxact XML] [--html DIR]"""
+[--registers MD] [--ipxact XML] [--html DIR] [--enums DIR]"""
 
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 from evclust.errors import EvclustError, atomic_output
 
@@ -26,6 +27,7 @@ def add_parser(sub) -> None:
     p.add_argument("--height", type=int, default=REFERENCE[2], help="sensor height, px")
     p.add_argument("--t-frame-us", type=float, default=None, help="frame period, µs (default: the parameters', else 50000)")
     p.add_argument("--verilog", metavar="VH", help="write the Verilog parameter header here")
+    p.add_argument("--enums", metavar="DIR", help="write the RTL's enumerations here, one include per module (<module>_enums.vh)")
     p.add_argument("--rdl", metavar="RDL", help="write the register map in SystemRDL here")
     p.add_argument("--c-header", metavar="H", help="write the register map as a C header here (a driver's; PeakRDL-cheader)")
     p.add_argument("--registers", metavar="MD", help="write the register map as a Markdown document here (PeakRDL-markdown)")
@@ -75,6 +77,14 @@ def run(args) -> int:
         if path:
             with atomic_output(path) as tmp:
                 tmp.write_text(texts[kind])
+            print(f"{path}: written")
+    if args.enums:
+        from evclust.fixed import enums
+
+        for module in enums.ENUMS:
+            path = Path(args.enums) / enums.header_name(module)
+            with atomic_output(path) as tmp:
+                tmp.write_text(enums.header(module))
             print(f"{path}: written")
     if args.html:
         rdl.write_html(table, args.html)

@@ -16,11 +16,12 @@ from pathlib import Path
 
 from evclust.clusterer.layout import FLAG_BORDER, FLAG_MOVING_INT, FLAG_MOVING_MCM, FLAG_NEW
 from evclust.documents import write_section
+from evclust.fixed.enums import enum
 from evclust.fixed.registers import SATURATING_SIGNALS
 from evclust.stamps import stamp_for
 
 COVERAGE_DIR = Path("build") / "coverage"
-STATES = ("INIT", "IDLE", "EXEC", "SCAN", "EVICT", "SWEEP", "MERGE", "PHASE")  # ST_* codes 0..7
+STATES = tuple(enum("evclust_core", "ST_").codes)  # the FSM's states, by code 0..7
 # The state changes the FSM is designed to make (rtl/evclust_core.v, "the FSM's next state"):
 # an event is taken into EXEC from IDLE or straight from the state that finishes the last one
 # without a filter step (EXEC -> EXEC is no change); it finishes in EXEC (a slot takes it) or

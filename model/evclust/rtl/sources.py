@@ -39,7 +39,7 @@ RTL_SOURCES = (
     "evclust_commit.v",
     "evclust_stage_reg.v",
 )
-RTL_INCLUDES = ("evclust_arith.vh", "evclust_increments.vh", "evclust_require.vh")
+RTL_INCLUDES = ("evclust_arith.vh", "evclust_increments.vh", "evclust_require.vh", "evclust_core_enums.vh", "evclust_objects_enums.vh")
 
 
 def require_rtl() -> None:
