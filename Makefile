@@ -154,8 +154,7 @@ bench: $(STAMP)
 # The RTL parameter header, the modules' enumerations and the register map's files (SystemRDL, and from it with PeakRDL the C
 # header, docs/REGISTERS.md and IP-XACT), generated from the formats table (tests fail when stale).
 params: $(STAMP)
-	$(VENV)/bin/evclust formats --verilog rtl/evclust_params.vh --rdl rtl/evclust_regs.rdl --c-header rtl/evclust_regs.h \
-		--registers docs/REGISTERS.md --ipxact rtl/evclust_regs.xml --enums rtl > /dev/null
+	$(VENV)/bin/evclust formats --generate . > /dev/null
 
 # The register map as HTML pages (PeakRDL-html, from the same RDL as `make params`' files), into
 # build/registers/ only: open build/registers/index.html.

@@ -276,7 +276,7 @@ def _header() -> str:
 def test_the_rdl_model_is_the_register_tables():
     # The model, from the RDL alone, against registers.py: reset reads, a wide value's two words,
     # a strobed byte, CTRL's pulses, a sticky flag and its interrupt.
-    from evclust.cli.formats import reference_table
+    from evclust.fixed.generate import reference_table
     from evclust.fixed import registers
 
     _header()

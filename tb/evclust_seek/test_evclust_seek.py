@@ -25,26 +25,9 @@ try:
 except ImportError:  # collected by pytest without cocotb: the pytest half still reports why
     cocotb = None
 
+from seek_builds import BUILDS, build_params, model_for, widths  # noqa: F401  (tb/seek_builds.py)
+
 TABLES = 1500
-BUILDS = {"scaled_seek": (160, 120, 16666.0, 16), "traffic": (480, 270, 50000.0, 4)}
-
-
-def build_params(name: str):
-    from cosim import configuration_params
-
-    width, height, t_frame, n = BUILDS[name]
-    if name == "scaled_seek":
-        from evclust.clusterer import ClustererParams
-
-        return ClustererParams(n_clusters=n, seek_scale=0.75, seek_margin=4.0), width, height, t_frame
-    return configuration_params(name, n), width, height, t_frame
-
-
-def model_for(name: str):
-    from evclust.fixed.model import FixedClusterer
-
-    params, width, height, t_frame = build_params(name)
-    return FixedClusterer(params, width, height, t_frame), width, height
 
 
 def tables(model, width: int, height: int, seed: int):
@@ -131,25 +114,6 @@ if cocotb is not None:
 # pytest: build, launch, check.
 
 from cosim import LEAF_SIMULATORS, run, selected_simulators  # noqa: E402
-
-
-def widths(name: str) -> dict:
-    """The core's widths for the module's parameters: REACH_W as evclust_core computes it."""
-    from evclust.rtl.sources import params_header
-
-    model, _, _ = model_for(name)
-    f, c = model.table.formats, model.table.constants
-    fp, fr, r_w = f["centre"].frac_bits, f["half_size"].frac_bits, f["half_size"].word_bits
-    scale_w = c["seek_scale"].fmt.word_bits if "seek_scale" in c else 1
-    scale_f = c["seek_scale"].fmt.frac_bits if "seek_scale" in c else 0
-    scaled = scale_w + r_w + max(0, fp - scale_f - fr)
-    base = max(r_w + fp - fr, c["seek_margin"].fmt.word_bits)
-    n = model.params.n_clusters
-    slot_w = max(1, (n - 1).bit_length())
-    params, width, height, t_frame = build_params(name)
-    return {"header": params_header(params, width, height, t_frame), "n": n, "xy_w": f["ev_xy"].word_bits,
-            "centre_w": f["centre"].word_bits, "reach_w": max(base, scaled) + 2, "slot_w": slot_w,
-            "key_w": 1 + f["seek_distance"].word_bits + slot_w}  # fmt: skip
 
 
 @pytest.mark.parametrize("build", sorted(BUILDS))

@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 from fxpmath import Fxp
 
-from evclust.cli.formats import reference_table
+from evclust.fixed.generate import reference_table
 from evclust.clusterer import ClustererParams, load_params
 from evclust.errors import EvclustError
 from evclust.fixed import build_formats, verilog_header

@@ -11,13 +11,13 @@ from pathlib import Path
 
 import pytest
 
-from evclust.cli.formats import reference_table
-from evclust.fixed import rdl, registers
+from evclust.fixed.generate import reference_table
+from evclust.fixed import generate, rdl, registers
 
 from testkit import run_cli
 
 ROOT = Path(__file__).resolve().parents[2]
-FILES = {"rdl": "rtl/evclust_regs.rdl", "c_header": "rtl/evclust_regs.h", "markdown": "docs/REGISTERS.md", "ipxact": "rtl/evclust_regs.xml"}
+FILES = generate.REGISTER_MAP_FILES
 
 
 @pytest.fixture(scope="module")

@@ -1,5 +1,5 @@
 """evclust formats [--params P.toml] [--width W --height H] [--verilog rtl/evclust_params.vh] [--rdl RDL] [--c-header H]
-[--registers MD] [--ipxact XML] [--html DIR] [--enums DIR]"""
+[--registers MD] [--ipxact XML] [--html DIR] [--enums DIR] [--generate ROOT]"""
 
 from __future__ import annotations
 
@@ -7,8 +7,6 @@ import math
 from pathlib import Path
 
 from evclust.errors import EvclustError, atomic_output
-
-REFERENCE = ("traffic", 480, 270, 50000.0)  # the parameter set the committed RTL header is made from
 
 
 def add_parser(sub) -> None:
@@ -18,15 +16,22 @@ def add_parser(sub) -> None:
         description=(
             "Print the fixed model's formats: every input, state field, intermediate and constant with its Q "
             "notation, range, LSB, rounding and overflow, and each constant's exact and quantised value. "
-            f"The default is the reference configuration of the RTL (preset '{REFERENCE[0]}' on "
-            f"{REFERENCE[1]}x{REFERENCE[2]}). --verilog writes the RTL parameter header from the same table."
+            "The default is the reference configuration the committed RTL is made from (evclust.fixed.generate.REFERENCE: "
+            "the traffic preset on its sensor). --verilog writes the RTL parameter header from the same table, --generate "
+            "every file the reference table drives."
         ),
     )
     p.add_argument("--params", metavar="P", help="parameter file (.toml) or preset (default: the reference preset)")
-    p.add_argument("--width", type=int, default=REFERENCE[1], help="sensor width, px")
-    p.add_argument("--height", type=int, default=REFERENCE[2], help="sensor height, px")
+    p.add_argument("--width", type=int, help="sensor width, px (default: the reference configuration's)")
+    p.add_argument("--height", type=int, help="sensor height, px (default: the reference configuration's)")
     p.add_argument("--t-frame-us", type=float, default=None, help="frame period, µs (default: the parameters', else 50000)")
     p.add_argument("--verilog", metavar="VH", help="write the Verilog parameter header here")
+    p.add_argument(
+        "--generate",
+        metavar="ROOT",
+        help="write every file the reference configuration's table drives under this repository top "
+        "(the RTL header, the enumerations, the register map's files: make params)",
+    )
     p.add_argument("--enums", metavar="DIR", help="write the RTL's enumerations here, one include per module (<module>_enums.vh)")
     p.add_argument("--rdl", metavar="RDL", help="write the register map in SystemRDL here")
     p.add_argument("--c-header", metavar="H", help="write the register map as a C header here (a driver's; PeakRDL-cheader)")
@@ -42,17 +47,13 @@ def add_parser(sub) -> None:
     p.set_defaults(run=run)
 
 
-def reference_table():
-    from evclust.clusterer import load_params
-    from evclust.fixed import build_formats
-
-    params, _ = load_params(REFERENCE[0])
-    return build_formats(params, REFERENCE[1], REFERENCE[2], params.t_frame_us or REFERENCE[3])
-
-
 def run(args) -> int:
     from evclust.events.format import MAX_SENSOR_SIDE
+    from evclust.fixed.generate import REFERENCE
 
+    reference = args.params is None and args.width is None and args.height is None and args.t_frame_us is None
+    args.width = REFERENCE[1] if args.width is None else args.width
+    args.height = REFERENCE[2] if args.height is None else args.height
     if not (1 <= args.width <= MAX_SENSOR_SIDE and 1 <= args.height <= MAX_SENSOR_SIDE):
         raise EvclustError(f"sensor {args.width}x{args.height}: width and height must be 1 to {MAX_SENSOR_SIDE} px (x and y are 16-bit)")
     if args.t_frame_us is not None and not 0 < args.t_frame_us < math.inf:
@@ -85,6 +86,15 @@ def run(args) -> int:
             path = Path(args.enums) / enums.header_name(module)
             with atomic_output(path) as tmp:
                 tmp.write_text(enums.header(module))
+            print(f"{path}: written")
+    if args.generate:
+        from evclust.fixed import generate
+
+        if not reference:
+            raise EvclustError(
+                "--generate writes the reference configuration's files; leave out --params, --width, --height and --t-frame-us"
+            )
+        for path in generate.write(args.generate, table):
             print(f"{path}: written")
     if args.html:
         rdl.write_html(table, args.html)

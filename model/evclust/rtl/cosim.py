@@ -34,6 +34,7 @@ BENCHES = {
     "evclust_palette": ((), TB_DIR.parent / "evclust_palette", "test_evclust_palette"),
     "evclust_merge_search": ((), TB_DIR.parent / "evclust_merge_search", "test_evclust_merge_search"),
     "evclust_seek": ((), TB_DIR.parent / "evclust_seek", "test_evclust_seek"),
+    "evclust_seek_key": ((), TB_DIR.parent / "evclust_seek_key", "test_evclust_seek_key"),
     "evclust_slot_ram": ((), TB_DIR.parent / "evclust_slot_ram", "test_evclust_slot_ram"),
     "evclust_top2": ((), TB_DIR.parent / "evclust_top2", "test_evclust_top2"),
     "evclust_update": ((), TB_DIR.parent / "evclust_update", "test_evclust_update"),
@@ -42,6 +43,7 @@ BENCHES = {
     "evclust_pipediv": ((), TB_DIR.parent / "evclust_pipediv", "test_evclust_pipediv"),
     "evclust_udiv": ((), TB_DIR.parent / "evclust_udiv", "test_evclust_udiv"),
     "evclust_regs": ((), TB_DIR.parent / "evclust_regs", "test_evclust_regs"),
+    "evclust_objects": ((), TB_DIR.parent / "evclust_objects", "test_evclust_objects"),
 }
 
 

@@ -48,18 +48,20 @@ def first_mismatch(name: str, events: list[int], event_fields, expected_trace: l
     return None
 
 
-def first_object_mismatch(name: str, object_fields, expected: list[int], objects: list[int], tags: list[int]) -> str | None:
+def first_object_mismatch(name: str, object_fields, expected: list[int], objects: list[int], tags: list[int],
+                          tagged: str = "event", source: str = "objects.hex") -> str | None:  # fmt: skip
     """None when the object records agree bit for bit; else the first difference, field by field,
-    with the events traced when the RTL's object record left (check the cluster records first:
-    a cluster record that differs makes every object record after it differ)."""
+    with the events traced (or the `tagged` things counted) when the RTL's object record left
+    (check the cluster records first: a cluster record that differs makes every object record
+    after it differ). `source`: where the expected records are written."""
     at = next((j for j, (want, got) in enumerate(zip(expected, objects)) if want != got), None)
     if at is not None:
         diffs = [
             f"{f[0]}: RTL {g}, model {w}"
             for f, w, g in zip(object_fields, unpack(expected[at], object_fields), unpack(objects[at], object_fields)) if w != g
         ]  # fmt: skip
-        after = f", emitted after event {tags[at] - 1}" if at < len(tags) else ""
-        return f"{name}: object record {at} (objects.hex line {at + 1}){after}: " + "; ".join(diffs)
+        after = f", emitted after {tagged} {tags[at] - 1}" if at < len(tags) else ""
+        return f"{name}: object record {at} ({source} line {at + 1}){after}: " + "; ".join(diffs)
     if len(objects) != len(expected):
         extra = "the RTL's" if len(objects) > len(expected) else "the model's"
         return f"{name}: the RTL emitted {len(objects)} object records, the model {len(expected)}; first unmatched is {extra} record {min(len(objects), len(expected))}"
