@@ -4,11 +4,13 @@ do), and fails here, naming the input and the make target, when one has changed 
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 
 from evclust import stamps
 from evclust.errors import EvclustError
-from evclust.documents import write_section
+from evclust.documents import NEW_BENCHMARKS, write_section
 
 
 @pytest.mark.parametrize("doc", stamps.DOCUMENTS, ids=lambda d: d.name)
@@ -124,3 +126,47 @@ def test_regenerating_stops_at_the_first_failing_command(tmp_path):
     with pytest.raises(EvclustError, match=r"`exit 3` failed \(exit status 3\); not run: echo three > three\.txt"):
         stamps.regenerate(commands, tmp_path)
     assert (tmp_path / "one.txt").exists() and not (tmp_path / "three.txt").exists()
+
+
+def test_regenerating_two_at_a_time_runs_them_together_and_the_readme_after_all(tmp_path):
+    # each of the first two waits for the other's file: one at a time, the first would wait forever
+    wait = "for i in $(seq 100); do [ -e {0} ] && break; sleep 0.05; done; [ -e {0} ]"
+    commands = [f"touch a; {wait.format('b')}", f"touch b; {wait.format('a')}", "echo c > c", stamps.README_TABLES]
+    old = stamps.README_TABLES
+    try:
+        stamps.README_TABLES = commands[-1] = "ls a b c > readme.txt"
+        stamps.regenerate(commands, tmp_path, jobs=2)
+    finally:
+        stamps.README_TABLES = old
+    assert (tmp_path / "readme.txt").read_text().split() == ["a", "b", "c"]
+    assert sorted(p.name for p in (tmp_path / "build" / "regenerate").iterdir()) == ["1.log", "2.log", "3.log"]
+
+
+def test_a_failure_two_at_a_time_waits_for_the_running_and_starts_nothing_more(tmp_path):
+    commands = ["sleep 0.5; echo one > one.txt", "exit 3", "echo three > three.txt"]
+    with pytest.raises(EvclustError, match=r"`exit 3` failed \(exit status 3\); see .*2\.log; not run: echo three > three\.txt"):
+        stamps.regenerate(commands, tmp_path, jobs=2)
+    assert (tmp_path / "one.txt").exists() and not (tmp_path / "three.txt").exists()
+
+
+def _write_sections(path: str, name: str, times: int) -> None:
+    for i in range(times):
+        write_section(Path(path), f"<!-- {name}:start -->\n{name} {i}\n<!-- {name}:end -->\n", f"<!-- {name}:start -->",
+                      f"<!-- {name}:end -->")  # fmt: skip
+
+
+def test_two_writers_of_one_document_lose_no_section(tmp_path):
+    import multiprocessing
+
+    path = tmp_path / "BENCHMARKS.md"
+    context = multiprocessing.get_context("spawn")
+    writers = [context.Process(target=_write_sections, args=(str(path), name, 200)) for name in ("one", "two")]
+    for w in writers:
+        w.start()
+    for w in writers:
+        w.join(60)
+    assert [w.exitcode for w in writers] == [0, 0]
+    text = path.read_text()
+    assert text.startswith(NEW_BENCHMARKS)
+    assert "one 199" in text and "two 199" in text
+    assert text.count("<!-- one:start -->") == 1 and text.count("<!-- two:start -->") == 1

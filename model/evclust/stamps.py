@@ -22,7 +22,7 @@ the behaviour keeps the stamps (as the golden vectors' staleness check compares 
 
     python -m evclust.stamps                       # the current fingerprints and every document's state
     python -m evclust.stamps --plan                # the commands that regenerate every stale document, each once
-    python -m evclust.stamps --regenerate          # run them, then the README's tables
+    python -m evclust.stamps --regenerate [--jobs 2]  # run them (two at a time), then the README's tables
     python -m evclust.stamps --stamp NAME --made-at COMMIT
         stamps a document made at COMMIT without regenerating it, only where each of its inputs'
         fingerprints at COMMIT equals today's (the probes run on COMMIT's model in a
@@ -44,6 +44,7 @@ import re
 import subprocess
 import sys
 import tempfile
+import time
 from pathlib import Path
 from typing import NamedTuple
 
@@ -420,6 +421,10 @@ def check(documents=DOCUMENTS, current: dict[str, str] | None = None, root: Path
 
 
 README_TABLES = f"{PY} -m evclust.readme --write README.md"  # the README's tables, copied from the documents
+# Each command's wall time on this machine (2 cores, from the documents' own recorded runs), in
+# minutes: only to start the longest first when commands run at once.
+MINUTES = {"make timing": 75, "make ablation": 30, "make report": 20, "make coverage": 20, "make generalize": 25, "make synth": 8,
+           f"{PY} synth/synth.py --defaults --n 16 --write docs/BENCHMARKS.md": 6}  # fmt: skip
 
 
 def regeneration_plan(documents) -> list[str]:
@@ -429,14 +434,59 @@ def regeneration_plan(documents) -> list[str]:
     return [*commands, README_TABLES] if commands else []
 
 
-def regenerate(commands: list[str], root: Path = REPO) -> None:
-    """Run the commands one after the other at the repository's top; the first failure stops them."""
-    for k, command in enumerate(commands, 1):
-        print(f"evclust.stamps: [{k}/{len(commands)}] {command}", flush=True)
-        done = subprocess.run(command, shell=True, cwd=root)
+def regenerate(commands: list[str], root: Path = REPO, jobs: int = 1) -> None:
+    """Run the commands at the repository's top, `jobs` at a time in the plan's order, the README's
+    tables (the plan's last) after all the others. They may share a document (write_section
+    locks it) and a build (the co-simulation's and synthesis' caches lock theirs). With more
+    than one job each command's output goes to build/regenerate/<k>.log. The first failure
+    stops the commands not yet started; those running are waited for."""
+    *others, last = commands if commands and commands[-1] == README_TABLES else (*commands, None)
+    logs = root / "build" / "regenerate"
+    running: dict[subprocess.Popen, tuple[int, str, float]] = {}
+    queue = list(enumerate(others, 1))
+    if jobs > 1:  # the longest first, so that the last to finish is a short one
+        queue.sort(key=lambda item: -MINUTES.get(item[1], 0))
+    failed = None
+    while queue or running:
+        while queue and len(running) < max(1, jobs) and failed is None:
+            k, command = queue.pop(0)
+            print(f"evclust.stamps: [{k}/{len(commands)}] {command}", flush=True)
+            out = None
+            if jobs > 1:
+                logs.mkdir(parents=True, exist_ok=True)
+                out = open(logs / f"{k}.log", "w")
+            running[subprocess.Popen(command, shell=True, cwd=root, stdout=out, stderr=out)] = (k, command, time.monotonic())
+            if out is not None:
+                out.close()  # the child has its own copy of the file
+        if failed is not None and not running:
+            break
+        process = _wait_any(running)
+        k, command, start = running.pop(process)
+        print(
+            f"evclust.stamps: [{k}/{len(commands)}] done in {time.monotonic() - start:.0f} s (exit status {process.returncode})", flush=True
+        )
+        if process.returncode != 0 and failed is None:
+            failed = (command, process.returncode, k)
+    if failed is not None:
+        command, code, k = failed
+        not_run = [c for _, c in queue] + ([last] if last else [])
+        where = f"; see {logs / f'{k}.log'}" if jobs > 1 else ""
+        left = f"; not run: {', '.join(not_run)}" if not_run else ""
+        raise EvclustError(f"`{command}` failed (exit status {code}){where}{left}")
+    if last:
+        print(f"evclust.stamps: [{len(commands)}/{len(commands)}] {last}", flush=True)
+        done = subprocess.run(last, shell=True, cwd=root)
         if done.returncode != 0:
-            left = f"; not run: {', '.join(commands[k:])}" if commands[k:] else ""
-            raise EvclustError(f"`{command}` failed (exit status {done.returncode}){left}")
+            raise EvclustError(f"`{last}` failed (exit status {done.returncode})")
+
+
+def _wait_any(running) -> subprocess.Popen:
+    """The first of the running commands to end."""
+    while True:
+        for process in running:
+            if process.poll() is not None:
+                return process
+        time.sleep(0.5)
 
 
 def stamp_document(doc: Document, values: dict[str, str] | None = None, root: Path = REPO) -> None:
@@ -485,6 +535,7 @@ def main(argv=None) -> int:
     ap.add_argument("--made-at", metavar="COMMIT", help="the commit at which the document was generated (required with --stamp)")
     ap.add_argument("--plan", action="store_true", help="print the commands that regenerate every stale document, each once")
     ap.add_argument("--regenerate", action="store_true", help="run them (an RTL change: about two and a half hours on 2 cores)")
+    ap.add_argument("--jobs", type=int, default=1, help="with --regenerate: commands at a time (output to build/regenerate/<k>.log)")
     args = ap.parse_args(argv)
     try:
         if args.plan or args.regenerate:
@@ -495,7 +546,7 @@ def main(argv=None) -> int:
             if args.plan:
                 print("\n".join(commands))
                 return 0
-            regenerate(commands)
+            regenerate(commands, jobs=args.jobs)
             left = check()
             print("\n".join(left or ["every document is current"]))
             return 1 if left else 0
