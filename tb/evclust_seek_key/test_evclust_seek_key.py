@@ -5,8 +5,8 @@ is {miss, L1 distance, slot} with the distance |x - Px| + |y - Py| in P's format
 Random slots around each event, and the edges the key's widths must hold: centres at 0 and at
 the sensor's last pixel, an event at a corner, each axis exactly at the reach and one LSB
 beyond it, half-sizes over their whole format (the reach as the core derives it from the
-model's `_margin` when the slot is written), dead slots. Both of the seek's builds
-(tb/seek_builds.py).
+model's `_margin` when the slot is written), dead slots. The seek's two builds (tb/seek_builds.py):
+the scaled seek in `make test`, both in `make test-full`.
 """
 
 from __future__ import annotations
@@ -112,10 +112,11 @@ if cocotb is not None:
 # ------------------------------------------------------------------------------------------
 # pytest: build, launch, check.
 
-from cosim import LEAF_SIMULATORS, run, selected_simulators  # noqa: E402
+from cosim import LEAF_SIMULATORS, full, run, selected_simulators  # noqa: E402
 
 
-@pytest.mark.parametrize("build", sorted(BUILDS))
+# make test: the scaled seek (its reach grows with the half-size: the widest key); make test-full: both builds
+@pytest.mark.parametrize("build", sorted(BUILDS) if full() else ["scaled_seek"])
 @pytest.mark.parametrize("sim", selected_simulators(LEAF_SIMULATORS))
 def test_each_slots_key_is_the_models_hit_and_distance(sim, build):
     w = widths(build)
