@@ -143,8 +143,12 @@ def test_regenerating_two_at_a_time_runs_them_together_and_the_readme_after_all(
 
 
 def test_a_failure_two_at_a_time_waits_for_the_running_and_starts_nothing_more(tmp_path):
-    commands = ["sleep 0.5; echo one > one.txt", "exit 3", "echo three > three.txt"]
-    with pytest.raises(EvclustError, match=r"`exit 3` failed \(exit status 3\); see .*2\.log; not run: echo three > three\.txt"):
+    # the first ends after the second has failed: the third must not start in its place
+    wait = "for i in $(seq 200); do [ -e failed ] && break; sleep 0.05; done"
+    commands = [f"{wait}; sleep 1; echo one > one.txt", "touch failed; exit 3", "echo three > three.txt"]
+    with pytest.raises(
+        EvclustError, match=r"`touch failed; exit 3` failed \(exit status 3\); see .*2\.log; not run: echo three > three\.txt"
+    ):
         stamps.regenerate(commands, tmp_path, jobs=2)
     assert (tmp_path / "one.txt").exists() and not (tmp_path / "three.txt").exists()
 

@@ -460,13 +460,12 @@ def regenerate(commands: list[str], root: Path = REPO, jobs: int = 1) -> None:
                 out.close()  # the child has its own copy of the file
         if failed is not None and not running:
             break
-        process = _wait_any(running)
-        k, command, start = running.pop(process)
-        print(
-            f"evclust.stamps: [{k}/{len(commands)}] done in {time.monotonic() - start:.0f} s (exit status {process.returncode})", flush=True
-        )
-        if process.returncode != 0 and failed is None:
-            failed = (command, process.returncode, k)
+        for process in _ended(running):  # all that ended, so that a failure is seen before the next start
+            k, command, start = running.pop(process)
+            took = time.monotonic() - start
+            print(f"evclust.stamps: [{k}/{len(commands)}] done in {took:.0f} s (exit status {process.returncode})", flush=True)
+            if process.returncode != 0 and failed is None:
+                failed = (command, process.returncode, k)
     if failed is not None:
         command, code, k = failed
         not_run = [c for _, c in queue] + ([last] if last else [])
@@ -480,12 +479,12 @@ def regenerate(commands: list[str], root: Path = REPO, jobs: int = 1) -> None:
             raise EvclustError(f"`{last}` failed (exit status {done.returncode})")
 
 
-def _wait_any(running) -> subprocess.Popen:
-    """The first of the running commands to end."""
+def _ended(running) -> list[subprocess.Popen]:
+    """The running commands that have ended, once at least one has."""
     while True:
-        for process in running:
-            if process.poll() is not None:
-                return process
+        ended = [process for process in running if process.poll() is not None]
+        if ended:
+            return ended
         time.sleep(0.5)
 
 
