@@ -2,7 +2,7 @@
 modules' enumerations and the register map's files (SystemRDL, and from it with PeakRDL the C
 header, the Markdown map and IP-XACT), each under its path in the repository, for the reference
 configuration the committed files are made from (`make params`, `evclust formats --generate`).
-tests/fixed/test_generate.py checks that each committed file is what this writes now.
+tests/fixed/test_generated_files.py checks that each committed file is what this writes now.
 
 This module sits above the table (formats.py), the register map (registers.py, rdl.py), the
 stream layouts (layouts.py) and the enumerations (enums.py); none of them imports it."""
