@@ -4,6 +4,10 @@ case, without input gaps or output stalls), and co-simulation speed under Icarus
 Writes its section of docs/BENCHMARKS.md. Targets: Verilator co-simulation >= 50k events/s
 (issue 5); 1 cycle per event outside sweeps and scans, and >= 90 Mevents/s on the traffic clip at
 the placed Fmax (issue 12; `make timing` first).
+
+Each run saves its figures in build/bench_rtl.json; `--figures build/bench_rtl.json` writes the
+section again from them without simulating (for instance once `make timing` has given the Fmax
+the sustained rate needs).
 """
 
 from __future__ import annotations
@@ -81,15 +85,23 @@ def sustained(rows) -> list[str]:
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--write", metavar="BENCHMARKS.md", help="rewrite this file's RTL section")
+    parser.add_argument("--figures", type=Path, metavar="JSON", help="an earlier run's figures (build/bench_rtl.json): no simulation")
     args = parser.parse_args()
-    cases = {sim: cycles_per_case(sim) for sim in SIMULATORS}
-    speed = {sim: stream_speed(sim) for sim in SIMULATORS}
+    if args.figures:
+        saved = json.loads(args.figures.read_text())
+        cases, speed = saved["cases"], saved["speed"]
+        run_at = datetime.datetime.fromisoformat(saved["run_at"]) if "run_at" in saved else \
+            datetime.datetime.fromtimestamp(args.figures.stat().st_mtime, datetime.UTC)  # fmt: skip
+    else:
+        cases = {sim: cycles_per_case(sim) for sim in SIMULATORS}
+        speed = {sim: stream_speed(sim) for sim in SIMULATORS}
+        run_at = datetime.datetime.now(datetime.UTC)
     lines = [
         START,
         "## RTL: cycles and co-simulation speed",
         "",
         f"Command: `make bench` (= `.venv/bin/python bench/rtl.py --write docs/BENCHMARKS.md`), "
-        f"run {datetime.datetime.now(datetime.UTC):%Y-%m-%d %H:%M} UTC, on the machine above.",
+        f"run {run_at:%Y-%m-%d %H:%M} UTC, on the machine above.",
         "",
         "Cycles, counted by the harness (tb/evclust_core/evclust_tb.v) while every vector case replays "
         "with no input gap and no output stall. `filter` cycles are those with `filter_active` high (a step's phase, "
@@ -139,7 +151,8 @@ def main() -> int:
         from evclust.stamps import stamp_for
 
         common.write_section(Path(args.write), text, START, END, stamp=stamp_for("BENCHMARKS:rtl"))
-    (ROOT / "build" / "bench_rtl.json").write_text(json.dumps({"cases": cases, "speed": speed}, indent=1))
+    if not args.figures:
+        (ROOT / "build" / "bench_rtl.json").write_text(json.dumps({"cases": cases, "speed": speed, "run_at": run_at.isoformat()}, indent=1))
     return 0
 
 

@@ -107,6 +107,15 @@ def test_the_plan_runs_each_stale_documents_command_once_in_the_tables_order_the
                                      by_name["REPORT"]])  # fmt: skip
     assert plan == ["make report", "make timing", "make coverage", stamps.README_TABLES]
     assert stamps.regeneration_plan([]) == []
+    # bench/rtl reads make timing's Fmax: it runs after it, though the table lists it first
+    plan = stamps.regeneration_plan([by_name["BENCHMARKS:rtl"], by_name["BENCHMARKS:timing"]])
+    assert plan == ["make timing", f"{stamps.PY} bench/rtl.py --write docs/BENCHMARKS.md", stamps.README_TABLES]
+
+
+def test_two_at_a_time_a_command_waits_for_the_one_it_reads(tmp_path, monkeypatch):
+    monkeypatch.setattr(stamps, "AFTER", {"[ -e made ] && touch read": ("sleep 1; touch made",)})
+    stamps.regenerate(["[ -e made ] && touch read", "sleep 1; touch made", "true"], tmp_path, jobs=2)
+    assert (tmp_path / "read").exists()
 
 
 def test_every_documents_command_is_a_make_target_or_a_script_of_the_repository():

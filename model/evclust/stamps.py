@@ -421,6 +421,9 @@ def check(documents=DOCUMENTS, current: dict[str, str] | None = None, root: Path
 
 
 README_TABLES = f"{PY} -m evclust.readme --write README.md"  # the README's tables, copied from the documents
+# A command that reads another's results runs after it: bench/rtl's sustained rate takes make
+# timing's Fmax from build/timing/results.json.
+AFTER = {f"{PY} bench/rtl.py --write docs/BENCHMARKS.md": ("make timing",)}
 # Each command's wall time on this machine (2 cores, from the documents' own recorded runs), in
 # minutes: only to start the longest first when commands run at once.
 MINUTES = {"make timing": 75, "make ablation": 30, "make report": 20, "make coverage": 20, "make generalize": 25, "make synth": 8,
@@ -428,9 +431,13 @@ MINUTES = {"make timing": 75, "make ablation": 30, "make report": 20, "make cove
 
 
 def regeneration_plan(documents) -> list[str]:
-    """The commands that regenerate `documents`, each once, in DOCUMENTS' order, then the README's
-    tables (copied from them)."""
+    """The commands that regenerate `documents`, each once, in DOCUMENTS' order but each after the
+    commands it reads (AFTER), then the README's tables (copied from them)."""
     commands = list(dict.fromkeys(doc.target for doc in DOCUMENTS if doc in documents))
+    for command, before in AFTER.items():
+        if command in commands and any(b in commands for b in before):
+            commands.remove(command)
+            commands.insert(max(commands.index(b) for b in before if b in commands) + 1, command)
     return [*commands, README_TABLES] if commands else []
 
 
@@ -448,8 +455,13 @@ def regenerate(commands: list[str], root: Path = REPO, jobs: int = 1) -> None:
         queue.sort(key=lambda item: -MINUTES.get(item[1], 0))
     failed = None
     while queue or running:
-        while queue and len(running) < max(1, jobs) and failed is None:
-            k, command = queue.pop(0)
+        while len(running) < max(1, jobs) and failed is None:
+            waiting = {c for _, c in queue} | {c for _, c, _ in running.values()}
+            ready = [item for item in queue if not any(b in waiting for b in AFTER.get(item[1], ()))]
+            if not ready:
+                break
+            k, command = ready[0]
+            queue.remove(ready[0])
             print(f"evclust.stamps: [{k}/{len(commands)}] {command}", flush=True)
             out = None
             if jobs > 1:
