@@ -50,3 +50,14 @@ def test_the_fusesoc_core_file_lints_through_edalize(tmp_path, target):
                           cwd=tmp_path, capture_output=True, text=True, env=os.environ)  # fmt: skip
     assert done.returncode == 0, done.stdout[-2000:] + done.stderr[-2000:]
     assert "%Warning" not in done.stdout + done.stderr
+
+
+def test_the_fusesoc_core_file_lists_every_rtl_file():
+    # a file the RTL needs but the core file leaves out fails only where a FuseSoC user builds it
+    import re
+
+    from evclust.rtl.sources import RTL_INCLUDES, RTL_SOURCES
+
+    text = (Path(__file__).resolve().parents[1] / "evclust.core").read_text()
+    listed = set(re.findall(r"^\s+- (rtl/[\w.]+)", text, flags=re.M))
+    assert {f"rtl/{name}" for name in (*RTL_SOURCES, *RTL_INCLUDES, "evclust_params.vh")} <= listed
