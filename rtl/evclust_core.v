@@ -90,6 +90,11 @@ module evclust_core #(
     localparam integer V_FULL_BITS = V_INT_W - 1 - FI;  // v_int's integer bits: full-scale speed
     localparam signed [63:0] ONE_A = 64'sd1 <<< FA;
     localparam signed [63:0] MAX_ACT = (64'sd1 <<< ACTIVITY_W) - 1;
+    // Against a reference time (ACTIVITY_REFERENCE), a slot keeps Ã, the activity scaled up to
+    // the reference by up to 2^REFERENCE_HALVINGS: that many integer bits more in its row.
+    localparam REFERENCED = ACTIVITY_REFERENCE != 0;
+    localparam integer ACT_ROW_W = REFERENCED ? ACTIVITY_W + REFERENCE_HALVINGS : ACTIVITY_W;
+    localparam signed [63:0] MAX_ACT_ROW = (64'sd1 <<< ACT_ROW_W) - 1;
     localparam signed [63:0] MAX_GAMMA = (64'sd1 <<< GAMMA_W) - 1;
     localparam signed [63:0] MAX_EVCOUNT = (64'sd1 <<< EVENTS_IN_INTERVAL_W) - 1;
     localparam signed [63:0] MAX_V = (64'sd1 <<< (V_MCM_W - 1)) - 1, MIN_V = -(64'sd1 <<< (V_MCM_W - 1));
@@ -280,7 +285,7 @@ module evclust_core #(
     localparam integer ROW_PPX = ROW_ID + ID_W;
     localparam integer ROW_PPY = ROW_PPX + CENTRE_W;
     localparam integer ROW_ACT = ROW_PPY + CENTRE_W;
-    localparam integer ROW_RESIDUAL = ROW_ACT + ACTIVITY_W;
+    localparam integer ROW_RESIDUAL = ROW_ACT + ACT_ROW_W;
     localparam integer ROW_T_LAST = ROW_RESIDUAL + DECAY_RESIDUAL_W;
     localparam integer ROW_GAMMA = ROW_T_LAST + T_LAST_W;
     localparam integer ROW_VMX = ROW_GAMMA + GAMMA_W;
@@ -304,7 +309,7 @@ module evclust_core #(
     wire [ID_W-1:0]                 id_b = row_b[ROW_ID +: ID_W];  // (port A's id: a merge copies the whole row)
     wire [CENTRE_W-1:0]             ppx_a = row_a[ROW_PPX +: CENTRE_W], ppx_b = row_b[ROW_PPX +: CENTRE_W];
     wire [CENTRE_W-1:0]             ppy_a = row_a[ROW_PPY +: CENTRE_W], ppy_b = row_b[ROW_PPY +: CENTRE_W];
-    wire [ACTIVITY_W-1:0]           act_a = row_a[ROW_ACT +: ACTIVITY_W], act_b = row_b[ROW_ACT +: ACTIVITY_W];
+    wire [ACT_ROW_W-1:0]            act_a = row_a[ROW_ACT +: ACT_ROW_W], act_b = row_b[ROW_ACT +: ACT_ROW_W];
     wire [DECAY_RESIDUAL_W-1:0]     residual_a = row_a[ROW_RESIDUAL +: DECAY_RESIDUAL_W], residual_b = row_b[ROW_RESIDUAL +: DECAY_RESIDUAL_W];
     wire [T_LAST_W-1:0]             t_last_a = row_a[ROW_T_LAST +: T_LAST_W], t_last_b = row_b[ROW_T_LAST +: T_LAST_W];
     wire [GAMMA_W-1:0]              gamma_a = row_a[ROW_GAMMA +: GAMMA_W];
@@ -326,9 +331,9 @@ module evclust_core #(
     reg [TAU_PHASE_W-1:0]      tau_phase;
     reg [EVERY_W-1:0]          since_filter;
     reg                        started;
-    reg [ACTIVITY_W-1:0]       bg_act;       // the activity of the events no reported cluster takes
-    reg [DECAY_RESIDUAL_W-1:0] bg_residual;
-    reg [EV_T_W-1:0]           bg_t;
+    reg [ACT_ROW_W-1:0]        bg_act;       // the activity of the events no reported cluster takes
+    reg [DECAY_RESIDUAL_W-1:0] bg_residual;  // (against a reference time: the reference's residual)
+    reg [EV_T_W-1:0]           bg_t;         // (and the reference time)
 
     // ---------------------------------------------------------------- the creation-support map
     // One cell per 2^SUPPORT_CELL_BITS px square, a border cell all round (model: layout.support_shape):
@@ -350,7 +355,7 @@ module evclust_core #(
     reg [EV_XY_W-1:0]      e_x, e_y;
     reg [EV_COLOUR_W-1:0]  e_lum, e_cb, e_cr;
     reg [SLOT_W-1:0]       weakest;
-    reg [ACTIVITY_W-1:0]   weakest_a;
+    reg [ACT_ROW_W-1:0]    weakest_a;
     reg [32:0]             boundaries;   // tau boundaries since the last filter step
     reg [FRAME_PER_TAU_W-1:0] per_frame; // T_frame / (boundaries * tau)
 
@@ -435,7 +440,7 @@ module evclust_core #(
     wire [ACTIVITY_W-1:0] dec_a;
     wire [DECAY_RESIDUAL_W-1:0] dec_residual;
     evclust_decay #(.ACTIVITY_BITS(ACTIVITY_W), .DT_BITS(DT_W), .RESIDUAL_BITS(DECAY_RESIDUAL_W), .INV_T_HALF_BITS(INV_T_HALF_W)) decay_unit (
-        .activity(commit_reads ? act_b : act_a),
+        .activity(commit_reads ? act_b[ACTIVITY_W-1:0] : act_a[ACTIVITY_W-1:0]),
         .dt(commit_reads ? c_t - t_last_b : e_t - t_last_a),
         .residual(commit_reads ? residual_b : residual_a),
         .use_residual(state != ST_SCAN),
@@ -443,13 +448,12 @@ module evclust_core #(
         .decayed(dec_a),
         .residual_out(dec_residual)
     );
-    wire signed [63:0] a_decayed = u64({{(63 - ACTIVITY_W){1'b0}}, dec_a});
 
     // The background's activity decayed to the event's time (model: _decay_background).
     wire [ACTIVITY_W-1:0] bg_dec_a;
     wire [DECAY_RESIDUAL_W-1:0] bg_dec_residual;
     evclust_decay #(.ACTIVITY_BITS(ACTIVITY_W), .DT_BITS(DT_W), .RESIDUAL_BITS(DECAY_RESIDUAL_W), .INV_T_HALF_BITS(INV_T_HALF_W)) bg_decay_unit (
-        .activity(bg_act),
+        .activity(bg_act[ACTIVITY_W-1:0]),
         .dt(e_t - bg_t),
         .residual(bg_residual),
         .use_residual(1'b1),
@@ -457,8 +461,60 @@ module evclust_core #(
         .decayed(bg_dec_a),
         .residual_out(bg_dec_residual)
     );
-    wire signed [63:0] bg_counted_full = u64({{(63 - ACTIVITY_W){1'b0}}, bg_dec_a}) + ONE_A;
-    wire signed [63:0] bg_counted = saturate(bg_counted_full, 0, MAX_ACT);
+
+    // ---------------------------------------------------------------- the activity against a reference time
+    // (ACTIVITY_REFERENCE; model: _reference_span, _weight, _move_reference.) bg_t is the
+    // reference and bg_residual its residual. The event in stage A gets its weight, and is held
+    // there while the reference first moves to its time if Ã could outgrow its headroom
+    // (`move_due`: a drain of the updates in flight, then a pass over the slots, PHASE and SWEEP
+    // with `moving`). A filter step moves the reference to its event's time in PHASE. Either
+    // way every activity is decayed by the one step count `ref_m`: the background's as PHASE
+    // ends, a slot's at its stage 0 (or the merge that reads it first, `k_decayed`).
+    reg                   moving;     // PHASE and SWEEP move the reference: no filter step
+    reg                   k_decayed;  // the swept slot's activity is already decayed (a merge wrote it)
+    reg [63:0]            ref_m;      // the steps every activity decays by, as PHASE ends
+    reg [ACT_ROW_W-1:0]   e_weight, h_weight, c_weight;  // the weight of the event in B, H, C
+    wire [EV_T_W-1:0]     ref_time = state == ST_PHASE && !moving ? e_t : a_t;  // the step's event, or the one in A
+    wire [63:0]           ref_steps;
+    wire [DECAY_RESIDUAL_W-1:0] ref_residual;
+    wire                  ref_passed;
+    wire [ACT_ROW_W-1:0]  a_weight;
+    wire [ACT_ROW_W-1:0]  ref_dec_a, ref_dec_b;
+    // Port B's decay, saturated: the background's in PHASE, the slot a merge absorbs in MERGE.
+    wire signed [63:0]    ref_dec_bg = saturate(u64({{(63 - ACT_ROW_W){1'b0}}, ref_dec_b}), 0, MAX_ACT);
+    wire signed [63:0]    ref_dec_j = ref_dec_bg;
+    generate
+        if (REFERENCED) begin : reference
+            evclust_reference #(.WEIGHT_BITS(ACT_ROW_W)) weights (
+                .t(ref_time), .t_ref(bg_t), .residual(bg_residual), .inv_t_half(K_INV_T_HALF),
+                .steps(ref_steps), .residual_out(ref_residual), .passed(ref_passed), .weight(a_weight)
+            );
+            // Port A's slot (the sweep's stage 0) and port B's (the slot a merge absorbs) or, in
+            // PHASE, the background.
+            evclust_decay_apply #(.ACTIVITY_BITS(ACT_ROW_W)) decay_a (.activity(act_a), .m(ref_m), .decayed(ref_dec_a));
+            evclust_decay_apply #(.ACTIVITY_BITS(ACT_ROW_W)) decay_b (
+                .activity(state == ST_PHASE ? bg_act : act_b), .m(state == ST_PHASE ? ref_steps : ref_m), .decayed(ref_dec_b)
+            );
+        end else begin : own_time
+            assign ref_steps = 64'd0;
+            assign ref_residual = {DECAY_RESIDUAL_W{1'b0}};
+            assign ref_passed = 1'b0;
+            assign a_weight = {ACT_ROW_W{1'b0}};
+            assign ref_dec_a = {ACT_ROW_W{1'b0}};
+            assign ref_dec_b = {ACT_ROW_W{1'b0}};
+        end
+    endgenerate
+    wire signed [63:0] ref_dec_k = saturate(u64({{(63 - ACT_ROW_W){1'b0}}, ref_dec_a}), 0, MAX_ACT);
+    // The swept (or merging) slot's activity at the step's time (model: the slot after _decay_slot
+    // or _move_reference), and the write-back's word.
+    wire signed [63:0] a_decayed = !REFERENCED ? u64({{(63 - ACTIVITY_W){1'b0}}, dec_a})
+                                 : k_decayed ? u64({{(63 - ACT_ROW_W){1'b0}}, act_a}) : ref_dec_k;
+    wire [ACT_ROW_W-1:0] act_now = a_decayed[ACT_ROW_W-1:0];
+    // The event's count: one (plus the background's decay), or its weight.
+    wire signed [63:0] bg_counted_full = REFERENCED ? u64({{(63 - ACT_ROW_W){1'b0}}, bg_act}) + u64({{(63 - ACT_ROW_W){1'b0}}, e_weight})
+                                                    : u64({{(63 - ACTIVITY_W){1'b0}}, bg_dec_a}) + ONE_A;
+    wire signed [63:0] bg_counted = saturate(bg_counted_full, 0, MAX_ACT_ROW);
+    wire signed [63:0] bg_dec_wide = u64({{(63 - ACTIVITY_W){1'b0}}, bg_dec_a});  // (the paper's, decayed to the step)
 
     // ---------------------------------------------------------------- creation support
     // Some event of the 3x3 cells around the event's cell at most SUPPORT_WINDOW us old (mod 2^32).
@@ -601,6 +657,13 @@ module evclust_core #(
     wire [MCM_NORM_W-1:0]  sw_norm = DELAYED ? cm_norm : up_norm;
     wire [COLOUR_W-1:0]    sw_cy = DELAYED ? cm_cy : up_cy, sw_ccb = DELAYED ? cm_ccb : up_ccb, sw_ccr = DELAYED ? cm_ccr : up_ccr;
     wire [EV_T_W-1:0]      sw_t = DELAYED ? c_t : e_t;
+    // Against a reference time the activity's update is Ã plus the event's weight (model: _commit).
+    wire signed [63:0]     ref_act_full = u64({{(63 - ACT_ROW_W){1'b0}}, sw_row[ROW_ACT +: ACT_ROW_W]})
+                                        + u64({{(63 - ACT_ROW_W){1'b0}}, DELAYED ? c_weight : e_weight});
+    wire signed [63:0]     ref_act = saturate(ref_act_full, 0, MAX_ACT_ROW);
+    wire signed [63:0]     cm_act_wide = u64({{(63 - ACTIVITY_W){1'b0}}, cm_act});
+    wire [ACT_ROW_W-1:0]   sw_act = REFERENCED ? ref_act[ACT_ROW_W-1:0] : cm_act_wide[ACT_ROW_W-1:0];
+    wire [1:0]             sw_act_saturations = REFERENCED ? outside(ref_act_full, 0, MAX_ACT_ROW) : cm_act_saturations;
     // The background colour's commit.
     reg signed [63:0] cm_bg_y, cm_bg_cb, cm_bg_cr;
     always @* begin
@@ -733,7 +796,7 @@ module evclust_core #(
     reg [7:0]         f_class;
     reg [3:0]         f_flags;
     always @* begin
-        f_act = u64({{(63 - ACTIVITY_W){1'b0}}, act_b});
+        f_act = u64({{(63 - ACT_ROW_W){1'b0}}, act_b});
         f_px = u64({{(63 - CENTRE_W){1'b0}}, px[t]});
         f_py = u64({{(63 - CENTRE_W){1'b0}}, py[t]});
         f_vix_t = $signed({{(64 - V_INT_W){vix[t][V_INT_W-1]}}, vix[t]});
@@ -763,7 +826,7 @@ module evclust_core #(
         // The noise gate: A * W * H >= gate * A_bg * (pixels of the box), the gate in Q.NOISE_GATE_FRAC.
         f_box = (2 * u64({{(63 - HALF_SIZE_W){1'b0}}, rx[t] >> FR}) + 1) * (2 * u64({{(63 - HALF_SIZE_W){1'b0}}, ry[t] >> FR}) + 1);
         f_noise_signal = (f_act * SENSOR_PIXELS) <<< NOISE_GATE_FRAC;  // both sides fit noise_count
-        f_noise_floor = K_NOISE_GATE * u64({{(63 - ACTIVITY_W){1'b0}}, bg_act}) * f_box;
+        f_noise_floor = K_NOISE_GATE * u64({{(63 - ACT_ROW_W){1'b0}}, bg_act}) * f_box;
         if (K_NOISE_GATE != 0 && f_report)
             f_report = f_noise_signal[NOISE_COUNT_W-1:0] >= f_noise_floor[NOISE_COUNT_W-1:0];
         // The class: the strongest non-background histogram entry, none while all are zero.
@@ -792,7 +855,7 @@ module evclust_core #(
     assign record[REC_Y_LSB +: REC_Y_W] = py[t];
     assign record[REC_RX_LSB +: REC_RX_W] = rx[t];
     assign record[REC_RY_LSB +: REC_RY_W] = ry[t];
-    assign record[REC_ACTIVITY_LSB +: REC_ACTIVITY_W] = act_b;
+    assign record[REC_ACTIVITY_LSB +: REC_ACTIVITY_W] = act_b[ACTIVITY_W-1:0];  // (swept: within the activity's format)
     assign record[REC_VX_MCM_LSB +: REC_VX_MCM_W] = f_vmx[V_MCM_W-1:0];
     assign record[REC_VY_MCM_LSB +: REC_VY_MCM_W] = f_vmy[V_MCM_W-1:0];
     assign record[REC_VX_INT_LSB +: REC_VX_INT_W] = vix[t];
@@ -856,7 +919,7 @@ module evclust_core #(
     localparam integer MOMENT_W = MERGE_MOMENT_W;
     reg  [SLOT_W-1:0]     m_j;          // the slot being absorbed
     reg                   m_started;    // MERGE: the dividers have their operands
-    wire signed [63:0]    m_act_j = u64({{(63 - ACTIVITY_W){1'b0}}, act_b});
+    wire signed [63:0]    m_act_j = REFERENCED ? ref_dec_j : u64({{(63 - ACT_ROW_W){1'b0}}, act_b});  // (the paper's: not decayed yet)
     wire signed [63:0]    m_weight = a_decayed + m_act_j;
     wire signed [63:0]    m_moment_x = a_decayed * c64(px[k]) + m_act_j * c64(px[m_j]);
     wire signed [63:0]    m_moment_y = a_decayed * c64(py[k]) + m_act_j * c64(py[m_j]);
@@ -917,7 +980,7 @@ module evclust_core #(
     // by comparison; more take two iterative divisions (phase / tau, then T_frame / count).
     reg  [32:0] phase_q;     // the phase at the filter step's event
     reg  [1:0]  phase_step;  // PHASE: deciding, dividing the phase, dividing the frame period
-    wire        phase_start = state == ST_PHASE && phase_step == PHASE_DECIDE && !phase_hold && phase_q >= TAU[31:0] * 33'd2;
+    wire        phase_start = state == ST_PHASE && !moving && phase_step == PHASE_DECIDE && !phase_hold && phase_q >= TAU[31:0] * 33'd2;
     wire        by_tau_done, frame_done;
     wire [32:0] by_tau_q;
     wire [TAU_PHASE_W:0] by_tau_left;
@@ -935,7 +998,7 @@ module evclust_core #(
     );
     wire        many_boundaries = by_tau_q >= (33'd1 << FRAME_PER_TAU_W);
     wire        no_boundary = phase_q < {1'b0, TAU[31:0]};
-    wire        frame_start = state == ST_PHASE && phase_step == PHASE_BY_TAU && by_tau_done && !many_boundaries;
+    wire        frame_start = state == ST_PHASE && !moving && phase_step == PHASE_BY_TAU && by_tau_done && !many_boundaries;
     wire [FRAME_PER_TAU_W-1:0] frame_q;
     wire [FRAME_PER_TAU_W-1:0] unused_frame_left;
     evclust_udiv #(.NUM_W(FRAME_PER_TAU_W), .DEN_W(FRAME_PER_TAU_W)) div_frame (
@@ -974,8 +1037,11 @@ module evclust_core #(
     // creates there if it is weak enough, else drops the event.
     wire scan_last = index == LAST_SLOT;
     wire init_done = index >= LAST_INIT && (CREATE_SUPPORT == 0 || init_cell == LAST_CELL);
-    wire scan_weaker = dec_a < weakest_a || index == {SWEEP_W{1'b0}};
-    wire evict = u64({{(63 - ACTIVITY_W){1'b0}}, weakest_a}) < K_A_VALID;
+    // Against a reference time every Ã has the one reference: the weakest now has the least Ã,
+    // and A < A_valid is Ã < A_valid * w (model: _slot_for_new).
+    wire scan_weaker = (REFERENCED ? act_a : a_decayed[ACT_ROW_W-1:0]) < weakest_a || index == {SWEEP_W{1'b0}};
+    wire signed [63:0] weakest_wide = u64({{(63 - ACT_ROW_W){1'b0}}, weakest_a});
+    wire evict = REFERENCED ? (weakest_wide <<< FA) < K_A_VALID * u64({{(63 - ACT_ROW_W){1'b0}}, e_weight}) : weakest_wide < K_A_VALID;
     reg              do_update, do_create, finish, split;
     reg [SLOT_W-1:0] create_slot;
     reg [2:0]        action;
@@ -1049,11 +1115,15 @@ module evclust_core #(
     wire sweep_due = {{(32 - EVERY_W){1'b0}}, since_filter} + 32'd1 >= {{(32 - EVERY_W){1'b0}}, K_FILTER_EVERY};
     // An update of a reported cluster is the object's colour, not the background's.
     wire bg_learns = finish && !bg_fixed && !(do_update && reported[e_slot]);
-    wire sweep_advance = state == ST_SWEEP && (!rec_valid || rec_ready);
+    wire sweep_advance = state == ST_SWEEP && (moving || !rec_valid || rec_ready);
     wire sweep_live = sweep_advance && index < N_SLOTS && valid[k];
-    wire sweep_merge = sweep_live && !f_expire && merge_found;  // k absorbs merge_j first
-    wire sweep_slot = sweep_live && !sweep_merge;
-    assign tail_en = sweep_advance && !sweep_merge;
+    wire sweep_merge = sweep_live && !moving && !f_expire && merge_found;  // k absorbs merge_j first
+    wire sweep_slot = sweep_live && !sweep_merge;                          // k's stage 0 (moving: its decay only)
+    assign tail_en = sweep_advance && !sweep_merge && !moving;
+    // The reference must move before the event in stage A goes on (model: _reference_passed).
+    wire move_pending = REFERENCED && a_valid && ref_passed;
+    wire move_due = state == ST_IDLE && move_pending;
+    wire move_hold = UPDATE_DELAY > 1 && (h_live || h_bg_live);  // stage H still to drain through C
 
     // ---------------------------------------------------------------- derived slot fields
     // At most one slot's size is written per cycle (an update, a creation or a merge, each in
@@ -1075,7 +1145,7 @@ module evclust_core #(
     // in the same cycle; B (EXEC) takes it when B is empty (IDLE) or finishes an event that
     // starts no filter step. B writes at most one slot as it finishes, w, which the next
     // event's seek tests again.
-    wire b_takes = state == ST_IDLE || (finish && !sweep_due);
+    wire b_takes = (state == ST_IDLE || (finish && !sweep_due)) && !move_pending;
     wire a_advance = a_valid && b_takes;
     wire [SLOT_W-1:0] written_slot = UPDATE_DELAY == 0 ? (do_update ? e_slot : create_slot) : (do_create ? create_slot : c_slot);
     assign ev_ready = !dp_rst && (!a_valid || a_advance);  // no handshake during a reset or clear
@@ -1089,11 +1159,16 @@ module evclust_core #(
         state_next = state;
         case (state)
             ST_INIT: if (init_done) state_next = ST_IDLE;
+            ST_IDLE: if (move_due) state_next = ST_PHASE;
             ST_EXEC: if (!finish && !split) state_next = ST_SCAN;
             ST_SCAN: if (scan_last) state_next = ST_EVICT;
-            ST_SWEEP: if (sweep_merge) state_next = ST_MERGE;
+            ST_SWEEP: if (moving) begin
+                          if (index == LAST_SLOT) state_next = ST_IDLE;
+                      end else if (sweep_merge) state_next = ST_MERGE;
                       else if (sweep_advance && index == LAST_SWEEP) state_next = ST_IDLE;
-            ST_PHASE: case (phase_step)
+            ST_PHASE: if (moving) begin
+                          if (!move_hold) state_next = ST_SWEEP;
+                      end else case (phase_step)
                 PHASE_DECIDE: if (!phase_hold && (no_boundary || !phase_start)) state_next = ST_SWEEP;
                 PHASE_BY_TAU: if (by_tau_done && many_boundaries) state_next = ST_SWEEP;
                 default: if (frame_done) state_next = ST_SWEEP;
@@ -1113,7 +1188,14 @@ module evclust_core #(
     // ---------------------------------------------------------------- status counters
     // What this cycle adds to each counter of evclust_regs, registered into count_inc. The
     // saturations are the model's `_store` sites (fixed_model.py), each counted where it applies.
-    wire               stage0 = sweep_slot && !f_expire;
+    wire               stage0 = sweep_slot && !moving && !f_expire;
+    // Against a reference time, what an activity's decay to the reference saturates (model:
+    // _move_reference): the background's as PHASE ends, a slot's where it is first decayed.
+    wire               phase_ends = state == ST_PHASE && state_next == ST_SWEEP;
+    wire [1:0]         ref_saturations = !REFERENCED ? 2'd0
+        : (phase_ends ? outside(u64({{(63 - ACT_ROW_W){1'b0}}, ref_dec_b}), 0, MAX_ACT) : 2'd0)
+        + ((sweep_slot || m_write) && !k_decayed ? outside(u64({{(63 - ACT_ROW_W){1'b0}}, ref_dec_a}), 0, MAX_ACT) : 2'd0)
+        + (m_write ? outside(u64({{(63 - ACT_ROW_W){1'b0}}, ref_dec_b}), 0, MAX_ACT) : 2'd0);
     wire               tail_out = tail_en && t_live;
     wire               bg_counts = finish && !(do_update && reported[e_slot]) && K_NOISE_GATE != 0;
     reg [COUNT_W-1:0]  inc;
@@ -1125,13 +1207,13 @@ module evclust_core #(
         inc[COUNT_EVICTIONS * COUNTER_INC_W +: 2] = {1'b0, state == ST_EVICT && finish && evict};
         inc[COUNT_DROPS * COUNTER_INC_W +: 2] = {1'b0, state == ST_EVICT && finish && !evict};
         inc[COUNT_UNSUPPORTED * COUNTER_INC_W +: 2] = {1'b0, finish && action == TRACE_UNSUPPORTED};
-        inc[COUNT_EXPIRIES * COUNTER_INC_W +: 2] = {1'b0, sweep_slot && f_expire};
+        inc[COUNT_EXPIRIES * COUNTER_INC_W +: 2] = {1'b0, sweep_slot && !moving && f_expire};
         inc[COUNT_EXITS * COUNTER_INC_W +: 2] = {1'b0, tail_out && f_exit};
         inc[COUNT_MERGES * COUNTER_INC_W +: 2] = {1'b0, m_write};
         inc[COUNT_RECORDS * COUNTER_INC_W +: 2] = {1'b0, tail_out && !f_exit && f_report};
-        inc[COUNT_SAT_ACTIVITY * COUNTER_INC_W +: 2] = (slot_write ? cm_act_saturations : 2'd0)
-            + (bg_counts ? outside(bg_counted_full, 0, MAX_ACT) : 2'd0)
-            + (m_write ? outside(m_weight, 0, MAX_ACT) : 2'd0);
+        inc[COUNT_SAT_ACTIVITY * COUNTER_INC_W +: 2] = (slot_write ? sw_act_saturations : 2'd0)
+            + (bg_counts ? outside(bg_counted_full, 0, MAX_ACT_ROW) : 2'd0)
+            + (m_write ? outside(m_weight, 0, MAX_ACT) : 2'd0) + ref_saturations;
         inc[COUNT_SAT_CENTRE_STEP * COUNTER_INC_W +: 2] = do_update ? up_step_saturations : 2'd0;
         inc[COUNT_SAT_MCM_STEP * COUNTER_INC_W +: 2] = (H_STAGE ? h_fresh : do_update) ? up_mcm_saturations : 2'd0;
         inc[COUNT_SAT_EVENTS_IN_INTERVAL * COUNTER_INC_W +: 2] = (slot_write ? cm_evc_saturations : 2'd0)
@@ -1159,7 +1241,7 @@ module evclust_core #(
             row_we = 1'b1;
             row_w_slot = sw_slot;
             row_w = sw_row;
-            row_w[ROW_ACT +: ACTIVITY_W] = cm_act;
+            row_w[ROW_ACT +: ACT_ROW_W] = sw_act;
             row_w[ROW_RESIDUAL +: DECAY_RESIDUAL_W] = dec_residual;
             row_w[ROW_T_LAST +: T_LAST_W] = sw_t;
             row_w[ROW_VMX +: V_MCM_W] = sw_vmx;
@@ -1177,7 +1259,7 @@ module evclust_core #(
             row_w[ROW_ID +: ID_W] = next_id;
             row_w[ROW_PPX +: CENTRE_W] = {{(CENTRE_W - EV_XY_W - FP){1'b0}}, e_x, {FP{1'b0}}};
             row_w[ROW_PPY +: CENTRE_W] = {{(CENTRE_W - EV_XY_W - FP){1'b0}}, e_y, {FP{1'b0}}};
-            row_w[ROW_ACT +: ACTIVITY_W] = ONE_A[ACTIVITY_W-1:0];
+            row_w[ROW_ACT +: ACT_ROW_W] = REFERENCED ? e_weight : ONE_A[ACT_ROW_W-1:0];
             row_w[ROW_RESIDUAL +: DECAY_RESIDUAL_W] = {DECAY_RESIDUAL_W{1'b0}};
             row_w[ROW_T_LAST +: T_LAST_W] = e_t;
             row_w[ROW_GAMMA +: GAMMA_W] = gamma_new[GAMMA_W-1:0];
@@ -1195,7 +1277,7 @@ module evclust_core #(
             row_w_slot = k;
             if (m_from_j)
                 row_w = row_b;
-            row_w[ROW_ACT +: ACTIVITY_W] = m_act[ACTIVITY_W-1:0];
+            row_w[ROW_ACT +: ACT_ROW_W] = m_act[ACT_ROW_W-1:0];
             row_w[ROW_RESIDUAL +: DECAY_RESIDUAL_W] = dec_residual;
             row_w[ROW_T_LAST +: T_LAST_W] = e_t;
             row_w[ROW_PPX +: CENTRE_W] = m_ppx[CENTRE_W-1:0];
@@ -1205,10 +1287,10 @@ module evclust_core #(
         if (sweep_slot) begin  // stage 0
             row_we = 1'b1;
             row_w_slot = k;
-            row_w[ROW_ACT +: ACTIVITY_W] = dec_a;
+            row_w[ROW_ACT +: ACT_ROW_W] = act_now;
             row_w[ROW_RESIDUAL +: DECAY_RESIDUAL_W] = dec_residual;
             row_w[ROW_T_LAST +: T_LAST_W] = e_t;
-            if (!f_expire) begin
+            if (!f_expire && !moving) begin
                 row_w[ROW_GAMMA +: GAMMA_W] = f_gamma[GAMMA_W-1:0];
                 row_w[ROW_EV_COUNT +: EVENTS_IN_INTERVAL_W] = f_evc[EVENTS_IN_INTERVAL_W-1:0];
                 if (boundaries != 33'd0) begin
@@ -1236,7 +1318,10 @@ module evclust_core #(
             rec_valid <= 1'b0;
             rec_data <= {REC_W{1'b0}};
             trace_data <= {TRACE_W{1'b0}};
-            bg_act <= {ACTIVITY_W{1'b0}};
+            bg_act <= {ACT_ROW_W{1'b0}};
+            moving <= 1'b0;
+            k_decayed <= 1'b0;
+            ref_m <= 64'd0;
             bg_residual <= {DECAY_RESIDUAL_W{1'b0}};
             bg_t <= {EV_T_W{1'b0}};
             init_cell <= {CELL_W{1'b0}};
@@ -1293,14 +1378,21 @@ module evclust_core #(
                 ST_SCAN: begin
                     if (scan_weaker) begin
                         weakest <= k;
-                        weakest_a <= dec_a;
+                        weakest_a <= REFERENCED ? act_a : a_decayed[ACT_ROW_W-1:0];
                     end
                     index <= index + 1'b1;
                 end
-                ST_SWEEP: if (sweep_merge) begin
+                ST_SWEEP: if (moving) begin  // the reference's move: every slot's activity decayed, nothing else
+                    index <= index + 1'b1;
+                    if (index == LAST_SLOT) begin
+                        index <= {SWEEP_W{1'b0}};
+                        moving <= 1'b0;
+                    end
+                end else if (sweep_merge) begin
                     m_j <= merge_j;
                 end else if (sweep_advance) begin
                     index <= index + 1'b1;
+                    k_decayed <= 1'b0;
                     if (index == LAST_SWEEP) begin
                         step <= step + 32'd1;
                         t_filter <= e_t;
@@ -1308,7 +1400,9 @@ module evclust_core #(
                         step_t <= e_t[31:0];
                     end
                 end
-                ST_PHASE: case (phase_step)  // tau boundaries since the last step and T_frame / (n tau)
+                ST_IDLE: if (move_due)
+                    moving <= 1'b1;
+                ST_PHASE: if (!moving) case (phase_step)  // tau boundaries since the last step and T_frame / (n tau)
                     PHASE_DECIDE: if (phase_hold) begin
                         // the last step's end not taken yet
                     end else if (no_boundary) begin
@@ -1339,10 +1433,20 @@ module evclust_core #(
                     m_started <= 1'b1;
                     if (m_write) begin
                         m_started <= 1'b0;  // SWEEP then takes the same slot again: it may absorb another
+                        k_decayed <= 1'b1;  // (with its activity decayed)
                     end
                 end
                 default: ;
             endcase
+
+            // Against a reference time, the end of PHASE moves the reference to the step's event
+            // (or, moving, to the event in A): the background decayed, the slots' steps kept.
+            if (REFERENCED && phase_ends) begin
+                ref_m <= ref_steps;
+                bg_act <= ref_dec_bg[ACT_ROW_W-1:0];
+                bg_residual <= ref_residual;
+                bg_t <= ref_time;
+            end
 
             // The end of an event: trace, background, the filter-step counter.
             if (finish) begin
@@ -1356,12 +1460,17 @@ module evclust_core #(
                 end
                 // The background's activity counts the event if no reported cluster took it, and
                 // is decayed to the filter step's time before a sweep.
-                if (!(do_update && reported[e_slot])) begin
-                    bg_act <= bg_counted[ACTIVITY_W-1:0];
+                // Against a reference time it adds the event's weight (when the noise gate reads
+                // it, as the model), and PHASE decays it to the step's time.
+                if (REFERENCED) begin
+                    if (!(do_update && reported[e_slot]) && K_NOISE_GATE != 0)
+                        bg_act <= bg_counted[ACT_ROW_W-1:0];
+                end else if (!(do_update && reported[e_slot])) begin
+                    bg_act <= bg_counted[ACT_ROW_W-1:0];
                     bg_residual <= bg_dec_residual;
                     bg_t <= e_t;
                 end else if (sweep_due) begin
-                    bg_act <= bg_dec_a;
+                    bg_act <= bg_dec_wide[ACT_ROW_W-1:0];
                     bg_residual <= bg_dec_residual;
                     bg_t <= e_t;
                 end
@@ -1383,6 +1492,7 @@ module evclust_core #(
             // The pipeline moves: A to B, the port to A.
             if (a_advance) begin
                 e_t <= a_t;
+                e_weight <= a_weight;
                 e_x <= a_x;
                 e_y <= a_y;
                 e_lum <= a_lum;
@@ -1406,6 +1516,10 @@ module evclust_core #(
                     started <= 1'b1;
                     t_filter <= in_t;
                     tau_phase <= {TAU_PHASE_W{1'b0}};
+                    if (REFERENCED) begin  // so does the activity's reference
+                        bg_t <= in_t;
+                        bg_residual <= {DECAY_RESIDUAL_W{1'b0}};
+                    end
                 end
             end
             if (ev_valid && ev_ready)
@@ -1444,6 +1558,7 @@ module evclust_core #(
                     c_bg_live <= to_c_bg_live;
                     c_slot <= to_c_slot;
                     c_t <= to_c_t;
+                    c_weight <= H_STAGE ? h_weight : e_weight;
                     c_dpx <= i_px;
                     c_dpy <= i_py;
                     c_drx <= i_rx;
@@ -1470,6 +1585,7 @@ module evclust_core #(
                     h_bg_live <= bg_learns;
                     h_slot <= e_slot;
                     h_t <= e_t;
+                    h_weight <= e_weight;
                     h_dbg_y <= bg_y_d[DB_W-1:0];
                     h_dbg_cb <= bg_cb_d[DB_W-1:0];
                     h_dbg_cr <= bg_cr_d[DB_W-1:0];
@@ -1510,14 +1626,14 @@ module evclust_core #(
                 reach_y[size_slot] <= d_reach_y[REACH_W-1:0];
                 grow[size_slot] <= d_grow[GROW_W-1:0];
             end
-            if (sweep_slot && !f_expire)
+            if (sweep_slot && !moving && !f_expire)
                 vrel[k] <= d_vrel[VREL_W-1:0];
             else if (do_create)
                 vrel[create_slot] <= {VREL_W{1'b0}};
             else if (m_write && m_from_j)
                 vrel[k] <= vrel[m_j];
 
-            if (sweep_slot) begin  // stage 0
+            if (sweep_slot && !moving) begin  // stage 0
                 if (f_expire) begin
                     valid[k] <= 1'b0;
                 end else begin

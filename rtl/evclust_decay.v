@@ -1,8 +1,8 @@
 // Activity decay A * 2^(-dt/T_half) (model: arith.decay_steps + arith.decay_apply).
 // n = dt * (1/T_half) + residual counts 1/64 half-lives; its bits below one step are handed
 // back as the new residual, so many short decays add up to one long one. The integer part
-// of m = n / 2^DROP shifts, its low 6 bits index the 2^-(i/64) table: one multiplier, one
-// barrel shifter, no exponential. Without the residual (eviction's comparison) it is arith.decay.
+// of m = n / 2^DROP shifts, its low 6 bits index the 2^-(i/64) table (evclust_decay_apply).
+// Without the residual (eviction's comparison) it is arith.decay.
 `default_nettype none
 `include "evclust_require.vh"
 module evclust_decay #(
@@ -28,32 +28,10 @@ module evclust_decay #(
     endgenerate
 
     localparam integer DROP = INV_T_HALF_FRAC - DECAY_TABLE_BITS;  // n's bits below one table step
-    localparam integer ENTRY_W = DECAY_TABLE_W;
-    // A shift beyond this leaves nothing of A (the model's `total > 62` test).
-    localparam integer MAX_SHIFT = 62 - DECAY_TABLE_FRAC;
-    localparam [6:0] FRACTION_SHIFT = DECAY_TABLE_FRAC[6:0];
-    localparam [63:0] MAX_HALVINGS = {32'd0, MAX_SHIFT[31:0]};
 
     wire [63:0] steps = {{(64 - DT_W){1'b0}}, dt} * {{(64 - INV_T_HALF_W){1'b0}}, inv_t_half}
                       + (use_residual ? {{(64 - DECAY_RESIDUAL_W){1'b0}}, residual} : 64'd0);
-    wire [63:0] m = steps >> DROP;
-    wire [63:0] halvings = m >> DECAY_TABLE_BITS;
-    wire [DECAY_TABLE_BITS-1:0] index = m[DECAY_TABLE_BITS-1:0];
-    // A multiplexer over the entries: an index times the entry width would be a multiply that
-    // synthesis maps to a DSP block.
-    reg [ENTRY_W-1:0] fraction;
-    integer e;
-    always @* begin
-        fraction = {ENTRY_W{1'b0}};
-        for (e = 0; e < (1 << DECAY_TABLE_BITS); e = e + 1)
-            if ({{(32 - DECAY_TABLE_BITS){1'b0}}, index} == e)
-                fraction = DECAY_TABLE[e * ENTRY_W +: ENTRY_W];
-    end
-    wire [ACTIVITY_W+ENTRY_W-1:0] scaled = activity * fraction;
-    wire [6:0] shift = {1'b0, halvings[5:0]} + FRACTION_SHIFT;  // <= 62 where used
-    wire [ACTIVITY_W+ENTRY_W-1:0] shifted = scaled >> shift;
-
-    assign decayed = halvings > MAX_HALVINGS ? {ACTIVITY_W{1'b0}} : shifted[ACTIVITY_W-1:0];
+    evclust_decay_apply #(.ACTIVITY_BITS(ACTIVITY_BITS)) apply (.activity(activity), .m(steps >> DROP), .decayed(decayed));
     assign residual_out = steps[DECAY_RESIDUAL_W-1:0];  // DECAY_RESIDUAL_W == DROP
 endmodule
 `default_nettype wire

@@ -96,7 +96,7 @@ def simulate(out: Path, header: str, file: str, top: str, inputs: tuple, rows: l
         + ");\n"
         + "  end\n  $finish;\n end\nendmodule\n"
     )
-    sources = [str(HARNESS / file), str(ROOT / "rtl" / "evclust_decay.v")]
+    sources = [str(HARNESS / file), str(ROOT / "rtl" / "evclust_decay.v"), str(ROOT / "rtl" / "evclust_decay_apply.v")]
     sim = subprocess.run(["iverilog", "-g2005", "-s", "tb", "-I", ".", "-I", str(ROOT / "rtl"), "-o", "tb.vvp", "tb.v", *sources],
                          cwd=out, capture_output=True, text=True)  # fmt: skip
     if sim.returncode != 0:

@@ -14,7 +14,7 @@ import math
 from typing import Literal
 
 from evclust.clusterer.objects import DT_MAX_US, object_time_us
-from evclust.clusterer.params import GAMMA_MODES, ClustererParams
+from evclust.clusterer.params import GAMMA_MODES, REFERENCE_HALVINGS, ClustererParams
 from evclust.errors import EvclustError
 
 Rounding = Literal["floor", "nearest", "trunc"]
@@ -503,6 +503,7 @@ def table_options(p: ClustererParams, background: Format) -> tuple[tuple[str, in
         ("BG_FIXED", int(p.background is not None)), ("BACKGROUND_MASK", mask),
         ("MERGE", int(p.merge)), ("CREATE_SUPPORT", int(p.create_support)), ("SUPPORT_CELL_BITS", p.support_cell_bits),
         ("VI_CAP", p.interval_warmup()), ("OBJECTS", int(p.objects)), ("N_OBJECTS", p.n_objects), ("UPDATE_DELAY", p.update_delay),
+        ("ACTIVITY_REFERENCE", int(p.activity_reference)), ("REFERENCE_HALVINGS", REFERENCE_HALVINGS),
         *((f"BG_INIT_{c}", int(round(v * 2**background.frac_bits))) for c, v in zip(("Y", "CB", "CR"), bg)),
     )  # fmt: skip
 

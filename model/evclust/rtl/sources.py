@@ -27,6 +27,8 @@ RTL_SOURCES = (
     "evclust_objects.v",
     "evclust_regs.v",
     "evclust_decay.v",
+    "evclust_decay_apply.v",
+    "evclust_reference.v",
     "evclust_palette.v",
     "evclust_udiv.v",
     "evclust_top2.v",
@@ -66,9 +68,6 @@ def require_rtl_semantics(params) -> None:
     if params.update_delay not in RTL_UPDATE_DELAYS:
         raise EvclustError(f"clusterer: update_delay = {params.update_delay}, but the RTL implements update_delay "
                            f"{' or '.join(map(str, RTL_UPDATE_DELAYS))}; the float and fixed models run any delay")  # fmt: skip
-    if params.activity_reference:
-        raise EvclustError("clusterer: activity_reference = true, but the RTL keeps the activity against each slot's own time; "
-                           "the float and fixed models run either")  # fmt: skip
 
 
 def params_header(params, width: int, height: int, t_frame_us: float, **formats) -> str:

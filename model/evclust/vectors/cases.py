@@ -455,6 +455,49 @@ def pipelined_eviction_voids() -> Case:
                                                              update_delay=2), source="directed")  # fmt: skip
 
 
+def _referenced(case: Case, what: str, delay: int | None = None) -> Case:
+    """A case with the activity kept against a reference time (activity_reference, docs/DESIGN.md
+    "Activity against a reference time"), at the case's own update delay or `delay`."""
+    update = {"activity_reference": True} | ({} if delay is None else {"update_delay": delay})
+    return dataclasses.replace(case, description=f"{case.description}; activity_reference: {what}",
+                               params=case.params.model_copy(update=update))  # fmt: skip
+
+
+def reference_suite_clip() -> Case:
+    return _referenced(suite_clip(), "every event adds its weight, each filter step decays every activity once (merges read "
+                                     "the absorbed slot decayed, the noise gate the background's decayed activity)")  # fmt: skip
+
+
+def reference_pipelined_traffic() -> Case:
+    return _referenced(pipelined_traffic(), "the weights travel with the updates in flight")
+
+
+def reference_table_full() -> Case:
+    return _referenced(pipelined_table_full(), "the weakest slot is the least Ã, evicted when Ã < A_valid times the event's weight")
+
+
+def reference_moves() -> Case:
+    # Two spots at a time out of five, pausing for 3 to 12 half-lives between filter steps: the
+    # event after a long pause first moves the reference (draining the two updates in flight), so
+    # Ã keeps within its headroom. The four-slot table evicts, and the noise gate reads the
+    # background's activity.
+    rng = np.random.default_rng(12)
+    spots = [(8, 8), (56, 8), (8, 40), (56, 40), (32, 24)]
+    rows, t = [], 1000
+    for burst in range(30):
+        pair = (spots[burst % 5], spots[(burst + 2) % 5])
+        for i in range(20 + 7 * (burst % 3)):
+            x, y = pair[i % 2]
+            rows.append((t, x + int(rng.integers(-2, 3)), y + int(rng.integers(-2, 3)), 200, 90, 160))
+            t += 15
+        t += 2000 * (3 + 3 * (burst % 4))  # 3, 6, 9 or 12 half-lives of 2 ms
+    return Case("two of five spots at a time, pausing 3 to 12 half-lives between filter steps; activity_reference, "
+                "update_delay = 2: the event after a long pause moves the reference first, draining the updates in flight; "
+                "evictions from a full table; the noise gate", _events(rows), **SMALL,
+                params=_small_params(n_clusters=4, t_half_us=2000.0, a_valid=3.0, a_min=0.25, filter_every=64, noise_gate=2.0,
+                                     activity_reference=True, update_delay=2), source="directed")  # fmt: skip
+
+
 def file_case(path: str | Path, max_events: int, params: ClustererParams, t_frame_us: float | None = None) -> Case:
     """The first `max_events` events of any event file, as a case a team replays against the RTL."""
     from evclust.errors import EvclustError
@@ -512,4 +555,8 @@ CASES = {
     "pipelined_traffic": pipelined_traffic,
     "pipelined_table_full": pipelined_table_full,
     "pipelined_eviction_voids": pipelined_eviction_voids,
+    "reference_suite_clip": reference_suite_clip,
+    "reference_pipelined_traffic": reference_pipelined_traffic,
+    "reference_table_full": reference_table_full,
+    "reference_moves": reference_moves,
 }
