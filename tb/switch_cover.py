@@ -47,6 +47,7 @@ SWITCHES: dict[str, dict[str, dict]] = {
     "seek": {"noseek": {"seek_scale": 0.0}, "seek": {"seek_scale": 0.09375}},
     "gate": {"nogate": {"noise_gate": 0.0}, "gate": {"noise_gate": 16.0}},
     "objects": {"noobjects": {"objects": False}, "objects": {"objects": True}},
+    "activity": {"owntime": {"activity_reference": False}, "reference": {"activity_reference": True}},
 }  # fmt: skip
 
 # The parameters every row shares: the small configuration's (tb/cosim.py), with the background

@@ -135,20 +135,23 @@ def test_random_streams_match_the_model_in_the_loop(sim, preset, n_clusters):
     assert result["records"] > 0, "a stream that reports nothing checks little"
 
 
-PIPELINED = [("small", 2), ("defaults", 1), ("defaults", 2)]  # one a simulator in make test
+# (preset, update_delay, activity_reference): one a simulator in make test.
+PIPELINED = [("small", 2, False), ("defaults", 1, False), ("defaults", 2, False), ("small", 1, True), ("defaults", 2, True)]
 
 
 @pytest.mark.rotating
-@pytest.mark.parametrize("sim, preset, delay", [(sim, *case) for sim in SIMS_TIMING for case in turn_share(PIPELINED, 1, "pipelined", sim)])
-def test_the_pipelined_core_matches_the_model_in_the_loop_through_gaps_and_stalls(sim, preset, delay):
+@pytest.mark.parametrize("sim, preset, delay, reference", [(sim, *case) for sim in SIMS_TIMING for case in turn_share(PIPELINED, 1, "pipelined", sim)])
+def test_the_pipelined_core_matches_the_model_in_the_loop_through_gaps_and_stalls(sim, preset, delay, reference):
     # update_delay = 1: each update commits as the next event finishes; 2: as the one after
-    # finishes, its second half computed a stage later. The pipeline is event-clocked, so the
-    # stream's random gaps and output stalls must not change what it computes.
+    # finishes, its second half computed a stage later; activity_reference: each commit adds the
+    # event's weight, and the reference moves before an event Ã could outgrow (the stream's
+    # gaps of seconds). The pipeline is event-clocked, so the stream's random gaps and output
+    # stalls must not change what it computes.
     from cosim import configuration_params
 
     seed = int(os.environ.get("EVCLUST_SEED", 1000)) + 7 + delay
     count = _stream_length(sim, 10_000)
-    params = configuration_params(preset, 16).model_copy(update={"update_delay": delay})
+    params = configuration_params(preset, 16).model_copy(update={"update_delay": delay, "activity_reference": reference})
     header, config = _random_config(preset, 16, seed=seed, count=count, params=params)
     result = run(sim, header, "model_in_the_loop", config)
     assert result["events"] == count

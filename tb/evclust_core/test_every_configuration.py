@@ -53,10 +53,10 @@ def test_the_papers_configuration_matches_the_model_in_the_loop(sim, n_clusters)
 
 def test_the_cover_holds_every_pair_of_switch_values():
     rows = cover()
-    assert len(all_pairs()) == 261  # two three-valued switches and nine two-valued ones
+    assert len(all_pairs()) == 309  # two three-valued switches and ten two-valued ones: 9 + 2·10·6 + 45·4
     assert pairs(rows) == all_pairs()
     # A pairwise cover needs at least 3 × 3 rows (the two three-valued switches); all
-    # 3 × 3 × 2^9 = 4,608 combinations would be exhaustive.
+    # 3 × 3 × 2^10 = 9,216 combinations would be exhaustive.
     assert 9 <= len(rows) <= 12
     assert len({row.name for row in rows}) == len(rows)
     from evclust.clusterer import load_params

@@ -1,6 +1,6 @@
-"""synth/activity_reference.py times the activity against a reference time in a harness, since the
-RTL does not carry the mode yet: the harness must compute what the fixed model computes, or its
-figures price something else. Icarus runs it on random operands against evclust.fixed.arith."""
+"""synth/activity_reference.py times the activity against a reference time in a harness, its
+datapath apart from the core's other paths: the harness must compute what the fixed model
+computes, or its figures price something else. Icarus runs it on random operands against evclust.fixed.arith."""
 
 from __future__ import annotations
 

@@ -38,7 +38,7 @@ GAMMA_MODES = ("global", "activity", "count")
 # The activity against a reference time (activity_reference) holds Ã = A·2^((t - t_ref)/T_half),
 # which grows by up to 2^REFERENCE_HALVINGS before the reference moves (at a filter step, or first
 # at an event this many half-lives after it): the fixed model gives Ã that many integer bits more
-# than the activity. The RTL does not implement the mode yet, so its header does not carry them.
+# than the activity, and the RTL's header carries the count (REFERENCE_HALVINGS) for its rows.
 REFERENCE_HALVINGS = 4
 
 MAX_WARMUP = 64  # the interval filter's running mean covers at most this many measurements

@@ -27,9 +27,11 @@ STATES = tuple(enum("evclust_core", "ST_").codes)  # the FSM's states, by code 0
 # without a filter step (EXEC -> EXEC is no change); it finishes in EXEC (a slot takes it) or
 # EVICT (created, evicted, dropped, unsupported), going to PHASE when a filter step is due; a
 # sweep runs PHASE -> SWEEP <-> MERGE -> IDLE (stage B takes no event during a filter step).
+# With the activity against a reference time, a move of the reference before the event in stage
+# A runs IDLE -> PHASE (the drain) -> SWEEP (the slots' decay) -> IDLE.
 # A reset enters INIT from wherever the core was, which these do not list.
 ARCS = (
-    ("INIT", "IDLE"), ("IDLE", "EXEC"), ("EXEC", "IDLE"), ("EXEC", "SCAN"), ("EXEC", "PHASE"),
+    ("INIT", "IDLE"), ("IDLE", "EXEC"), ("IDLE", "PHASE"), ("EXEC", "IDLE"), ("EXEC", "SCAN"), ("EXEC", "PHASE"),
     ("SCAN", "EVICT"), ("EVICT", "IDLE"), ("EVICT", "EXEC"), ("EVICT", "PHASE"),
     ("PHASE", "SWEEP"), ("SWEEP", "MERGE"), ("MERGE", "SWEEP"), ("SWEEP", "IDLE"),
 )  # fmt: skip
