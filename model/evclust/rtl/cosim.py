@@ -31,6 +31,8 @@ BENCHES = {
     "evclust_tb": ((TB_DIR / "evclust_tb.v",), None, "evclust.rtl.harness"),
     "evclust_axis": ((), TB_DIR.parent / "evclust_axis", "test_evclust_axis"),
     "evclust_decay": ((), TB_DIR.parent / "evclust_decay", "test_evclust_decay"),
+    "evclust_decay_apply": ((), TB_DIR.parent / "evclust_decay_apply", "test_evclust_decay_apply"),
+    "evclust_reference": ((), TB_DIR.parent / "evclust_reference", "test_evclust_reference"),
     "evclust_palette": ((), TB_DIR.parent / "evclust_palette", "test_evclust_palette"),
     "evclust_merge_search": ((), TB_DIR.parent / "evclust_merge_search", "test_evclust_merge_search"),
     "evclust_seek": ((), TB_DIR.parent / "evclust_seek", "test_evclust_seek"),
