@@ -10,6 +10,7 @@ random m over all 64 bits and random Ã.
 
 from __future__ import annotations
 
+import functools
 import random
 
 import pytest
@@ -41,11 +42,19 @@ def apply_cases(bits: int, seed: int):
         yield rng.choice((a_max, rng.randrange(a_max + 1))), m
 
 
-def model_apply(activity: int, m: int) -> int:
-    from evclust.fixed.arith import FLOOR, decay_apply, decay_table
+@functools.cache
+def _table():
+    from evclust.fixed.arith import decay_table
     from evclust.fixed.formats import DECAY_FRAC_BITS, DECAY_TABLE_BITS
 
-    return decay_apply(activity, m, decay_table(DECAY_TABLE_BITS, DECAY_FRAC_BITS), DECAY_TABLE_BITS, DECAY_FRAC_BITS, FLOOR)
+    return decay_table(DECAY_TABLE_BITS, DECAY_FRAC_BITS)
+
+
+def model_apply(activity: int, m: int) -> int:
+    from evclust.fixed.arith import FLOOR, decay_apply
+    from evclust.fixed.formats import DECAY_FRAC_BITS, DECAY_TABLE_BITS
+
+    return decay_apply(activity, m, _table(), DECAY_TABLE_BITS, DECAY_FRAC_BITS, FLOOR)
 
 
 if cocotb is not None:
