@@ -140,7 +140,9 @@ PIPELINED = [("small", 2, False), ("defaults", 1, False), ("defaults", 2, False)
 
 
 @pytest.mark.rotating
-@pytest.mark.parametrize("sim, preset, delay, reference", [(sim, *case) for sim in SIMS_TIMING for case in turn_share(PIPELINED, 1, "pipelined", sim)])
+@pytest.mark.parametrize(
+    "sim, preset, delay, reference", [(sim, *case) for sim in SIMS_TIMING for case in turn_share(PIPELINED, 1, "pipelined", sim)]
+)
 def test_the_pipelined_core_matches_the_model_in_the_loop_through_gaps_and_stalls(sim, preset, delay, reference):
     # update_delay = 1: each update commits as the next event finishes; 2: as the one after
     # finishes, its second half computed a stage later; activity_reference: each commit adds the

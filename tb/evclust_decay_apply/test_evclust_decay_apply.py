@@ -99,7 +99,9 @@ def test_the_decay_of_a_referenced_activity_matches_the_models_function(sim):
     from evclust.fixed.formats import DECAY_FRAC_BITS, DECAY_TABLE_BITS
 
     header, bits = apply_build()
-    result = run(sim, header, "apply_vectors", {"bits": bits, "seed": 5}, toplevel="evclust_decay_apply", parameters={"ACTIVITY_BITS": bits})
+    result = run(
+        sim, header, "apply_vectors", {"bits": bits, "seed": 5}, toplevel="evclust_decay_apply", parameters={"ACTIVITY_BITS": bits}
+    )
     assert result["checked"] == 3 * (((62 - DECAY_FRAC_BITS + 2) << DECAY_TABLE_BITS) + 1) + RANDOM_CASES
 
 

@@ -93,7 +93,9 @@ if cocotb is not None:
             got = (int(dut.steps.value), int(dut.residual_out.value), passed, 0 if passed else int(dut.weight.value))
             checked += 1
             if got != want:
-                error = f"t={t} t_ref={t_ref} residual={residual} inv_t_half={inv}: RTL (steps, residual, passed, weight) {got}, model {want}"
+                error = (
+                    f"t={t} t_ref={t_ref} residual={residual} inv_t_half={inv}: RTL (steps, residual, passed, weight) {got}, model {want}"
+                )
                 break
         return error, checked
 
