@@ -50,7 +50,7 @@ CONSTANT_ORDER = (
 RUNTIME_OPTIONS = ("FILTER_EVERY", "TAU_US", "GAMMA_MODE", "WARM_START", "MCM_CORRECT", "VOTE_CONTRAST", "MIXING", "BG_FIXED",
                    "BACKGROUND_MASK", "BG_INIT_Y", "BG_INIT_CB", "BG_INIT_CR")  # fmt: skip
 BUILD_OPTIONS = ("MERGE", "CREATE_SUPPORT", "SUPPORT_CELL_BITS", "VI_CAP", "OBJECTS", "N_OBJECTS", "UPDATE_DELAY",
-                 "ACTIVITY_REFERENCE", "REFERENCE_HALVINGS")
+                 "ACTIVITY_REFERENCE", "REFERENCE_HALVINGS")  # fmt: skip
 OPTION_DOCS = {
     "FILTER_EVERY": "events between filter steps", "TAU_US": "τ, µs", "GAMMA_MODE": "γ: 0 global, 1 from activity, 2 counted",
     "WARM_START": "interval velocity warm start", "MCM_CORRECT": "MCM bias correction", "VOTE_CONTRAST": "palette votes weighted by contrast",
