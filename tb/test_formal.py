@@ -43,7 +43,7 @@ BREAKAGES = {
     ),
     "core sweeps on while a record waits": (
         "evclust_core",
-        "wire sweep_advance = state == ST_SWEEP && (!rec_valid || rec_ready);",
+        "wire sweep_advance = state == ST_SWEEP && (moving || !rec_valid || rec_ready);",
         "wire sweep_advance = state == ST_SWEEP;",
         # The overwritten record is also one that the sweep's record accounting misses.
         (
@@ -60,8 +60,8 @@ BREAKAGES = {
     ),
     "core's sweep waits for the record consumer with no record on offer": (
         "evclust_core",
-        "wire sweep_advance = state == ST_SWEEP && (!rec_valid || rec_ready);",
-        "wire sweep_advance = state == ST_SWEEP && rec_ready;",
+        "wire sweep_advance = state == ST_SWEEP && (moving || !rec_valid || rec_ready);",
+        "wire sweep_advance = state == ST_SWEEP && (moving || rec_ready);",
         ("assert (!f_filter || f_filter_cycles < F_FILTER_BOUND);", "f_filter_cycles <= f_sweep_cycles);"),
     ),
     "core ends a sweep before its tail drains (the last slot's record skipped)": (

@@ -98,6 +98,10 @@
     always @* if (f_past_valid) begin
         assert (!f_filter || f_filter_cycles < F_FILTER_BOUND);
         assert (state != ST_IDLE || dp_rst || ev_ready);
+        // The reference's move (ACTIVITY_REFERENCE) is built only with the mode; these jobs prove
+        // the builds without it, where k-induction must not start from a move under way.
+        if (!REFERENCED)
+            assert (!moving);
         // What k-induction needs: where each phase of the step stands, against the dividers'
         // steps to go.
         if (MERGE == 0)
