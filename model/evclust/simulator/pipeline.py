@@ -167,10 +167,10 @@ class Simulator:
         """The events of one frame interval, ordered by (t, y, x).
 
         Each band of rows runs on its own thread (the kernel releases the GIL) into its own part
-        of one buffer. Emission indices then still follow row-major order across the bands, so one
-        sort of the keys gives the same stream as a single thread."""
+        of one buffer. The parts, taken in band order, then still hold the events in row-major
+        emission order, so one stable sort by time gives the same stream as a single thread."""
         buf = self.buffer
-        share = buf.keys.size // len(self.bands)
+        share = buf.capacity // len(self.bands)
 
         def band(b):
             lo, hi = self.bands[b]
@@ -179,17 +179,17 @@ class Simulator:
         results = list(self.pool.map(band, range(len(self.bands)))) if self.pool else [band(0)]
         parts = [(b * share, n) for b, (n, _) in enumerate(results)]
         if all(pixel == hi for (_, pixel), (_, hi) in zip(results, self.bands)):  # every band had room: the usual case
-            events = buf.time_ordered(parts, self._room(sum(n for _, n in parts)))
+            events = buf.time_ordered(parts, t0_us, self.geometry.t_sample_us, self._room(sum(n for _, n in parts)))
         else:
-            chunks = [buf.time_ordered(parts)]
+            chunks = [buf.time_ordered(parts, t0_us, self.geometry.t_sample_us)]
             for b, (_, pixel) in enumerate(results):  # a band that filled its share goes on alone
                 hi = self.bands[b][1]
                 while pixel < hi:
-                    n, pixel = self._kernel(l0, l1, rgb0, rgb1, ref, t0_us, pixel, hi, 0, self.buffer.keys.size)
+                    n, pixel = self._kernel(l0, l1, rgb0, rgb1, ref, t0_us, pixel, hi, 0, self.buffer.capacity)
                     if n == 0 and pixel < hi:  # one pixel crosses more levels than the buffer holds
-                        self.buffer = EventBuffer(2 * self.buffer.keys.size)
+                        self.buffer = EventBuffer(2 * self.buffer.capacity)
                         continue
-                    chunks.append(self.buffer.time_ordered([(0, n)]))
+                    chunks.append(self.buffer.time_ordered([(0, n)], t0_us, self.geometry.t_sample_us))
             joined = sort_events(concat_events(chunks))  # each chunk is in order, not their union
             events = self._room(joined.size)
             events.view(np.uint64)[:] = joined.view(np.uint64)  # as raw words: a record-wise copy is slow
@@ -204,14 +204,11 @@ class Simulator:
     def _kernel(self, l0, l1, rgb0, rgb1, ref, t0_us, first, end, offset, room) -> tuple[int, int]:
         """Detect pixels first..end-1 into buffer slots offset..offset+room-1: (events, next pixel)."""
         buf = self.buffer
-        keys = buf.keys[offset : offset + room]
-        n, pixel = detect_interval(
+        return detect_interval(
             l0[:end], l1[:end], rgb0[:end], rgb1[:end], ref[:end], self.th_on, self.th_off, self.th_stride,
-            self.geometry.width, t0_us, self.geometry.t_sample_us, first, buf.words[2 * offset : 2 * (offset + room)], keys,
+            self.geometry.width, t0_us, self.geometry.t_sample_us, first, buf.words[2 * offset : 2 * (offset + room)],
             RGB_TO_YCBCR,
         )  # fmt: skip
-        keys[:n] += np.uint64(offset)  # the kernel numbers its events from 0 in its slice
-        return n, pixel
 
     def _set_bands(self, rows: np.ndarray) -> None:
         w = self.geometry.width
