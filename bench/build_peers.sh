@@ -45,11 +45,15 @@ elif [ ! -d "$src/esim_py" ]; then
   mv "$src/rpg_vid2e/esim_py" "$src/esim_py" && rm -rf "$src/rpg_vid2e"
 fi
 "$python" -m pip install --quiet pybind11 cmake
+cmake="$(dirname "$python")/cmake"  # the one just installed, whatever is first on PATH
 build="$src/esim_py/build"
 mkdir -p "$build"
-cmake -S "$src/esim_py" -B "$build" -DCMAKE_BUILD_TYPE=Release -DPYTHON_EXECUTABLE="$python" \
-  -Dpybind11_DIR="$("$python" -c 'import pybind11; print(pybind11.get_cmake_dir())')" > "$build/cmake.log"
-cmake --build "$build" -j 2 > "$build/make.log"
+# esim_py asks for CMake 3.3; PyPI's CMake 4 refuses anything older than 3.5 without this policy floor.
+"$cmake" -S "$src/esim_py" -B "$build" -DCMAKE_BUILD_TYPE=Release -DCMAKE_POLICY_VERSION_MINIMUM=3.5 -DPYTHON_EXECUTABLE="$python" \
+  -Dpybind11_DIR="$("$python" -c 'import pybind11; print(pybind11.get_cmake_dir())')" > "$build/cmake.log" 2>&1 \
+  || { tail -n 20 "$build/cmake.log" >&2; echo "evclust: configuring esim_py failed (log: $build/cmake.log)" >&2; exit 2; }
+"$cmake" --build "$build" -j 2 > "$build/make.log" 2>&1 \
+  || { tail -n 20 "$build/make.log" >&2; echo "evclust: building esim_py failed (log: $build/make.log)" >&2; exit 2; }
 mkdir -p "$out/esim_py"
 cp "$build"/esim_py*.so "$out/esim_py/"
 touch "$out/esim_py/done"
