@@ -8,6 +8,7 @@ L interpolated linearly between frames, as the model defines it.
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -199,3 +200,38 @@ def test_bands_on_several_threads_give_the_same_stream(scene_name, threads):
     events_one = one.run(scene.source.frames()).events
     assert events_one.size > 1000 and np.array_equal(events_one, reference.events)
     assert np.array_equal(many.run(scene.source.frames()).events, events_one)
+
+
+def test_a_run_spread_over_many_arena_blocks_gives_the_same_stream(monkeypatch):
+    # Blocks of 50 events: intervals land in new blocks, and the run's end joins them.
+    from evclust.simulator import pipeline
+
+    scene = scene_from_toml(edge_scene(1.7, "log", 0.1, 0.1, frames=8))
+    reference = make_simulator(scene).run(scene.source.frames()).events
+    assert reference.size > 3 * 50
+    monkeypatch.setattr(pipeline._EventArena, "BLOCK_EVENTS", 50)
+    assert np.array_equal(make_simulator(scene).run(scene.source.frames()).events, reference)
+
+
+@pytest.mark.skipif(not Path("/proc/self/smaps").exists(), reason="the page flags are read from Linux's /proc")
+def test_the_event_arena_is_mapped_without_huge_pages():
+    # The arena's block is its own mapping, and the kernel was never asked for huge pages in it
+    # (VmFlags "hg" is MADV_HUGEPAGE; numpy's own arrays over 4 MB carry it).
+    from evclust.simulator.pipeline import _EventArena
+
+    def flags_of(address: int) -> list[str]:
+        inside = False
+        for line in Path("/proc/self/smaps").read_text().splitlines():
+            head = line.split()[0]
+            if "-" in head and ":" not in head:
+                lo, hi = (int(v, 16) for v in head.split("-"))
+                inside = lo <= address < hi
+            elif inside and head == "VmFlags:":
+                return line.split()[1:]
+        raise AssertionError("address not mapped")
+
+    events = _EventArena().take(1 << 20)
+    events["t"] = 1  # touched
+    assert "hg" not in flags_of(events[1 << 19 :].ctypes.data)
+    numpy_array = np.empty(1 << 24, np.uint8)  # numpy leaves its first page out of the advice
+    assert "hg" in flags_of(numpy_array[1 << 23 :].ctypes.data) or not np._core.multiarray._get_madvise_hugepage()

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import mmap
 import queue
 import contextlib
 import threading
@@ -78,7 +79,13 @@ class _EventArena:
     stream effect), so a run makes no array per interval and no copy at the end.
 
     Room is reserved in large blocks that never move, so every view handed out stays valid; the
-    pages the events never reach are never touched and cost address space only."""
+    pages the events never reach are never touched and cost address space only.
+
+    A block is an anonymous mapping of ordinary 4 KiB pages, not a numpy allocation: numpy asks
+    the kernel for transparent huge pages on any array over 4 MB, and where THP is in "madvise"
+    mode (Debian's and Ubuntu's default) each first write to a 2 MB page may compact memory to find
+    one. Events are written once, front to back, and gain nothing from huge pages
+    (docs/DESIGN.md, "The event arena's pages")."""
 
     BLOCK_EVENTS = 1 << 26  # 1 GiB of address space
 
@@ -86,12 +93,16 @@ class _EventArena:
         self.blocks: list[np.ndarray] = []
         self.filled: list[int] = []
 
+    @staticmethod
+    def _block(n: int) -> np.ndarray:
+        return np.frombuffer(mmap.mmap(-1, n * EVENT_DTYPE.itemsize), EVENT_DTYPE)  # the array keeps the mapping
+
     def take(self, n: int) -> np.ndarray:
         if not self.blocks or self.filled[-1] + n > self.blocks[-1].size:
             try:
-                self.blocks.append(np.empty(max(n, self.BLOCK_EVENTS), EVENT_DTYPE))
-            except MemoryError:  # strict overcommit: reserve what is needed now, and more later
-                self.blocks.append(np.empty(max(n, 1 << 20), EVENT_DTYPE))
+                self.blocks.append(self._block(max(n, self.BLOCK_EVENTS)))
+            except (MemoryError, OSError):  # strict overcommit: reserve what is needed now, and more later
+                self.blocks.append(self._block(max(n, 1 << 20)))
             self.filled.append(0)
         start = self.filled[-1]
         self.filled[-1] += n
