@@ -54,13 +54,20 @@ def ycbcr_to_rgb(ycc: np.ndarray) -> np.ndarray:
     return ycc @ YCBCR_TO_RGB[:, :3].T + YCBCR_TO_RGB[:, 3]
 
 
-def frame_to_luma(rgb: np.ndarray) -> np.ndarray:
+def frame_to_luma(rgb: np.ndarray, rgb_f32: np.ndarray | None = None, out: np.ndarray | None = None) -> np.ndarray:
     """An (H, W, 3) RGB frame -> (H, W) float32 Y; the only plane the change detector needs.
     OpenCV's RGB->GRAY weights are BT.601's (0.299, 0.587, 0.114), and it is the fastest path.
-    OpenCV is imported here, not with the module: `track` needs the colour tables, not OpenCV."""
+    OpenCV is imported here, not with the module: `track` needs the colour tables, not OpenCV.
+
+    `rgb_f32` ((H, W, 3) float32) and `out` ((H, W) float32) are optional room to reuse from frame
+    to frame: the float32 copy of a uint8 frame is the largest array made per frame, and fresh
+    memory costs a page fault per 4 KiB."""
     import cv2
 
-    return cv2.cvtColor(np.ascontiguousarray(rgb, dtype=np.float32), cv2.COLOR_RGB2GRAY)
+    if rgb_f32 is not None and rgb.dtype != np.float32:
+        np.copyto(rgb_f32, rgb, casting="unsafe")  # uint8 -> float32 is exact
+        rgb = rgb_f32
+    return cv2.cvtColor(np.ascontiguousarray(rgb, dtype=np.float32), cv2.COLOR_RGB2GRAY, dst=out)
 
 
 def frame_to_ycbcr(rgb: np.ndarray) -> np.ndarray:

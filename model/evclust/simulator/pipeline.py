@@ -151,6 +151,7 @@ class Simulator:
         self.buffer = EventBuffer(max(1 << 16, n_pixels // 2))
         self.pool = ThreadPoolExecutor(len(self.bands)) if len(self.bands) > 1 else None
         self._arena: _EventArena | None = None
+        self._luma_room: tuple[np.ndarray, np.ndarray] | None = None  # frame_to_luma's, reused frame to frame
 
     def _observe(self, rgb: np.ndarray, level: np.ndarray) -> np.ndarray:
         """Fill `level` (flat float32) with the detector input L; return the (H*W, 3) RGB the
@@ -159,7 +160,9 @@ class Simulator:
         if self.observer is not None:
             intensity, rgb = self.observer.observe(rgb)
         else:
-            intensity = frame_to_luma(rgb)
+            if self._luma_room is None or self._luma_room[1].shape != rgb.shape[:2]:
+                self._luma_room = (np.empty(rgb.shape, np.float32), np.empty(rgb.shape[:2], np.float32))
+            intensity = frame_to_luma(rgb, *self._luma_room)  # read before the next frame comes
         intensity = np.asarray(intensity, dtype=np.float32).reshape(-1)
         if self.transfer is not None:
             self.transfer.transfer(intensity, level, self.sensor.log_eps)
