@@ -235,3 +235,29 @@ def test_the_event_arena_is_mapped_without_huge_pages():
     assert "hg" not in flags_of(events[1 << 19 :].ctypes.data)
     numpy_array = np.empty(1 << 24, np.uint8)  # numpy leaves its first page out of the advice
     assert "hg" in flags_of(numpy_array[1 << 23 :].ctypes.data) or not np._core.multiarray._get_madvise_hugepage()
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_joining_two_intervals_orders_the_boundary_microsecond_by_row_then_column(seed):
+    # Two intervals each in (t, y, x) order, sharing the boundary's microsecond in random rows and
+    # columns: after the join their union is in (t, y, x) order, the records the same, and records
+    # of one pixel keep their interval order (previous first).
+    from evclust.events.format import EVENT_DTYPE
+    from evclust.simulator.pipeline import _join_at_boundary
+
+    rng = np.random.default_rng(seed)
+
+    def interval(times):
+        e = np.zeros(len(times), EVENT_DTYPE)
+        e["t"], e["x"], e["y"] = times, rng.integers(0, 4, len(times)), rng.integers(0, 3, len(times))
+        e["p"] = rng.choice([-1, 1], len(times))
+        return e[np.lexsort((e["x"], e["y"], e["t"]))]
+
+    previous = interval(np.r_[rng.integers(0, 100, 30), np.full(rng.integers(1, 12), 100)])
+    current = interval(np.r_[np.full(rng.integers(1, 12), 100), rng.integers(101, 200, 30)])
+    previous["Y"], current["Y"] = 1, 2  # which interval a record came from
+    before = np.concatenate([previous, current])
+    _join_at_boundary(previous, current)
+    after = np.concatenate([previous, current])
+    assert np.array_equal(np.sort(after), np.sort(before))
+    assert np.array_equal(after, before[np.lexsort((before["x"], before["y"], before["t"]))])  # lexsort is stable

@@ -147,6 +147,36 @@ def _time_ordered_words(words, starts, counts, t0_us, dt_us, out):
             out[2 * k + 1] = words[2 * j + 1]
 
 
+@njit(cache=True, nogil=True, boundscheck=False)
+def join_at_boundary(previous, current):
+    """Re-order, in place, the records of two consecutive intervals ((n, 2) uint64 words each) that
+    fall on the boundary's microsecond: the last of `previous` and the first of `current` with
+    that time, put in (y, x) order, stably. Each interval is ordered on its own; only those can be
+    out of (t, y, x) order across the boundary."""
+    if previous.shape[0] == 0 or current.shape[0] == 0:
+        return
+    t = previous[previous.shape[0] - 1, 0]
+    if current[0, 0] > t:
+        return
+    lo = previous.shape[0] - 1
+    while lo > 0 and previous[lo - 1, 0] == t:
+        lo -= 1
+    hi = 0
+    while hi < current.shape[0] and current[hi, 0] <= t:
+        hi += 1
+    n_prev = previous.shape[0] - lo
+    tied = np.empty((n_prev + hi, 2), np.uint64)
+    tied[:n_prev] = previous[lo:]
+    tied[n_prev:] = current[:hi]
+    order = np.argsort(tied[:, 1] & np.uint64(0xFFFFFFFF), kind="mergesort")  # word 1's low half is y << 16 | x
+    for k in range(n_prev + hi):
+        row = tied[order[k]]
+        if k < n_prev:
+            previous[lo + k] = row
+        else:
+            current[k - n_prev] = row
+
+
 class EventBuffer:
     """Room for the events of one call of detect_interval."""
 

@@ -19,7 +19,7 @@ from evclust.errors import EvclustError
 from evclust.events.format import EVENT_DTYPE, EventMeta, concat_events, empty_events, sort_events
 from evclust.scenes.schema import SensorSpec
 from evclust.simulator.effects import Effect, Interval, SensorGeometry
-from evclust.simulator.kernel import EventBuffer, detect_interval
+from evclust.simulator.kernel import EventBuffer, detect_interval, join_at_boundary
 from evclust.threads import stopped_on_interrupt, worker_threads
 
 
@@ -58,20 +58,16 @@ def _stage(effects: list[Effect], stage: str) -> list[Effect]:
 
 
 def _join_at_boundary(previous: np.ndarray, current: np.ndarray) -> None:
-    """Re-order, in place, events of two consecutive intervals that fall on the same microsecond.
+    """Re-order, in place, events of two consecutive intervals that fall on the same microsecond
+    (`kernel.join_at_boundary`, on the records' raw words)."""
+    join_at_boundary(_words(previous), _words(current))
 
-    Each interval is ordered on its own; only events rounded to the boundary's microsecond can be
-    out of (t, y, x) order across it, so only those are sorted again.
-    """
-    if previous.size == 0 or current.size == 0 or current["t"][0] > previous["t"][-1]:
-        return
-    t = previous["t"][-1]
-    lo = int(np.searchsorted(previous["t"], t))
-    hi = int(np.searchsorted(current["t"], t, side="right"))
-    tied = concat_events([previous[lo:], current[:hi]])
-    tied = tied[np.lexsort((tied["x"], tied["y"]))]
-    previous[lo:] = tied[: previous.size - lo]
-    current[:hi] = tied[previous.size - lo :]
+
+def _words(events: np.ndarray) -> np.ndarray:
+    """An event array's records as (n, 2) uint64 words, in place (a copy would not write back)."""
+    if not events.flags.c_contiguous:
+        raise ValueError("event records must be contiguous to be re-ordered in place")
+    return events.view(np.uint64).reshape(-1, 2)
 
 
 class _EventArena:
