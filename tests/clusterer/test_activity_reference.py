@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 
 from evclust.clusterer import ClustererParams
+from evclust.clusterer.params import REFERENCE_HALVINGS
 from evclust.clusterer.layout import ACT, BG_T, EVICTED, PX, VALID
 from evclust.clusterer.run import FloatClusterer
-from evclust.errors import EvclustError
 from evclust.events import EVENT_DTYPE
 from evclust.fixed.fixed_model import SIGNALS
 from evclust.fixed.model import FixedClusterer
@@ -131,9 +131,13 @@ def test_eviction_decides_as_the_paper_does(model, gap):
     assert decisions == [int(gap > T_HALF)] * 2
 
 
-def test_the_rtl_refuses_the_mode_in_one_line():
-    with pytest.raises(EvclustError, match="activity_reference"):
-        params_header(ClustererParams(activity_reference=True), W, H, T_FRAME)
+@pytest.mark.parametrize("on", [False, True])
+def test_the_header_builds_the_mode_as_the_parameters_ask(on):
+    # The RTL builds the mode (docs/RTL.md): the header carries it as a build option, with Ã's
+    # integer bits above A's.
+    header = params_header(ClustererParams(activity_reference=on), W, H, T_FRAME)
+    assert f"localparam integer ACTIVITY_REFERENCE = {int(on)};" in header
+    assert f"localparam integer REFERENCE_HALVINGS = {REFERENCE_HALVINGS};" in header
 
 
 @pytest.mark.parametrize("halves", range(5))
