@@ -1400,8 +1400,10 @@ module evclust_core #(
                         step_t <= e_t[31:0];
                     end
                 end
-                ST_IDLE: if (move_due)
+                ST_IDLE: if (move_due) begin
                     moving <= 1'b1;
+                    index <= {SWEEP_W{1'b0}};  // the pass starts at slot 0, wherever the last sweep or scan left it
+                end
                 ST_PHASE: if (!moving) case (phase_step)  // tau boundaries since the last step and T_frame / (n tau)
                     PHASE_DECIDE: if (phase_hold) begin
                         // the last step's end not taken yet

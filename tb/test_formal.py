@@ -98,6 +98,17 @@ BREAKAGES = {
             "f_filter_cycles + f_merge_x_count <= f_sweep_cycles + 2 + MERGE_MOMENT_W);",
         ),
     ),
+    # Only the reference build (ACTIVITY_REFERENCE = 1) moves the reference: its own job.
+    "core's reference move starts its pass over the slots where the last sweep left the index": (
+        "evclust_core",
+        "                    index <= {SWEEP_W{1'b0}};  // the pass starts at slot 0, wherever the last sweep or scan left it\n",
+        "",
+        (
+            "assert (index == {SWEEP_W{1'b0}} && (moving || phase_step != 2'd3));",
+            "assert (state != ST_PHASE || (index == {SWEEP_W{1'b0}} && f_filter_cycles + move_hold < F_MOVE_DRAIN));",
+            "assert (state != ST_SWEEP || (index <= LAST_SLOT && f_filter_cycles <= F_MOVE_DRAIN + index));",
+        ),
+    ),
     "object unit overwrites an object record before it is taken": (
         "evclust_objects",
         "S_OUT: if (out_free) begin",
@@ -118,13 +129,16 @@ BREAKAGES = {
     ),
 }
 # The job that proves a breakage's module, where it is not <module>.sby.
-JOB = {"core's merge never finishes (its dividers restart in every MERGE cycle)": "evclust_core_merge"}
+JOB = {
+    "core's merge never finishes (its dividers restart in every MERGE cycle)": "evclust_core_merge",
+    "core's reference move starts its pass over the slots where the last sweep left the index": "evclust_core_reference",
+}
 
 
 # `make test` breaks ROTATING_BREAKAGES of them, drawn from the commit hash, on the turn of the
 # "checks" pool (tb/cosim.py: TAKING_TURNS, with the switch cover's row); `make test-full` all.
-# The merge job's breakage is left to `make test-full`: its failing proof took 123 s of a CI run
-# (d822ae1), the two others drawn in recent runs 44 and 52 s.
+# The merge job's and the reference job's breakages are left to `make test-full`: the merge's
+# failing proof took 123 s of a CI run (d822ae1), the two others drawn in recent runs 44 and 52 s.
 ROTATING_BREAKAGES = 1
 FULL_ONLY_BREAKAGES = set(JOB)
 

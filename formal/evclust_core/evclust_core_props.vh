@@ -14,14 +14,17 @@
 //    step's end waits for its consumer
 //    (80 in the reference build, which has no merges; with MERGE = 1, up to N - 1 merges of
 //    MERGE_MOMENT_W + 3 cycles more: 227 in the merge job's build), and the core, IDLE again,
-//    takes the next event;
+//    takes the next event, or first moves the reference the event in stage A needs (a move is
+//    PHASE and one SWEEP pass of N cycles, with no record, under the same bound);
 //  - one record per reported slot per sweep: every slot visited once, each slot kept leaves the
 //    sweep's tail once, a record only for a slot out of the tail and never two for one slot,
 //    and at the sweep's end the records are exactly the table's reported clusters.
 // The dividers' steps to go and the tail's stage tags reach the properties through ports that
-// evclust_udiv and evclust_pipediv have only under `ifdef FORMAL. Two jobs: evclust_core.sby on
-// the reference build's header (MERGE = 0, N = 16) and evclust_core_merge.sby on a generated
-// merge-enabled one (model/evclust/rtl/formal.py: the default parameters at N = 4).
+// evclust_udiv and evclust_pipediv have only under `ifdef FORMAL. Three jobs: evclust_core.sby on
+// the reference build's header (MERGE = 0, N = 16), evclust_core_merge.sby on a generated
+// merge-enabled one (model/evclust/rtl/formal.py: the default parameters at N = 4), and
+// evclust_core_reference.sby on that build with the activity kept against a reference time
+// (ACTIVITY_REFERENCE = 1, UPDATE_DELAY = 2), the only one with the reference's move.
 
     genvar f_j, f_s;
     reg f_past_valid = 1'b0;
@@ -50,7 +53,8 @@
         assert (step_valid && step_t == $past(step_t));
     always @* assert (!(step_valid && rec_valid));
     // What k-induction needs: no sweep runs while the last step's end waits (PHASE holds it).
-    always @* if (f_past_valid && step_pending)
+    // The reference's move (below) may: it makes no record.
+    always @* if (f_past_valid && step_pending && !moving)
         assert (state != ST_SWEEP && state != ST_MERGE && (state != ST_PHASE || phase_step == PHASE_DECIDE));
 
     // ---------------------------------------------------------------- the filter step ends
@@ -67,6 +71,7 @@
     localparam integer F_MERGES_MAX = MERGE != 0 ? N - 1 : 0;
     localparam integer F_FILTER_BOUND = F_PHASE_MAX + LAST_SWEEP_I + 1 + F_MERGES_MAX * F_MERGE_CYCLES;
     localparam integer F_CYCLES_W = $clog2(F_FILTER_BOUND + 1);
+    localparam integer F_MOVE_DRAIN = 2;  // a move's PHASE cycles at most: one drains stage H through C, one goes on
     wire f_filter = state == ST_PHASE || state == ST_SWEEP || state == ST_MERGE;
     wire f_sweeping = state == ST_SWEEP || state == ST_MERGE;
     reg [F_CYCLES_W-1:0] f_filter_cycles;  // the filter step's cycles so far without a record waiting
@@ -97,22 +102,30 @@
 
     always @* if (f_past_valid) begin
         assert (!f_filter || f_filter_cycles < F_FILTER_BOUND);
-        assert (state != ST_IDLE || dp_rst || ev_ready);
+        assert (state != ST_IDLE || dp_rst || ev_ready || move_due);  // (or it moves the reference first)
         // The reference's move (ACTIVITY_REFERENCE) is built only with the mode; these jobs prove
         // the builds without it, where k-induction must not start from a move under way.
         if (!REFERENCED)
             assert (!moving);
+        // The reference's move: PHASE (stage H drained through C) from IDLE, then one pass of
+        // SWEEP over the slots that decays each activity and moves nothing down the tail.
+        if (moving) begin
+            assert (state == ST_PHASE || state == ST_SWEEP);
+            assert (state != ST_PHASE || (index == {SWEEP_W{1'b0}} && f_filter_cycles + move_hold < F_MOVE_DRAIN));
+            assert (state != ST_SWEEP || (index <= LAST_SLOT && f_filter_cycles <= F_MOVE_DRAIN + index));
+        end
         // What k-induction needs: where each phase of the step stands, against the dividers'
         // steps to go.
         if (MERGE == 0)
             assert (state != ST_MERGE && f_absorbed == {N{1'b0}});
         if (state == ST_PHASE) begin
-            assert (index == {SWEEP_W{1'b0}} && phase_step != 2'd3);
-            if (phase_step == PHASE_DECIDE)
+            // (A move's PHASE finds phase_step as the last step left it, or unset after a reset.)
+            assert (index == {SWEEP_W{1'b0}} && (moving || phase_step != 2'd3));
+            if (phase_step == PHASE_DECIDE && !moving)  // (a move's PHASE: above)
                 assert (f_filter_cycles == {F_CYCLES_W{1'b0}});
-            if (phase_step == PHASE_BY_TAU)
+            if (phase_step == PHASE_BY_TAU && !moving)
                 assert ((f_by_tau_count != 0 || by_tau_done) && f_filter_cycles + f_by_tau_count <= 1 + 33);
-            if (phase_step == PHASE_FRAME)
+            if (phase_step == PHASE_FRAME && !moving)
                 assert ((f_frame_count != 0 || frame_done) && f_filter_cycles + f_frame_count <= 1 + (33 + 1) + FRAME_PER_TAU_W);
         end
         if (state == ST_SWEEP)
@@ -172,7 +185,7 @@
     endgenerate
     always @(posedge clk) begin
         f_held_q <= rec_valid && !rec_ready;
-        f_after_sweep <= !dp_rst && state == ST_SWEEP && state_next == ST_IDLE;
+        f_after_sweep <= !dp_rst && state == ST_SWEEP && !moving && state_next == ST_IDLE;
         if (dp_rst || state == ST_PHASE) begin
             f_visited <= {N{1'b0}};
             f_kept <= {N{1'b0}};
@@ -204,14 +217,14 @@
     generate
         for (f_j = 0; f_j <= F_STAGES; f_j = f_j + 1) begin : f_position
             always @* if (f_past_valid) begin
-                if (state != ST_SWEEP && state != ST_MERGE)
+                if ((state != ST_SWEEP && state != ST_MERGE) || moving)
                     assert (!f_live[f_j]);
                 if (f_live[f_j])
                     assert (index >= f_j + 1 && index - f_j - 1 < N && f_slot[f_j] == index - f_j - 1);
             end
         end
         for (f_s = 0; f_s < N; f_s = f_s + 1) begin : f_sweep_slot
-            always @* if (f_past_valid && f_sweeping) begin
+            always @* if (f_past_valid && f_sweeping && !moving) begin
                 assert (f_visited[f_s] == (f_s < index));
                 assert (f_visited[f_s] || !f_kept[f_s]);
                 assert (f_kept[f_s] || !f_out[f_s]);
@@ -222,7 +235,7 @@
                     assert (f_out[f_s] == f_kept[f_s]);
             end
             for (f_j = 0; f_j <= F_STAGES; f_j = f_j + 1) begin : f_in_tail
-                always @* if (f_past_valid && f_sweeping && index == f_s + f_j + 1)
+                always @* if (f_past_valid && f_sweeping && !moving && index == f_s + f_j + 1)
                     assert (!f_out[f_s] && f_kept[f_s] == f_live[f_j]);
             end
         end

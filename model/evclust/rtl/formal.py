@@ -55,8 +55,24 @@ def _objects_header() -> str:
     return params_header(params, 160, 120, params.t_frame_us or 16666.0)
 
 
+def _reference_header() -> str:
+    """evclust_core_reference.sby's header: the merge job's build (the defaults at N = 4, 160x120)
+    with the activity kept against a reference time, committed two events late (update_delay = 2),
+    as the datasheet's reference build is: the mode's own state (the reference's move) is proved
+    there and nowhere else."""
+    from evclust.clusterer import ClustererParams
+    from evclust.rtl.sources import params_header
+
+    params = ClustererParams(n_clusters=4, support_cell_bits=4, update_delay=2, activity_reference=True)
+    return params_header(params, 160, 120, params.t_frame_us or 16666.0)
+
+
 # Jobs (by file stem) whose header is generated: the function that writes it.
-GENERATED_HEADERS = {"evclust_core_merge": _merge_header, "evclust_objects": _objects_header}
+GENERATED_HEADERS = {
+    "evclust_core_merge": _merge_header,
+    "evclust_core_reference": _reference_header,
+    "evclust_objects": _objects_header,
+}
 
 
 def jobs(root: Path = FORMAL_DIR) -> list[Path]:
