@@ -1229,6 +1229,9 @@ module evclust_core #(
     // ---------------------------------------------------------------- the slot row's write port
     // One writer per cycle; the fields it leaves keep their value, read at port A (the written
     // slot's, for an update, a merge or the sweep; a creation writes every field).
+    // Against a reference time nothing reads a slot's residual: writing it 0 leaves the paper's
+    // decay unit (its dt * (1/T_half) multiply) without a reader, so that build has none.
+    wire [DECAY_RESIDUAL_W-1:0] row_residual = REFERENCED ? {DECAY_RESIDUAL_W{1'b0}} : dec_residual;
     // A delayed update reads its slot at port E, so port A's address (the scan, the sweep, a
     // merge) does not hang on the event's search; without delay EXEC decays at port A.
     assign row_a_slot = state == ST_EXEC && UPDATE_DELAY == 0 ? e_slot : k;
@@ -1242,7 +1245,7 @@ module evclust_core #(
             row_w_slot = sw_slot;
             row_w = sw_row;
             row_w[ROW_ACT +: ACT_ROW_W] = sw_act;
-            row_w[ROW_RESIDUAL +: DECAY_RESIDUAL_W] = dec_residual;
+            row_w[ROW_RESIDUAL +: DECAY_RESIDUAL_W] = row_residual;
             row_w[ROW_T_LAST +: T_LAST_W] = sw_t;
             row_w[ROW_VMX +: V_MCM_W] = sw_vmx;
             row_w[ROW_VMY +: V_MCM_W] = sw_vmy;
@@ -1278,7 +1281,7 @@ module evclust_core #(
             if (m_from_j)
                 row_w = row_b;
             row_w[ROW_ACT +: ACT_ROW_W] = m_act[ACT_ROW_W-1:0];
-            row_w[ROW_RESIDUAL +: DECAY_RESIDUAL_W] = dec_residual;
+            row_w[ROW_RESIDUAL +: DECAY_RESIDUAL_W] = row_residual;
             row_w[ROW_T_LAST +: T_LAST_W] = e_t;
             row_w[ROW_PPX +: CENTRE_W] = m_ppx[CENTRE_W-1:0];
             row_w[ROW_PPY +: CENTRE_W] = m_ppy[CENTRE_W-1:0];
@@ -1288,7 +1291,7 @@ module evclust_core #(
             row_we = 1'b1;
             row_w_slot = k;
             row_w[ROW_ACT +: ACT_ROW_W] = act_now;
-            row_w[ROW_RESIDUAL +: DECAY_RESIDUAL_W] = dec_residual;
+            row_w[ROW_RESIDUAL +: DECAY_RESIDUAL_W] = row_residual;
             row_w[ROW_T_LAST +: T_LAST_W] = e_t;
             if (!f_expire && !moving) begin
                 row_w[ROW_GAMMA +: GAMMA_W] = f_gamma[GAMMA_W-1:0];
