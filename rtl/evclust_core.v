@@ -66,9 +66,10 @@ module evclust_core #(
     localparam integer SLOT_W = N > 1 ? $clog2(N) : 1;
     localparam integer CLASS_W = P > 1 ? $clog2(P) : 1;
     localparam integer SWEEP_LEN = N > P ? N : P;
-    // The sweep tail: the operand register and the divider's stages (SWEEP_DIV_STEP bits each).
+    // The sweep tail: the operand register, the divider's stages (SWEEP_DIV_STEP bits each) and
+    // stage T1's register (the squares and the record, so T2's exit and report start from registers).
     localparam integer INV_STAGES = (INV_WW_W + SWEEP_DIV_STEP - 1) / SWEEP_DIV_STEP;  // 2^32 / |w|^2
-    localparam integer MCM_TAIL = 1 + (V_MCM_W - 1 + SWEEP_DIV_STEP - 1) / SWEEP_DIV_STEP;
+    localparam integer MCM_TAIL = 2 + (V_MCM_W - 1 + SWEEP_DIV_STEP - 1) / SWEEP_DIV_STEP;
     localparam integer TAIL = MCM_TAIL > INV_STAGES ? MCM_TAIL : INV_STAGES;
     localparam integer SWEEP_W = $clog2(SWEEP_LEN + TAIL + 1);
     localparam integer EVERY_W = $clog2(FILTER_EVERY + 1);
@@ -675,8 +676,10 @@ module evclust_core #(
     // ---------------------------------------------------------------- the filter sweep
     // Stage 0, one slot k per cycle: decay, expiry, gamma, the interval velocity at tau
     // boundaries. The tail, TAIL cycles behind: the MCM bias correction (a pipelined divider),
-    // exit prediction, the report and the record. Nothing the tail reads of slot t changes after
-    // t's stage 0 (later slots' merges touch only later slots), so the tail reads the table.
+    // then T1 (the corrected velocity, its squares, the record) and T2 (exit prediction, the
+    // report, the record out). Nothing the tail reads of slot t changes after t's stage 0 (later
+    // slots' merges touch only later slots, and the sweep runs no event), so T1 reads the table
+    // and registers what T2 needs.
     wire [SLOT_W-1:0] k = index[SLOT_W-1:0];
     reg signed [63:0] f_gamma, f_mx, f_my, f_vix, f_viy, f_per_frame, f_evc;
     reg signed [63:0] f_gamma_activity, f_gamma_count, f_mx_full, f_my_full;  // before saturation
@@ -770,7 +773,10 @@ module evclust_core #(
     wire             t_correct = t_tag[6], t_neg_x = t_tag[5], t_sat_x = t_tag[4], t_neg_y = t_tag[3], t_sat_y = t_tag[2];
     wire             t_over_x = t_tag[1], t_over_y = t_tag[0];
 
-    // The tail's last stage: the reported MCM velocity V / w, exit, report, class, record.
+    // The tail's stage T1, at the divider's output (slot t): the reported MCM velocity V / w, its
+    // squares, the report's terms, the class and the record, registered for T2, which compares
+    // and decides (a path through the squares and on through the exit's multiply was the core's
+    // longest).
     function automatic signed [63:0] corrected_v;
         input [V_MCM_W-1:0] raw;
         input correct, negative, saturated;
@@ -788,10 +794,10 @@ module evclust_core #(
     endfunction
     integer cls;
     reg signed [63:0] f_vmx, f_vmy, f_vmx_raw, f_vmy_raw, f_px, f_py, f_act, f_vix_t, f_viy_t;
-    reg signed [63:0] f_speed_sq, f_speed_full, f_limit;
+    reg signed [63:0] f_speed_sq, f_speed_full, f_speed_sq_x, f_speed_sq_y;
     reg [2*SQ_MAG_W-1:0] f_sq_x, f_sq_y;
-    reg               f_exit, f_left, f_right, f_top, f_bottom, f_moving_mcm, f_moving_int, f_report;
-    reg signed [63:0] f_box, f_noise_signal, f_noise_floor;
+    reg               f_left, f_right, f_top, f_bottom, f_out_x, f_out_y, f_fast, f_moving_mcm, f_moving_int, f_active_moving;
+    reg signed [63:0] f_box, f_noise_signal, f_noise_scale;
     reg signed [63:0] f_best;
     reg [7:0]         f_class;
     reg [3:0]         f_flags;
@@ -810,25 +816,24 @@ module evclust_core #(
         f_sq_y = square(f_vmy, FV);
         f_speed_full = speed_sq({1'b0, f_sq_x} + {1'b0, f_sq_y}, FV);
         f_speed_sq = f_speed_full;  // < 2^SPEED_SQ_W by construction: square() clamps each component below full scale
+        f_speed_sq_x = speed_sq({1'b0, f_sq_x}, FV);
+        f_speed_sq_y = speed_sq({1'b0, f_sq_y}, FV);
+        f_fast = f_speed_sq >= K_V_EXIT_SQ && f_speed_sq > 0;
         f_left = f_px < K_EXIT_M;
         f_right = f_px > HI_X;
         f_top = f_py < K_EXIT_M;
         f_bottom = f_py > HI_Y;
-        f_limit = (f_speed_sq * K_COS_SQ) >>> COS_SQ_F;
-        f_exit = f_speed_sq >= K_V_EXIT_SQ && f_speed_sq > 0
-              && ((f_left && f_vmx < 0 && speed_sq({1'b0, f_sq_x}, FV) >= f_limit)
-               || (f_right && f_vmx > 0 && speed_sq({1'b0, f_sq_x}, FV) >= f_limit)
-               || (f_top && f_vmy < 0 && speed_sq({1'b0, f_sq_y}, FV) >= f_limit)
-               || (f_bottom && f_vmy > 0 && speed_sq({1'b0, f_sq_y}, FV) >= f_limit));
+        // Heading out across a border the centre is beyond, per axis (T2 weighs the axis's share of the speed).
+        f_out_x = (f_left && f_vmx < 0) || (f_right && f_vmx > 0);
+        f_out_y = (f_top && f_vmy < 0) || (f_bottom && f_vmy > 0);
         f_moving_mcm = speed_sq({1'b0, square(f_vmx_raw, FV)} + {1'b0, square(f_vmy_raw, FV)}, FV) >= K_V_MIN_SQ;
         f_moving_int = speed_sq({1'b0, square(f_vix_t, FI)} + {1'b0, square(f_viy_t, FI)}, FI) >= K_V_MIN_SQ;
-        f_report = f_act >= K_A_VALID && (f_moving_mcm || f_moving_int);
-        // The noise gate: A * W * H >= gate * A_bg * (pixels of the box), the gate in Q.NOISE_GATE_FRAC.
+        f_active_moving = f_act >= K_A_VALID && (f_moving_mcm || f_moving_int);  // the report, but for the noise gate
+        // The noise gate's terms: A * W * H against gate * A_bg * (pixels of the box), the gate in
+        // Q.NOISE_GATE_FRAC; T2 multiplies the floor's two factors, both exact here.
         f_box = (2 * u64({{(63 - HALF_SIZE_W){1'b0}}, rx[t] >> FR}) + 1) * (2 * u64({{(63 - HALF_SIZE_W){1'b0}}, ry[t] >> FR}) + 1);
         f_noise_signal = (f_act * SENSOR_PIXELS) <<< NOISE_GATE_FRAC;  // both sides fit noise_count
-        f_noise_floor = K_NOISE_GATE * u64({{(63 - ACT_ROW_W){1'b0}}, bg_act}) * f_box;
-        if (K_NOISE_GATE != 0 && f_report)
-            f_report = f_noise_signal[NOISE_COUNT_W-1:0] >= f_noise_floor[NOISE_COUNT_W-1:0];
+        f_noise_scale = K_NOISE_GATE * u64({{(63 - ACT_ROW_W){1'b0}}, bg_act});
         // The class: the strongest non-background histogram entry, none while all are zero.
         f_class = 8'hff;
         f_best = 0;
@@ -865,6 +870,26 @@ module evclust_core #(
     assign record[REC_CR_LSB +: REC_CR_W] = r_cr[COLOUR_W-1:0];
     assign record[REC_CLASS_LSB +: REC_CLASS_W] = f_class;
     assign record[REC_FLAGS_LSB +: REC_FLAGS_W] = f_flags;
+
+    // The tail's stage T2, slot t2_slot (T1's, one enabled cycle later): T1's register, then the
+    // exit prediction and the noise gate, each a multiply of registered terms and a compare.
+    localparam integer BOX_W = 2 * (HALF_SIZE_W - FR + 1);            // (2 (R >> FR) + 1)^2 < 2^BOX_W
+    localparam integer NOISE_SCALE_W = CFG_NOISE_GATE_W + ACT_ROW_W;  // gate * A_bg, exact
+    reg                     t2_live;
+    reg [SLOT_W-1:0]        t2_slot;
+    reg [REC_W-1:0]         t2_record;
+    reg [SPEED_SQ_W-1:0]    t2_speed_sq, t2_speed_sq_x, t2_speed_sq_y;
+    reg                     t2_fast, t2_out_x, t2_out_y, t2_active_moving;
+    reg [NOISE_COUNT_W-1:0] t2_noise_signal;
+    reg [NOISE_SCALE_W-1:0] t2_noise_scale;
+    reg [BOX_W-1:0]         t2_box;
+    wire signed [63:0] f_limit = (u64({{(63 - SPEED_SQ_W){1'b0}}, t2_speed_sq}) * K_COS_SQ) >>> COS_SQ_F;
+    wire               f_exit_x = t2_out_x && u64({{(63 - SPEED_SQ_W){1'b0}}, t2_speed_sq_x}) >= f_limit;
+    wire               f_exit_y = t2_out_y && u64({{(63 - SPEED_SQ_W){1'b0}}, t2_speed_sq_y}) >= f_limit;
+    wire               f_exit = t2_fast && (f_exit_x || f_exit_y);
+    // The floor's low NOISE_COUNT_W bits, as the product of the three factors had them.
+    wire signed [63:0] f_noise_floor = u64({{(63 - NOISE_SCALE_W){1'b0}}, t2_noise_scale}) * u64({{(63 - BOX_W){1'b0}}, t2_box});
+    wire               f_report = t2_active_moving && (K_NOISE_GATE == 0 || t2_noise_signal >= f_noise_floor[NOISE_COUNT_W-1:0]);
 
     // ---------------------------------------------------------------- merging (model: _mergeable, _merge)
     // The swept slot k absorbs the lowest later slot j that is the same object (evclust_merge_search).
@@ -1196,7 +1221,7 @@ module evclust_core #(
         : (phase_ends ? outside(u64({{(63 - ACT_ROW_W){1'b0}}, ref_dec_b}), 0, MAX_ACT) : 2'd0)
         + ((sweep_slot || m_write) && !k_decayed ? outside(u64({{(63 - ACT_ROW_W){1'b0}}, ref_dec_a}), 0, MAX_ACT) : 2'd0)
         + (m_write ? outside(u64({{(63 - ACT_ROW_W){1'b0}}, ref_dec_b}), 0, MAX_ACT) : 2'd0);
-    wire               tail_out = tail_en && t_live;
+    wire               tail_out = tail_en && t2_live;  // a slot leaves the tail (T2)
     wire               bg_counts = finish && !(do_update && reported[e_slot]) && K_NOISE_GATE != 0;
     reg [COUNT_W-1:0]  inc;
     always @* begin
@@ -1221,7 +1246,7 @@ module evclust_core #(
         inc[COUNT_SAT_GAMMA * COUNTER_INC_W +: 2] = (stage0 && f_gamma_by_activity ? outside(f_gamma_activity, 0, MAX_GAMMA) : 2'd0)
             + (stage0 && f_gamma_by_count ? outside(f_gamma_count, 0, MAX_GAMMA) : 2'd0);
         inc[COUNT_SAT_V_INT * COUNTER_INC_W +: 2] = stage0 && boundaries != 33'd0 ? outside(f_mx_full, MIN_VI, MAX_VI) + outside(f_my_full, MIN_VI, MAX_VI) : 2'd0;
-        inc[COUNT_SAT_V_MCM * COUNTER_INC_W +: 2] = (tail_out && t_correct ? {1'b0, t_over_x} + {1'b0, t_over_y} : 2'd0)
+        inc[COUNT_SAT_V_MCM * COUNTER_INC_W +: 2] = (tail_en && t_live && t_correct ? {1'b0, t_over_x} + {1'b0, t_over_y} : 2'd0)  // (at T1)
             + (do_commit ? cm_vm_saturations : 2'd0);  // (without delay, V's alpha step cannot leave its format)
     end
     assign idle = state == ST_IDLE && !a_valid && !rec_valid && !step_pending;
@@ -1357,6 +1382,7 @@ module evclust_core #(
             h_dbg_cr <= {DB_W{1'b0}};
             creating <= 1'b0;
             p_live <= 1'b0;
+            t2_live <= 1'b0;
             boundaries <= 33'd0;
             per_frame <= {FRAME_PER_TAU_W{1'b0}};
             for (i = 0; i < N; i = i + 1) begin
@@ -1659,15 +1685,30 @@ module evclust_core #(
                 p_vmy <= vmy_a;
                 p_w20 <= norm_cut[W20_W-1:0];
             end
-            if (tail_en && t_live) begin  // the tail's last stage
+            if (tail_en) begin  // the tail's stage T1: what T2 decides on
+                t2_live <= t_live;
+                t2_slot <= t;
+                t2_record <= record;
+                t2_speed_sq <= f_speed_sq[SPEED_SQ_W-1:0];
+                t2_speed_sq_x <= f_speed_sq_x[SPEED_SQ_W-1:0];
+                t2_speed_sq_y <= f_speed_sq_y[SPEED_SQ_W-1:0];
+                t2_fast <= f_fast;
+                t2_out_x <= f_out_x;
+                t2_out_y <= f_out_y;
+                t2_active_moving <= f_active_moving;
+                t2_noise_signal <= f_noise_signal[NOISE_COUNT_W-1:0];
+                t2_noise_scale <= f_noise_scale[NOISE_SCALE_W-1:0];
+                t2_box <= f_box[BOX_W-1:0];
+            end
+            if (tail_en && t2_live) begin  // the tail's last stage, T2
                 if (f_exit) begin
-                    valid[t] <= 1'b0;
+                    valid[t2_slot] <= 1'b0;
                 end else begin
-                    reported[t] <= f_report;
+                    reported[t2_slot] <= f_report;
                     if (f_report) begin
-                        ever_reported[t] <= 1'b1;
+                        ever_reported[t2_slot] <= 1'b1;
                         rec_valid <= 1'b1;
-                        rec_data <= record;
+                        rec_data <= t2_record;
                     end
                 end
             end

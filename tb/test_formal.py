@@ -68,7 +68,7 @@ BREAKAGES = {
         "evclust_core",
         "LAST_SWEEP_I = SWEEP_LEN + TAIL - 1;",
         "LAST_SWEEP_I = SWEEP_LEN + TAIL - 2;",
-        ("assert (&f_visited && f_out == f_kept", "assert (!f_live[f_j]);", "assert (f_kept[t] && !f_out[t]);"),
+        ("assert (&f_visited && f_out == f_kept", "assert (!f_live[f_j]);", "assert (f_kept[t2_slot] && !f_out[t2_slot]);"),
     ),
     "core's sweep skips the last slot": (
         "evclust_core",

@@ -12,8 +12,8 @@
 //    while a record waits (the object unit sees every record of a step before its end);
 //  - a filter step ends within F_FILTER_BOUND cycles in which neither a record nor the last
 //    step's end waits for its consumer
-//    (80 in the reference build, which has no merges; with MERGE = 1, up to N - 1 merges of
-//    MERGE_MOMENT_W + 3 cycles more: 227 in the merge job's build), and the core, IDLE again,
+//    (81 in the reference build, which has no merges; with MERGE = 1, up to N - 1 merges of
+//    MERGE_MOMENT_W + 3 cycles more: 228 in the merge job's build), and the core, IDLE again,
 //    takes the next event, or first moves the reference the event in stage A needs (a move is
 //    PHASE and one SWEEP pass of N cycles, with no record, under the same bound);
 //  - one record per reported slot per sweep: every slot visited once, each slot kept leaves the
@@ -160,11 +160,15 @@
     // reported clusters (valid and reported). With the stream property above (a record holds
     // until taken), each is taken once.
     localparam integer F_STAGES = (Q_W + SWEEP_DIV_STEP - 1) / SWEEP_DIV_STEP;  // div_vmx's stages
-    // The tail's positions: 0, its first register (p_*); j >= 1, div_vmx's stage j.
-    wire [F_STAGES:0]          f_live;
-    wire [SLOT_W-1:0]          f_slot [0:F_STAGES];
+    localparam integer F_LAST = F_STAGES + 1;  // T1's register, which stage T2 reads
+    // The tail's positions: 0, its first register (p_*); 1 to F_STAGES, div_vmx's stages; F_LAST,
+    // T1's register (t2_*), out of which a slot leaves the tail.
+    wire [F_LAST:0]            f_live;
+    wire [SLOT_W-1:0]          f_slot [0:F_LAST];
     assign f_live[0] = p_live;
     assign f_slot[0] = p_slot;
+    assign f_live[F_LAST] = t2_live;
+    assign f_slot[F_LAST] = t2_slot;
     generate
         for (f_j = 1; f_j <= F_STAGES; f_j = f_j + 1) begin : f_tail
             assign f_live[f_j] = f_vmx_tags[(f_j - 1) * TAG_W + TAG_W - 1];
@@ -197,7 +201,7 @@
             if (stage0)
                 f_kept[k] <= 1'b1;
             if (tail_out)
-                f_out[t] <= 1'b1;
+                f_out[t2_slot] <= 1'b1;
             if (f_new_record && f_rec_slot < N)
                 f_recorded[f_rec_slot] <= 1'b1;
         end
@@ -205,7 +209,7 @@
 
     always @* if (f_past_valid) begin
         if (tail_out)
-            assert (f_kept[t] && !f_out[t]);
+            assert (f_kept[t2_slot] && !f_out[t2_slot]);
         if (f_new_record)
             assert (f_rec_slot < N && f_out[f_rec_slot] && !f_recorded[f_rec_slot]);
         if (f_after_sweep)
@@ -213,9 +217,12 @@
         // What k-induction needs: the sweep's shadows against the index and the tail's tags.
         if (f_new_record)
             assert (state == ST_SWEEP || f_after_sweep);
+        // T1 registered its slot's record: the record T2 offers names that slot.
+        if (t2_live)
+            assert (t2_record[REC_SLOT_LSB +: REC_SLOT_W] == t2_slot);  // (zero-extended)
     end
     generate
-        for (f_j = 0; f_j <= F_STAGES; f_j = f_j + 1) begin : f_position
+        for (f_j = 0; f_j <= F_LAST; f_j = f_j + 1) begin : f_position
             always @* if (f_past_valid) begin
                 if ((state != ST_SWEEP && state != ST_MERGE) || moving)
                     assert (!f_live[f_j]);
@@ -231,10 +238,10 @@
                 assert (!f_visited[f_s] || f_kept[f_s] || !valid[f_s]);
                 assert (!f_kept[f_s] || f_out[f_s] || valid[f_s]);
                 assert (f_offered[f_s] == (f_out[f_s] && f_reported[f_s]));
-                if (index > f_s + F_STAGES + 1)
+                if (index > f_s + F_LAST + 1)
                     assert (f_out[f_s] == f_kept[f_s]);
             end
-            for (f_j = 0; f_j <= F_STAGES; f_j = f_j + 1) begin : f_in_tail
+            for (f_j = 0; f_j <= F_LAST; f_j = f_j + 1) begin : f_in_tail
                 always @* if (f_past_valid && f_sweeping && !moving && index == f_s + f_j + 1)
                     assert (!f_out[f_s] && f_kept[f_s] == f_live[f_j]);
             end

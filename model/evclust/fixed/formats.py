@@ -573,9 +573,11 @@ SWEEP_DIV_STEP = 4
 
 def sweep_tail_cycles(table: FormatTable) -> int:
     """The cycles a filter sweep's tail adds: the longer of the MCM correction's (its operand
-    register and its divider's stages) and the mixing table's (2^32 / |w|^2, inv_ww's bits)."""
+    register, its divider's stages and the register of stage T1, which computes the record and
+    the squared speeds so that T2's exit and report start from registers) and the mixing
+    table's (2^32 / |w|^2, inv_ww's bits)."""
     quotient_bits = table.formats["v_mcm"].word_bits - 1
-    return max(1 + -(-quotient_bits // SWEEP_DIV_STEP), -(-table.formats["inv_ww"].word_bits // SWEEP_DIV_STEP))
+    return max(2 + -(-quotient_bits // SWEEP_DIV_STEP), -(-table.formats["inv_ww"].word_bits // SWEEP_DIV_STEP))
 
 
 def mixing_fill_cycles(table: FormatTable) -> int:
