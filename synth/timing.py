@@ -128,7 +128,7 @@ def within(r) -> str:
     """The endpoints that meet the target clock, of all (evclust.rtl.census), or why none are known."""
     c = r.get("census")
     if c is None:
-        return "not placed" if r["fmax_mhz"] is None else "not known"
+        return "not placed" if r["fmax_mhz"] is None else "not routed (nextpnr times endpoints after routing)"
     met = c.endpoints - c.missing
     return f"{met:,} of {c.endpoints:,} ({100 * met / c.endpoints:.0f} %){'' if r['routed'] else ', placement estimate'}"
 
