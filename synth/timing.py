@@ -118,10 +118,38 @@ def datasheet(rows) -> str:
         "| fits | " + " | ".join("yes" if r["fits"] else "**no**" for r in rows) + " |",
         f"| register endpoints within {TARGET_MHZ} MHz (10 ns) | " + " | ".join(within(r) for r in rows) + " |",
         "| targets | " + " | ".join(verdict(r) for r in rows) + " |",
+        *extrapolated(rows),
         DATASHEET_END,
         "",
     ]
     return "\n".join(lines)
+
+
+EXTRAPOLATED_N = 256  # the table's largest size (the trace port names a slot in 8 bits)
+
+
+def extrapolated(rows) -> list[str]:
+    """The defaults at N = 256, a straight line through the two sizes built (synthesis at that
+    size would take hours): what each slot adds, times the slots beyond."""
+    built = sorted((r for r in rows if r["configuration"] == "defaults" and not r.get("static")), key=lambda r: r["n_clusters"])
+    if len(built) < 2 or built[-1]["n_clusters"] >= EXTRAPOLATED_N:
+        return []
+    lo, hi = built[0], built[-1]
+    span = hi["n_clusters"] - lo["n_clusters"]
+
+    def at(key, what):
+        per_slot = (hi["resources"][key] - lo["resources"][key]) / span
+        value = hi["resources"][key] + per_slot * (EXTRAPOLATED_N - hi["n_clusters"])
+        avail = hi["available"][key]
+        return f"{value:,.0f} {what} ({f'{100 * value / avail:.0f} % of the part; ' if avail else ''}{per_slot:,.2f} a slot)"
+
+    return [
+        "",
+        f"At N = {EXTRAPOLATED_N} (not built: synthesis at N = 64 takes an hour) the defaults would need, on a straight "
+        f"line through the runs at N = {lo['n_clusters']} and N = {hi['n_clusters']} (nextpnr's packed cells): "
+        f"{at('lut4', 'logic cells')}, {at('ff', 'flip-flops')}, {at('mult18', 'multipliers')} and "
+        f"{at('lutram_w', 'distributed RAM write ports')}.",
+    ]
 
 
 def within(r) -> str:
