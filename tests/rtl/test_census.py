@@ -95,3 +95,10 @@ def test_the_datasheet_gives_the_share_of_endpoints_within_the_target(monkeypatc
     lines = script.census_lines([_row(16, 1, 1, 1, 1, census, routed=True)])
     assert "| defaults, N = 16 | 7 | 3 (43 %) | 3 | 2 | 1, 1, 1 |" in lines  # registers at 1, 2 and 3 cycles
     assert "| `speed` | 3 | 25.0 | 3 |" in lines
+
+
+def test_cells_yosys_named_after_the_logic_they_sit_in_belong_to_that_register():
+    assert register_of("state_TRELLIS_FF_Q_2_DI_LUT4_C_Z_TRELLIS_FF_DI") == "state"
+    assert register_of("div_frame.done_LUT4_A_1_Z_LUT4_D_Z_PFUMX_BLUT_Z_TRELLIS_FF_DI") == "div_frame.done"
+    assert register_of("div_vmx.tag_q[3]_LUT4_C_1_Z_TRELLIS_FF_DI") == "div_vmx.tag_q"
+    assert register_of("seek_w_key.slot_TRELLIS_FF_Q_1_DI_LUT4_C_Z_TRELLIS_FF_DI") == "seek_w_key.slot"

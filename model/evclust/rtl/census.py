@@ -17,10 +17,11 @@ import re
 from typing import NamedTuple
 
 # Yosys names a flip-flop after the net it drives (`<net>_TRELLIS_FF_Q`, then `_1`, `_2` ... for
-# the other bits), nextpnr a packed cell `<cell>$<part>`; a bus's bits are `<name>[i]`, a RAM's
-# rows `<name>.<i>.<j>`. All of them are one register.
+# the other bits), and a net it makes after a cell it meets (`<net>_LUT4_Z_..._TRELLIS_FF_DI`, a
+# flip-flop it added beside `<net>`'s logic); nextpnr names a packed cell `<cell>$<part>`; a bus's
+# bits are `<name>[i]`, a RAM's rows `<name>.<i>.<j>`. All of them are one register.
 _PACKED = re.compile(r"\$.*$")
-_FF = re.compile(r"_TRELLIS_FF_Q(_\d+)?$")
+_FF = re.compile(r"_(?:TRELLIS_FF|TRELLIS_DPR16X4|LUT4|PFUMX|L6MUX21|CCU2C|MULT18X18D)(?:_.*)?$")
 _INDEX = re.compile(r"(\[\d+\]|\.\d+)+$")
 _INNER_INDEX = re.compile(r"\[\d+\]")
 
