@@ -183,7 +183,7 @@ def census_lines(rows) -> list[str]:
         f"![the share of register endpoints that meet each clock, per run]({PLOT.relative_to(ROOT / 'docs')})",
         "",
         f"Endpoints against {TARGET_MHZ} MHz (`evclust.rtl.census`: nextpnr's detailed report gives each register "
-        "endpoint's worst arrival, clock-to-out to setup; a register is a flip-flop bus or a distributed RAM's write "
+        "endpoint's latest arrival, clock-to-out through logic and routing, before its setup time; a register is a flip-flop bus or a distributed RAM's write "
         f"ports, its endpoints their bits). `cycles` is the slowest arrival in {TARGET_MHZ} MHz periods: a register's "
         "inputs need that many cycles, so that many minus one cuts, to meet the clock.",
         "",

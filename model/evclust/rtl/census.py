@@ -2,8 +2,9 @@
 
 nextpnr's report with `--detailed-timing-report` gives, for every net that ends at a register (a
 flip-flop's data, enable or reset, a distributed RAM's write address, data or enable), each
-endpoint's worst arrival time: clock-to-out, logic and routing of its slowest input path, and the
-setup time. The critical path is the largest of them; the census is all of them. Grouped by the
+endpoint's arrival time, earliest and latest: the clock-to-out, logic and routing of its fastest
+and slowest input paths (nextpnr's `TimingAnalyser::build_detailed_net_timing_report`; the
+setup time is not in it). The critical path is the latest of them; the census is all of them. Grouped by the
 register they belong to, they say how many registers miss a clock target, by how much, and how
 many cycles of logic each register's input holds at that clock: the number of pipeline cuts a
 target needs, where the critical path alone names one at a time.
@@ -35,8 +36,8 @@ def register_of(cell: str) -> str:
 class Register(NamedTuple):
     name: str
     endpoints: int
-    worst_ns: float  # the slowest endpoint's arrival, clock-to-out to setup
-    missing: int  # endpoints whose arrival exceeds the target's period
+    worst_ns: float  # the slowest endpoint's latest arrival (clock-to-out, logic, routing)
+    missing: int  # endpoints whose arrival exceeds the target's period (before their setup time)
 
     def cycles(self, target_mhz: float) -> int:
         """Clock periods of the target its slowest input path takes: the cuts it needs, plus one."""
@@ -60,7 +61,8 @@ class Census(NamedTuple):
 
 
 def endpoint_arrivals(report: dict) -> list[tuple[str, str, float]]:
-    """(cell, port, arrival ns) of every register endpoint on the clock in nextpnr's report."""
+    """(cell, port, latest arrival ns) of every register endpoint on the clock in nextpnr's
+    report, whose `delay` is the arrival's [min, max]."""
     arrivals = []
     for net in report.get("detailed_net_timings", []):
         for end in net.get("endpoints", []):
