@@ -116,11 +116,96 @@ def datasheet(rows) -> str:
         "| distributed RAM write ports (TRELLIS_RAMW) | " + " | ".join(cell(r, "lutram_w") for r in rows) + " |",
         "| block RAM (DP16KD) | " + " | ".join(cell(r, "bram") for r in rows) + " |",
         "| fits | " + " | ".join("yes" if r["fits"] else "**no**" for r in rows) + " |",
+        f"| register endpoints within {TARGET_MHZ} MHz (10 ns) | " + " | ".join(within(r) for r in rows) + " |",
         "| targets | " + " | ".join(verdict(r) for r in rows) + " |",
+        *extrapolated(rows),
         DATASHEET_END,
         "",
     ]
     return "\n".join(lines)
+
+
+EXTRAPOLATED_N = 256  # the table's largest size (the trace port names a slot in 8 bits)
+
+
+def extrapolated(rows) -> list[str]:
+    """The defaults at N = 256, a straight line through the two sizes built (synthesis at that
+    size would take hours): what each slot adds, times the slots beyond."""
+    built = sorted((r for r in rows if r["configuration"] == "defaults" and not r.get("static")), key=lambda r: r["n_clusters"])
+    if len(built) < 2 or built[-1]["n_clusters"] >= EXTRAPOLATED_N:
+        return []
+    lo, hi = built[0], built[-1]
+    span = hi["n_clusters"] - lo["n_clusters"]
+
+    def at(key, what):
+        per_slot = (hi["resources"][key] - lo["resources"][key]) / span
+        value = hi["resources"][key] + per_slot * (EXTRAPOLATED_N - hi["n_clusters"])
+        avail = hi["available"][key]
+        return f"{value:,.0f} {what} ({f'{100 * value / avail:.0f} % of the part; ' if avail else ''}{per_slot:,.2f} a slot)"
+
+    return [
+        "",
+        f"At N = {EXTRAPOLATED_N} (not built: synthesis at N = 64 takes an hour) the defaults would need, on a straight "
+        f"line through the runs at N = {lo['n_clusters']} and N = {hi['n_clusters']} (nextpnr's packed cells): "
+        f"{at('lut4', 'logic cells')}, {at('ff', 'flip-flops')}, {at('mult18', 'multipliers')} and "
+        f"{at('lutram_w', 'distributed RAM write ports')}.",
+    ]
+
+
+def within(r) -> str:
+    """The endpoints that meet the target clock, of all (evclust.rtl.census), or why none are known."""
+    c = r.get("census")
+    if c is None:
+        return "not placed" if r["fmax_mhz"] is None else "not routed (nextpnr times endpoints after routing)"
+    met = c.endpoints - c.missing
+    return f"{met:,} of {c.endpoints:,} ({100 * met / c.endpoints:.0f} %){'' if r['routed'] else ', placement estimate'}"
+
+
+def census_json(c) -> dict | None:
+    if c is None:
+        return None
+    # (not every arrival: the registers' figures are what a reader of the results compares)
+    return {"target_mhz": c.target_mhz, "endpoints": c.endpoints, "missing": c.missing, "registers": [r._asdict() for r in c.registers]}
+
+
+CENSUS_SHOWN = 12  # the slowest registers listed per run
+PLOT = ROOT / "docs" / "img" / "timing_census.png"  # written with the BENCHMARKS section
+
+
+def run_name(r) -> str:
+    return f"{r['configuration']}, N = {r['n_clusters']}{'' if r['routed'] else ' (placement estimate)'}"
+
+
+def census_lines(rows) -> list[str]:
+    """Every register endpoint's worst arrival, grouped by register: how far each run is from the
+    target clock, not only along its critical path."""
+    lines = [
+        f"![the share of register endpoints that meet each clock, per run]({PLOT.relative_to(ROOT / 'docs')})",
+        "",
+        f"Endpoints against {TARGET_MHZ} MHz (`evclust.rtl.census`: nextpnr's detailed report gives each register "
+        "endpoint's latest arrival, clock-to-out through logic and routing, before its setup time; a register is a flip-flop bus or a distributed RAM's write "
+        f"ports, its endpoints their bits). `cycles` is the slowest arrival in {TARGET_MHZ} MHz periods: a register's "
+        "inputs need that many cycles, so that many minus one cuts, to meet the clock.",
+        "",
+        f"| run | endpoints | missing {TARGET_MHZ} MHz | registers | missing {TARGET_MHZ} MHz | registers by cycles (1, 2, 3, ...) |",
+        "|---|---:|---:|---:|---:|---|",
+    ]
+    shown = []
+    for r in rows:
+        c = r.get("census")
+        if c is None:
+            continue
+        name = run_name(r)
+        most = max(g.cycles(TARGET_MHZ) for g in c.registers)
+        by_cycles = [sum(g.cycles(TARGET_MHZ) == k for g in c.registers) for k in range(1, most + 1)]
+        lines.append(f"| {name} | {c.endpoints:,} | {c.missing:,} ({100 * c.missing / c.endpoints:.0f} %) | {len(c.registers)} "
+                     f"| {c.registers_missing} | {', '.join(map(str, by_cycles))} |")  # fmt: skip
+        shown.append((name, c))
+    for name, c in shown:
+        lines += ["", f"{name}: the {CENSUS_SHOWN} slowest registers", "",
+                  "| register | endpoints | slowest arrival (ns) | cycles |", "|---|---:|---:|---:|"]  # fmt: skip
+        lines += [f"| `{g.name}` | {g.endpoints:,} | {g.worst_ns:.1f} | {g.cycles(TARGET_MHZ)} |" for g in c.registers[:CENSUS_SHOWN]]
+    return lines if shown else []
 
 
 def section(rows) -> str:
@@ -159,7 +244,8 @@ def section(rows) -> str:
         )
         shown = ", ".join(where)
         lines.append(f"- {r['configuration']}, N = {r['n_clusters']}: `{cp.get('from')}` to `{cp.get('to')}`, through the lines {shown}.")
-    return "\n".join(lines + [END, ""])
+    census = census_lines(rows)
+    return "\n".join(lines + ([""] + census if census else []) + [END, ""])
 
 
 def main():
@@ -194,12 +280,17 @@ def main():
     except EvclustError as e:
         sys.exit(f"timing: {e}")
     args.json.parent.mkdir(parents=True, exist_ok=True)
-    args.json.write_text(json.dumps(rows, indent=2) + "\n")
+    args.json.write_text(json.dumps([r | {"census": census_json(r["census"])} for r in rows], indent=2) + "\n")
     print(table(rows))
     if args.write:
         from evclust.documents import write_section
         from evclust.stamps import stamp_for
 
+        from evclust.rtl.census import plot_clock_shares
+
+        censuses = {run_name(r): r for r in rows if r.get("census")}
+        if censuses:
+            plot_clock_shares({k: r["census"] for k, r in censuses.items()}, PLOT, {k: r["fmax_mhz"] for k, r in censuses.items()})
         write_section(args.write, section(rows), START, END, stamp=stamp_for("BENCHMARKS:timing"))
     if args.datasheet:
         from evclust.documents import write_section

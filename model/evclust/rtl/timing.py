@@ -24,6 +24,7 @@ from pathlib import Path
 
 from evclust.errors import EvclustError
 from evclust.paths import BUILD, REPO
+from evclust.rtl.census import Census, endpoint_census
 from evclust.rtl.sources import RTL_SOURCES, require_repository
 from evclust.rtl.synth import ABC9_KNOBS, last_step, rtl_snapshot, run_tool, stage_sources, yowasp_command
 
@@ -169,9 +170,10 @@ def place_and_route(header: str, label: str, route: bool = True, heartbeat=None,
     out = BUILD / "timing" / f"{label}-{cache_key(header, sources, route, identity, static, top, tuple(extra))}"
     done = out / "figures.json"
     if done.exists():
-        return json.loads(done.read_text()) | {"cached": True}
+        return json.loads(done.read_text()) | {"cached": True, "census": _census(out)}
     if _finished(out):  # the tools finished but their figures were not written: read, not rerun
-        return _write_figures(out, _figures(out), label, rtl, identity, route, *_tool_seconds(out)) | {"cached": True}
+        figures = _write_figures(out, _figures(out), label, rtl, identity, route, *_tool_seconds(out))
+        return figures | {"cached": True, "census": _census(out)}
     stage_sources(out, sources, header)
     # The tools run in `out` and see it by relative paths only: yowasp maps its own temporary
     # folder over /tmp, so an absolute path into a clone under /tmp would not be the clone's.
@@ -186,7 +188,14 @@ def place_and_route(header: str, label: str, route: bool = True, heartbeat=None,
         if measured is None:
             raise
         pnr_s = 0.0
-    return _write_figures(out, measured, label, rtl, identity, route, synth_s, pnr_s) | {"cached": False}
+    return _write_figures(out, measured, label, rtl, identity, route, synth_s, pnr_s) | {"cached": False, "census": _census(out)}
+
+
+def _census(out: Path) -> Census | None:
+    """The run's endpoints by register against the target clock (evclust.rtl.census), read from
+    its report each time rather than kept in figures.json, so the cached runs have it too."""
+    report = out / "report.json"
+    return endpoint_census(json.loads(report.read_text()), TARGET_MHZ) if report.exists() else None
 
 
 def _write_figures(out: Path, measured: dict, label, rtl, identity, route, synth_s, pnr_s) -> dict:
