@@ -145,7 +145,7 @@ def extrapolated(rows) -> list[str]:
 
     return [
         "",
-        f"At N = {EXTRAPOLATED_N} (not built: synthesis at N = 64 takes an hour) the defaults would need, on a straight "
+        f"At N = {EXTRAPOLATED_N} (not built: synthesis at N = 64 takes 40 to 70 minutes here) the defaults would need, on a straight "
         f"line through the runs at N = {lo['n_clusters']} and N = {hi['n_clusters']} (nextpnr's packed cells): "
         f"{at('lut4', 'logic cells')}, {at('ff', 'flip-flops')}, {at('mult18', 'multipliers')} and "
         f"{at('lutram_w', 'distributed RAM write ports')}.",
