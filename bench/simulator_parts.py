@@ -97,26 +97,20 @@ def main(argv: list[str] | None = None) -> int:
     silent = np.array([np.inf])
     th_on, th_off, th_stride = sim.th_on, sim.th_off, sim.th_stride
 
-    def detect(on: np.ndarray, off: np.ndarray, stride: int) -> None:
+    def detect(on: np.ndarray, off: np.ndarray, stride: int, kept: list[np.ndarray] | None = None) -> None:
+        """The kernel over every interval into the one buffer; `kept` gets a copy of each
+        interval's words (for `order`)."""
         ref = observed[0][0].astype(np.float64)
         for k in range(1, len(observed)):
             (l0, c0), (l1, c1) = observed[k - 1], observed[k]
-            _, done = detect_interval(l0, l1, c0, c1, ref, on, off, stride, width, (k - 1) * dt_us, dt_us, 0, buffer.words, RGB_TO_YCBCR)
+            n, done = detect_interval(l0, l1, c0, c1, ref, on, off, stride, width, (k - 1) * dt_us, dt_us, 0, buffer.words, RGB_TO_YCBCR)
             if done != pixels:
                 raise SystemExit("an interval overflowed the buffer: raise its capacity")
+            if kept is not None:
+                kept.append(buffer.words[: 2 * n].copy())
 
     intervals: list[np.ndarray] = []
-
-    def collect() -> None:
-        ref = observed[0][0].astype(np.float64)
-        for k in range(1, len(observed)):
-            (l0, c0), (l1, c1) = observed[k - 1], observed[k]
-            n, _ = detect_interval(
-                l0, l1, c0, c1, ref, th_on, th_off, th_stride, width, (k - 1) * dt_us, dt_us, 0, buffer.words, RGB_TO_YCBCR
-            )
-            intervals.append(buffer.words[: 2 * n].copy())
-
-    collect()
+    detect(th_on, th_off, th_stride, intervals)
     total = sum(w.size // 2 for w in intervals)
     ordered = np.empty(total, EVENT_DTYPE)
 
