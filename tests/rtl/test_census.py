@@ -60,23 +60,14 @@ def test_the_share_of_endpoints_within_a_clock_counts_arrivals_up_to_its_period(
     assert census.share_within(1000.0) == 0.0  # 1 ns: none
 
 
-def _timing_script(monkeypatch):
-    import importlib
-    from pathlib import Path
-
-    # synth/timing.py imports its neighbour synth.py as a script does: its folder on the path.
-    monkeypatch.syspath_prepend(str(Path(__file__).resolve().parents[2] / "synth"))
-    return importlib.import_module("timing")
-
-
 def _row(n, lut4, ff, mult18, lutram_w, census=None, routed=False, fmax=5.0):
     return {"configuration": "defaults", "n_clusters": n, "static": False, "routed": routed, "fmax_mhz": fmax, "census": census,
             "resources": {"lut4": lut4, "ff": ff, "mult18": mult18, "lutram_w": lutram_w, "bram": 0},
             "available": {"lut4": 1000, "ff": 1000, "mult18": 100, "lutram_w": 100, "bram": 10}}  # fmt: skip
 
 
-def test_the_datasheet_extrapolates_the_defaults_to_256_slots_on_the_line_through_the_runs(monkeypatch):
-    script = _timing_script(monkeypatch)
+def test_the_datasheet_extrapolates_the_defaults_to_256_slots_on_the_line_through_the_runs(timing_script):
+    script = timing_script
     # 10 cells a slot from N = 16 to 64: 640 + 10 * (256 - 64) = 2560 cells, 256 % of a 1000-cell part
     line = "\n".join(script.extrapolated([_row(16, 160, 32, 4, 16), _row(64, 640, 128, 10, 64)]))
     assert "2,560 logic cells (256 % of the part; 10.00 a slot)" in line
@@ -86,8 +77,8 @@ def test_the_datasheet_extrapolates_the_defaults_to_256_slots_on_the_line_throug
     assert script.extrapolated([_row(16, 160, 32, 4, 16)]) == []  # one size gives no line
 
 
-def test_the_datasheet_gives_the_share_of_endpoints_within_the_target(monkeypatch):
-    script = _timing_script(monkeypatch)
+def test_the_datasheet_gives_the_share_of_endpoints_within_the_target(timing_script):
+    script = timing_script
     census = endpoint_census(REPORT, 100.0)
     assert script.within(_row(16, 1, 1, 1, 1, census, routed=True)) == "4 of 7 (57 %)"
     assert "not routed" in script.within(_row(16, 1, 1, 1, 1))

@@ -115,15 +115,8 @@ def test_the_tools_see_their_run_folder_by_relative_paths_only(tmp_path, monkeyp
     assert all(not a.startswith("/") for a in timing.nextpnr_args(timing.Path("."), True))
 
 
-def test_a_run_may_stop_after_placement(monkeypatch):
-    import importlib
-    from pathlib import Path
-
-    # synth/timing.py is a script that imports its neighbour synth.py as a script does: its folder
-    # on the path, for this test only (pytest takes it off again).
-    monkeypatch.syspath_prepend(str(Path(__file__).resolve().parents[2] / "synth"))
-    script = importlib.import_module("timing")
-
+def test_a_run_may_stop_after_placement(timing_script):
+    script = timing_script
     assert script.parse_run("defaults:64:placed") == ("defaults", 64, True)
     assert script.parse_run("paper:16") == ("paper", 16, False)
     for bad in ("defaults", "defaults:x", "nope:16", "paper:16:routed"):
