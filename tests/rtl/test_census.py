@@ -3,7 +3,7 @@ nextpnr's JSON layout (`--detailed-timing-report`) with known arrival times."""
 
 import json
 
-from evclust.rtl.census import endpoint_census, register_of
+from evclust.rtl.census import compare, comparison_table, endpoint_census, main, register_of
 
 
 def _net(driver, *endpoints, event="posedge clk"):
@@ -93,3 +93,34 @@ def test_cells_yosys_named_after_the_logic_they_sit_in_belong_to_that_register()
     assert register_of("div_frame.done_LUT4_A_1_Z_LUT4_D_Z_PFUMX_BLUT_Z_TRELLIS_FF_DI") == "div_frame.done"
     assert register_of("div_vmx.tag_q[3]_LUT4_C_1_Z_TRELLIS_FF_DI") == "div_vmx.tag_q"
     assert register_of("seek_w_key.slot_TRELLIS_FF_Q_1_DI_LUT4_C_Z_TRELLIS_FF_DI") == "seek_w_key.slot"
+
+
+def test_a_comparison_lists_each_register_in_either_run_by_its_change():
+    after_report = {"detailed_net_timings": [
+        _net("lut0", ("speed_TRELLIS_FF_Q", "DI", 8.0)),  # cut: 25 -> 8
+        _net("ramw", ("rows.1.2$DPRAM_COMB0", "WD", 13.0)),  # 12 -> 13
+        _net("lut3", ("look_TRELLIS_FF_Q", "DI", 11.0)),  # new
+    ]}  # fmt: skip
+    before, after = endpoint_census(REPORT, 100.0), endpoint_census(after_report, 100.0)
+    changes = compare(before, after)
+    assert [(c.register, c.before_ns, c.after_ns) for c in changes] == [
+        ("speed", 25.0, 8.0), ("look", None, 11.0), ("seek.slot[i].key", 10.0, None), ("rows", 12.0, 13.0)]  # fmt: skip
+    assert changes[0].delta_ns == -17.0
+    table = comparison_table(before, after, top=2)
+    assert "| missing 100 MHz | 3 | 2 |" in table  # 25, 12, 10.5 before; 13, 11 after
+    assert "| slowest arrival (ns) | 25.0 | 13.0 |" in table
+    assert "| `speed` | 25.0 | 8.0 |" in table and "| `look` | – | 11.0 |" in table
+    assert "| `rows` | 12.0 | 13.0 |" in table  # the slowest after
+
+
+def test_the_comparison_command_reads_two_reports_and_refuses_one_without_timings(tmp_path, capsys):
+    before, after, bare = tmp_path / "before.json", tmp_path / "after.json", tmp_path / "bare.json"
+    before.write_text(json.dumps(REPORT))
+    after.write_text(json.dumps(REPORT))
+    bare.write_text(json.dumps({"fmax": {}}))
+    assert main([str(before), str(after), "--top", "1"]) == 0
+    assert "| endpoints | 7 | 7 |" in capsys.readouterr().out
+    assert main([str(before), str(bare)]) == 2
+    assert "no detailed net timings" in capsys.readouterr().err
+    assert main([str(before), str(tmp_path / "missing.json")]) == 2
+    assert "cannot read" in capsys.readouterr().err

@@ -12,9 +12,13 @@ target needs, where the critical path alone names one at a time.
 
 from __future__ import annotations
 
+import argparse
 import bisect
+import json
 import math
 import re
+import sys
+from pathlib import Path
 from typing import NamedTuple
 
 # Yosys names a flip-flop after the net it drives (`<net>_TRELLIS_FF_Q`, then `_1`, `_2` ... for
@@ -114,3 +118,71 @@ def plot_clock_shares(runs: dict[str, Census], path, fmax: dict[str, float] | No
     fig.tight_layout()
     fig.savefig(path, dpi=100)
     plt.close(fig)
+
+
+class Change(NamedTuple):
+    register: str
+    before_ns: float | None  # None: the register is not in that run
+    after_ns: float | None
+
+    @property
+    def delta_ns(self) -> float:
+        return (self.after_ns or 0.0) - (self.before_ns or 0.0)
+
+
+def compare(before: Census, after: Census) -> list[Change]:
+    """Every register of either run with its slowest arrival in each, largest change first: what
+    a cut did to the registers it aimed at, and where the worst paths went."""
+    worst_before = {r.name: r.worst_ns for r in before.registers}
+    worst_after = {r.name: r.worst_ns for r in after.registers}
+    changes = [Change(name, worst_before.get(name), worst_after.get(name)) for name in worst_before.keys() | worst_after.keys()]
+    changes.sort(key=lambda c: (-abs(c.delta_ns), c.register))
+    return changes
+
+
+def comparison_table(before: Census, after: Census, top: int = 15) -> str:
+    """Markdown: the totals of both runs, then the `top` registers that changed most and the
+    `top` slowest after."""
+    ns = lambda v: "–" if v is None else f"{v:.1f}"
+    lines = ["| | before | after |", "|---|---:|---:|"]
+    for label, b, a in (("endpoints", before.endpoints, after.endpoints),
+                        (f"missing {before.target_mhz:g} MHz", before.missing, after.missing),
+                        ("registers", len(before.registers), len(after.registers)),
+                        (f"registers missing {before.target_mhz:g} MHz", before.registers_missing, after.registers_missing),
+                        ("slowest arrival (ns)", ns(before.registers[0].worst_ns), ns(after.registers[0].worst_ns))):  # fmt: skip
+        lines.append(f"| {label} | {b:,} | {a:,} |" if isinstance(b, int) else f"| {label} | {b} | {a} |")
+    lines += ["", "| register (most changed) | before (ns) | after (ns) |", "|---|---:|---:|"]
+    lines += [f"| `{c.register}` | {ns(c.before_ns)} | {ns(c.after_ns)} |" for c in compare(before, after)[:top]]
+    worst_before = {r.name: r.worst_ns for r in before.registers}
+    lines += ["", "| register (slowest after) | before (ns) | after (ns) |", "|---|---:|---:|"]
+    lines += [f"| `{r.name}` | {ns(worst_before.get(r.name))} | {ns(r.worst_ns)} |" for r in after.registers[:top]]
+    return "\n".join(lines)
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(
+        prog="python -m evclust.rtl.census",
+        description="Compare two routed runs' register endpoints (nextpnr report.json with --detailed-timing-report).")
+    parser.add_argument("before", type=Path, help="the report.json before the change")
+    parser.add_argument("after", type=Path, help="the report.json after it")
+    parser.add_argument("--target-mhz", type=float, default=100.0)
+    parser.add_argument("--top", type=int, default=15, help="registers listed per table")
+    args = parser.parse_args(argv)
+    censuses = []
+    for path in (args.before, args.after):
+        try:
+            report = json.loads(path.read_text())
+        except (OSError, ValueError) as error:
+            print(f"census: cannot read {path}: {error}", file=sys.stderr)
+            return 2
+        census = endpoint_census(report, args.target_mhz)
+        if census is None:
+            print(f"census: {path} has no detailed net timings (nextpnr without --detailed-timing-report?)", file=sys.stderr)
+            return 2
+        censuses.append(census)
+    print(comparison_table(*censuses, top=args.top))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
