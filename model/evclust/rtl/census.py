@@ -162,7 +162,8 @@ def comparison_table(before: Census, after: Census, top: int = 15) -> str:
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(
         prog="python -m evclust.rtl.census",
-        description="Compare two routed runs' register endpoints (nextpnr report.json with --detailed-timing-report).")
+        description="Compare two routed runs' register endpoints (nextpnr report.json with --detailed-timing-report).",
+    )
     parser.add_argument("before", type=Path, help="the report.json before the change")
     parser.add_argument("after", type=Path, help="the report.json after it")
     parser.add_argument("--target-mhz", type=float, default=100.0)
