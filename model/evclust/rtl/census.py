@@ -130,11 +130,14 @@ class Change(NamedTuple):
         return (self.after_ns or 0.0) - (self.before_ns or 0.0)
 
 
+def _worst_by_register(census: Census) -> dict[str, float]:
+    return {r.name: r.worst_ns for r in census.registers}
+
+
 def compare(before: Census, after: Census) -> list[Change]:
     """Every register of either run with its slowest arrival in each, largest change first: what
     a cut did to the registers it aimed at, and where the worst paths went."""
-    worst_before = {r.name: r.worst_ns for r in before.registers}
-    worst_after = {r.name: r.worst_ns for r in after.registers}
+    worst_before, worst_after = _worst_by_register(before), _worst_by_register(after)
     changes = [Change(name, worst_before.get(name), worst_after.get(name)) for name in worst_before.keys() | worst_after.keys()]
     changes.sort(key=lambda c: (-abs(c.delta_ns), c.register))
     return changes
@@ -153,7 +156,7 @@ def comparison_table(before: Census, after: Census, top: int = 15) -> str:
         lines.append(f"| {label} | {b:,} | {a:,} |" if isinstance(b, int) else f"| {label} | {b} | {a} |")
     lines += ["", "| register (most changed) | before (ns) | after (ns) |", "|---|---:|---:|"]
     lines += [f"| `{c.register}` | {ns(c.before_ns)} | {ns(c.after_ns)} |" for c in compare(before, after)[:top]]
-    worst_before = {r.name: r.worst_ns for r in before.registers}
+    worst_before = _worst_by_register(before)
     lines += ["", "| register (slowest after) | before (ns) | after (ns) |", "|---|---:|---:|"]
     lines += [f"| `{r.name}` | {ns(worst_before.get(r.name))} | {ns(r.worst_ns)} |" for r in after.registers[:top]]
     return "\n".join(lines)
