@@ -183,3 +183,47 @@ def test_two_writers_of_one_document_lose_no_section(tmp_path):
     assert text.startswith(NEW_BENCHMARKS)
     assert "one 199" in text and "two 199" in text
     assert text.count("<!-- one:start -->") == 1 and text.count("<!-- two:start -->") == 1
+
+
+def test_the_rtl_is_fingerprinted_as_its_tools_read_it():
+    read = stamps.verilog_as_read
+    code = "module m;\n  wire a = 1'b1;\nendmodule\n"
+    # Comments, indentation and blank lines are not read: the fingerprint keeps.
+    assert read(code) == read("// why m\nmodule m;  /* one\nwire */\n\n\twire   a = 1'b1; // a's why\nendmodule")
+    # A change of code is read.
+    assert read(code) != read(code.replace("1'b1", "1'b0"))
+    # A "//" inside a string is no comment; the tools' directives are read; a `define ends at its line.
+    assert read('initial $display("a // b /* c */"); // x') == 'initial $display("a // b /* c */");'
+    assert read("wire w; // verilator lint_off WIDTH") == "wire w; // verilator lint_off WIDTH"
+    assert read("// synthesis translate_off\nx") == "// synthesis translate_off\nx"
+    assert read("`define M 1 /* one\ntwo */\nwire w = `M;") == "`define M 1\nwire w = `M;"
+
+
+def test_the_rtl_as_the_fingerprint_reads_it_is_the_same_design_to_icarus(tmp_path):
+    """What the fingerprint drops changes nothing Icarus builds: the repository's RTL, read so,
+    compiles to the same netlist (Icarus' object addresses and source lines aside)."""
+    import re
+    import shutil
+    import subprocess
+
+    if shutil.which("iverilog") is None:
+        pytest.fail("iverilog is not on PATH (the machine's Icarus Verilog is a requirement)")
+    read_dir = tmp_path / "read"
+    read_dir.mkdir()
+    for path in sorted((stamps.REPO / "rtl").glob("*.v*")):
+        text = path.read_text()
+        (read_dir / path.name).write_text(text if path.name == "evclust_params.vh" else stamps.verilog_as_read(text) + "\n")
+
+    def netlist(folder: Path) -> list[str]:
+        out = tmp_path / f"{folder.name}.vvp"
+        sources = sorted(str(p) for p in folder.glob("*.v"))
+        subprocess.run(["iverilog", "-g2005", f"-I{folder}", "-s", "evclust_axis", "-o", str(out), *sources], check=True,
+                       capture_output=True)  # fmt: skip
+        lines = [ln for ln in out.read_text().splitlines() if not ln.startswith(":file_names") and not ln.startswith('    "')]
+        # addresses, and the (file, line) pairs of scopes and parameters
+        lines = [re.sub(r"0x[0-9a-f]+", "0x", ln) for ln in lines]
+        lines = [re.sub(r'^(P_0x \.param/\w+ "\w+") \d+ \d+ \d+,', r"\1", ln) for ln in lines]
+        return [re.sub(r'^(S_0x \.scope [\w.]+, "[^"]*" "[^"]*") \d+ \d+(, \d+ \d+ \d+)?', r"\1", ln) for ln in lines]
+
+    original, as_read = netlist(stamps.REPO / "rtl"), netlist(read_dir)
+    assert len(original) > 10_000 and original == as_read

@@ -7,7 +7,10 @@ the behaviour keeps the stamps (as the golden vectors' staleness check compares 
 
   formats  sha256 of the generated header rtl/evclust_params.vh (a test keeps it current with the
            formats table)
-  rtl      sha256 over the RTL's sources (rtl/*.v, rtl/*.vh but the generated header), by name
+  rtl      sha256 over the RTL's sources (rtl/*.v, rtl/*.vh but the generated header), by name, each
+           as its tools read it: without comments (but the tools' own directives, `// verilator
+           lint_off`, `// synthesis translate_off`), blank lines and indentation, so that a comment
+           or a reflow of the Verilog does not make two hours of documents stale
   fixed    sha256 over the golden vectors' manifests' sha256 entries (vectors/*/manifest.json; the
            vectors' staleness test keeps them equal to what the fixed model writes now)
   simulator  the simulator's behaviour: a small scene simulated without and with every sensor
@@ -147,9 +150,29 @@ def formats_fingerprint(files: Files) -> str:
     return hashlib.sha256(files.read(HEADER)).hexdigest()
 
 
+# A Verilog source's strings and comments, in one scan so that a "//" inside a string is no comment.
+_VERILOG_LEXEMES = re.compile(r'"(?:\\.|[^"\\\n])*"|//[^\n]*|/\*.*?\*/', re.S)
+# Comments that a tool reads: they change what is linted, simulated or synthesised.
+_DIRECTIVE = re.compile(r"(//|/\*)\s*(verilator|synopsys|synthesis|pragma|yosys|translate_(on|off))\b")
+
+
+def verilog_as_read(text: str) -> str:
+    """The Verilog without what no tool reads: comments (but directives) become a space, each
+    line's runs of blanks one space, blank lines go. Line breaks stay (a `define ends at one)."""
+
+    def lexeme(match: re.Match) -> str:
+        s = match.group(0)
+        if s.startswith('"') or _DIRECTIVE.match(s):
+            return s
+        return " " + "\n" * s.count("\n")  # a block comment's line breaks stay: a `define may span them
+
+    lines = (" ".join(line.split()) for line in _VERILOG_LEXEMES.sub(lexeme, text).split("\n"))
+    return "\n".join(line for line in lines if line)
+
+
 def rtl_fingerprint(files: Files) -> str:
     names = [n for n in files.names("rtl", (".v", ".vh")) if n != HEADER and n.count("/") == 1]
-    return _sha(part for n in names for part in (n, files.read(n)))
+    return _sha(part for n in names for part in (n, verilog_as_read(files.read(n).decode())))
 
 
 def fixed_fingerprint(files: Files) -> str:
