@@ -22,6 +22,9 @@ the behaviour keeps the stamps (as the golden vectors' staleness check compares 
   reference  the activity against a reference time (ClustererParams.activity_reference), which
            neither probe above runs: the float and fixed models' records on the float probe's
            events with the mode on, at update_delay 0 and 2.
+  sweep    the filter step's sweep beside the events (ClustererParams.sweep_slots_per_event),
+           which no probe above runs: the float and fixed models' records on the float probe's
+           events at one slot an event, with the paper's update and with D = 2 against a reference time.
 
     python -m evclust.stamps                       # the current fingerprints and every document's state
     python -m evclust.stamps --plan                # the commands that regenerate every stale document, each once
@@ -55,7 +58,7 @@ from evclust.errors import EvclustError
 
 REPO = Path(__file__).resolve().parents[2]
 HEADER = "rtl/evclust_params.vh"
-INPUTS = ("formats", "rtl", "fixed", "simulator", "float", "reference")
+INPUTS = ("formats", "rtl", "fixed", "simulator", "float", "reference", "sweep")
 DIGITS = 12  # hex digits of each fingerprint in a stamp
 STAMP_RE = re.compile(r"<!-- inputs: ((?:[a-z]+=[0-9a-f]+ ?)+) -->")
 
@@ -91,7 +94,7 @@ DOCUMENTS = (
     Document("RESULTS:video", "docs/RESULTS.md", "<!-- results:video:start -->", "<!-- results:video:end -->", ("float",),
              "make results-video"),
     Document("GENERALIZATION", "docs/GENERALIZATION.md", None, None, ("formats", "fixed", "float"), "make generalize"),
-    Document("PIPELINE", "docs/PIPELINE.md", None, None, ("float", "fixed", "reference"), "make generalize"),
+    Document("PIPELINE", "docs/PIPELINE.md", None, None, ("float", "fixed", "reference", "sweep"), "make generalize"),
     Document("ABLATION", "docs/ABLATION.md", None, None, ("float",), "make ablation"),
     _bench("simulator", ("simulator",), f"{PY} bench/simulator.py --write docs/BENCHMARKS.md"),
     _bench("clusterer", ("formats", "fixed", "float"), f"{PY} bench/clusterer.py --write docs/BENCHMARKS.md"),
@@ -310,6 +313,35 @@ def probe_reference_records() -> list[tuple[str, bytes]]:
     return out
 
 
+def probe_sweep_records() -> list[tuple[str, bytes]]:
+    """The sweep beside the events (ClustererParams.sweep_slots_per_event), which no other probe
+    runs: the float and fixed models' records on the probe's events at one slot an event, with the
+    paper's update (D = 0) and the pipelined core's (D = 2, the activity against a reference time)."""
+    import numpy as np
+
+    from evclust.clusterer import ClustererParams, FloatClusterer
+    from evclust.events import EVENT_DTYPE
+    from evclust.fixed.model import FixedClusterer
+
+    events = {label.split(" ", 1)[1]: data for label, data in probe_events() if label.startswith("events ")}
+    out = []
+    for label, scene in _probe_scenes():
+        src = scene.source
+        for delay, reference in ((0, False), (2, True)):
+            params = ClustererParams(sweep_slots_per_event=1, update_delay=delay, activity_reference=reference, objects=False)
+            for name, model in (("float", FloatClusterer), ("fixed", FixedClusterer)):
+                rows = model(params, src.width, src.height, src.t_frame_us).feed(np.frombuffer(events[label], dtype=EVENT_DTYPE))
+                out.append((f"{label} D={delay} {name}", _rounded(rows) if name == "float" else np.ascontiguousarray(rows).tobytes()))
+    return out
+
+
+def sweep_fingerprint(files: Files | None = None) -> str:
+    """The sweep probe's hash, run here, or (files at a commit) on that commit's models."""
+    if files is None or files.commit is None:
+        return _hash(probe_sweep_records())
+    return _at_commit(files, "sweep_fingerprint", "sweep")
+
+
 def reference_fingerprint(files: Files | None = None) -> str:
     """The activity-reference probe's hash, run here, or (files at a commit) on that commit's models."""
     if files is None or files.commit is None:
@@ -358,6 +390,7 @@ FINGERPRINTS = {
     "simulator": simulator_fingerprint,
     "float": float_fingerprint,
     "reference": reference_fingerprint,
+    "sweep": sweep_fingerprint,
 }
 
 

@@ -86,7 +86,7 @@ def run(args) -> int:
 
 def run_pipeline(args) -> int:
     from evclust.suite import dask_client, split_seeds
-    from evclust.suite.pipeline import configurations, paired_changes, reference_changes, write_page
+    from evclust.suite.pipeline import configurations, paired_changes, reference_changes, sweep_changes, write_page
     from evclust.suite.report import run_configurations
 
     if args.ablation or args.seeds or args.json:
@@ -94,13 +94,14 @@ def run_pipeline(args) -> int:
     out = Path(args.output or "docs/PIPELINE.md")
     command = f"evclust generalize --pipeline -o {shlex.quote(str(out))}"
     machine = f"{platform.machine()}, {platform.python_implementation()} {platform.python_version()}"
-    by_split, reference_by_split, scenes = {}, {}, {}
+    by_split, reference_by_split, sweep_by_split, scenes = {}, {}, {}, {}
     with dask_client(args.scheduler, args.workers) as client:
         for split in ("test", "tuning"):
             seeds = split_seeds(split)
             runs = run_configurations(client, Path(args.suite_dir), seeds, configurations(), progress=not args.quiet)
             by_split[split], scenes[split] = paired_changes(runs), len(seeds)
             reference_by_split[split] = reference_changes(runs)
-    write_page(by_split, out, command, machine, scenes, reference_by_split)
+            sweep_by_split[split] = sweep_changes(runs)
+    write_page(by_split, out, command, machine, scenes, reference_by_split, sweep_by_split)
     print(f"{out}: pipeline semantics on the test and tuning splits")
     return 0

@@ -17,6 +17,7 @@ FIELDS = (
     "v_min", "exit_margin", "v_exit", "cos_exit", "width", "height", "has_colour", "warm_start", "mcm_correct",
     "vote_contrast", "mixing", "mixing_tolerance", "merge", "merge_scale", "merge_v_tol", "merge_v_rel", "noise_gate",
     "create_support", "support_cell_bits", "support_window_us", "interval_warmup", "activity_reference", "reference_halvings",
+    "sweep_slots_per_event",
 )  # fmt: skip
 DTYPE = np.dtype([(name, np.float64) for name in FIELDS])
 
@@ -44,5 +45,6 @@ def param_vector(p, width: int, height: int, t_frame_us: float, has_colour: bool
         "interval_warmup": p.interval_warmup(),
         "activity_reference": p.activity_reference,
         "reference_halvings": REFERENCE_HALVINGS,
+        "sweep_slots_per_event": p.sweep_slots_per_event,
     }
     return named_record(DTYPE, values)

@@ -15,8 +15,8 @@ from evclust.clusterer.layout import (
     ACT, BG_ACT, BG_CB, BG_CR, BG_T, BG_Y, CCB, CCR, MERGED, UNSUPPORTED, CREATED, CY, DROPPED, EV_COUNT, EVENTS, EVER_REPORTED, EVICTED, EXITED,
     EXPIRED, T_FIRST, FLAG_BORDER, FLAG_MOVING_INT, FLAG_MOVING_MCM, FLAG_NEW, GAMMA, ID, MCM_NORM, NEXT_ID, NOISE, PPX, PPY, PX,
     PD_BG, PD_BG_CB, PD_BG_CR, PD_BG_Y, PD_CCB, PD_CCR, PD_CLASS, PD_CY, PD_LIVE, PD_NORM, PD_PX, PD_PY, PD_RX, PD_RY, PD_SLOT,
-    PD_T, PD_VMX, PD_VMY, PD_VOTE, PY, REPORTED, RX, RY, SINCE_FILTER, STEP, T_FILTER, T_LAST, VALID, VI_COUNT, VIX, VIY, VMX,
-    VMY,
+    PD_T, PD_VMX, PD_VMY, PD_VOTE, PY, REPORTED, RX, RY, SINCE_FILTER, STEP, SWEEP_BOUNDARIES, SWEEP_DECAY, SWEEP_FORCED, SWEEP_LEFT,
+    SWEEP_RECORDS, SWEEP_T, T_FILTER, T_LAST, VALID, VI_COUNT, VIX, VIY, VMX, VMY,
 )  # fmt: skip
 from evclust.jit import njit
 
@@ -238,8 +238,8 @@ def _commit(S, H, G, row, k, precision):
         s, t = int(row[PD_SLOT]), row[PD_T]
         if k.activity_reference != 0.0:  # an addition: the event's weight
             S[s, ACT] = _q_referenced(S[s, ACT] + _weight(G, t, k), precision, k)
-        else:  # decayed from the slot's own time, plus one
-            a = _q(_decayed(S[s, ACT], t - S[s, T_LAST], k.t_half_us, precision), Q_ACT, precision) + 1.0
+        else:  # decayed from the slot's own time, plus one (a sweep beside the events may have set a later time: no decay back)
+            a = _q(_decayed(S[s, ACT], max(t - S[s, T_LAST], 0.0), k.t_half_us, precision), Q_ACT, precision) + 1.0
             S[s, ACT] = _q(a, Q_ACT, precision)
         S[s, RX] = min(max(_q(S[s, RX] + row[PD_RX], Q_HALF, precision), k.r_min), k.r_max)
         S[s, RY] = min(max(_q(S[s, RY] + row[PD_RY], Q_HALF, precision), k.r_min), k.r_max)
@@ -259,7 +259,7 @@ def _commit(S, H, G, row, k, precision):
                 for j in range(H.shape[1]):
                     H[s, j] >>= 1
         S[s, EV_COUNT] += 1.0
-        S[s, T_LAST] = t
+        S[s, T_LAST] = max(S[s, T_LAST], t)
         row[PD_LIVE] = 0.0
     if row[PD_BG] != 0.0:
         G[BG_Y] = _q(G[BG_Y] + row[PD_BG_Y], Q_BG, precision)
@@ -368,105 +368,153 @@ def _merge(S, H, G, s, j, k, precision):
 
 
 @njit(cache=True, nogil=True)
-def _filter_step(S, H, G, t, k, palette, background_mask, out, n_out, precision):
-    """Every N_f events: decay, free, interval velocity, noise and exit decisions, records."""
+def _step_open(S, G, t, k, precision):
+    """A filter step every N_f events, at t: its τ boundaries and the activities' time; the sweep
+    of its slots is then to come (all at once, or beside the events: _sweep_slot)."""
     # τ boundaries crossed since the last step: usually 0 or 1, more when events are sparse.
-    boundaries = math.floor((t - G[T_FIRST]) / k.tau_us) - math.floor((G[T_FILTER] - G[T_FIRST]) / k.tau_us)
-    interval_due = boundaries > 0
-    per_frame = k.t_frame_us / (max(boundaries, 1) * k.tau_us)  # T_frame over the time measured
-    v_min = k.v_min
+    G[SWEEP_BOUNDARIES] = math.floor((t - G[T_FIRST]) / k.tau_us) - math.floor((G[T_FILTER] - G[T_FIRST]) / k.tau_us)
+    G[SWEEP_T] = t
+    G[T_FILTER] = t
+    G[SWEEP_DECAY] = 1.0
     if k.activity_reference != 0.0:
-        _move_reference(S, G, t, k, precision)  # every activity decayed to t at once
+        if k.sweep_slots_per_event == 0.0:
+            _move_reference(S, G, t, k, precision)  # every activity decayed to t at once
+        else:  # the reference stays: the sweep reads each A as Ã times the step's one decay
+            G[SWEEP_DECAY] = math.exp2(-(t - G[BG_T]) / k.t_half_us)
     else:
         G[BG_ACT] = _q(_decayed(G[BG_ACT], t - G[BG_T], k.t_half_us, precision), Q_ACT, precision)
         G[BG_T] = t
-    for s in range(S.shape[0]):
-        if S[s, VALID] == 0.0:
-            continue
-        if k.activity_reference == 0.0:
+    G[SWEEP_LEFT] = S.shape[0]
+    G[SWEEP_RECORDS] = 0
+
+
+@njit(cache=True, nogil=True)
+def _sweep_slot(S, H, G, s, k, palette, background_mask, line, held, precision):
+    """The open step on slot s: decay, free, merge, interval velocity, noise and exit decisions,
+    and its record into `held` (the step's records until it closes). A slot the sweep frees
+    voids the updates still in flight for it."""
+    t = G[SWEEP_T]
+    boundaries = G[SWEEP_BOUNDARIES]
+    interval_due = boundaries > 0
+    per_frame = k.t_frame_us / (max(boundaries, 1) * k.tau_us)  # T_frame over the time measured
+    v_min = k.v_min
+    if S[s, VALID] == 0.0:
+        return
+    if k.activity_reference == 0.0:
+        # (beside the events a slot may have taken events since the step: it is no older than t)
+        if S[s, T_LAST] < t or k.sweep_slots_per_event == 0.0:
             S[s, ACT] = _q(_decayed(S[s, ACT], t - S[s, T_LAST], k.t_half_us, precision), Q_ACT, precision)
+            S[s, T_LAST] = t
+        act, bg_act = S[s, ACT], G[BG_ACT]
+    elif k.sweep_slots_per_event == 0.0:
         S[s, T_LAST] = t
-        if S[s, ACT] < k.a_min:
-            S[s, VALID] = 0.0
-            G[EXPIRED] += 1
-            continue
-        if k.merge != 0.0:  # absorb every later slot that is the same object, lowest first
-            j = s + 1
-            while j < S.shape[0]:
-                if S[j, VALID] != 0.0 and _mergeable(S, s, j, k):
-                    _merge(S, H, G, s, j, k, precision)
-                    j = s  # the merged box may now reach a slot passed over
-                j += 1
-        if k.gamma_mode != GAMMA_COUNT or S[s, VI_COUNT] == 0.0:
-            S[s, GAMMA] = _q(_gamma(S[s, ACT], k), Q_GAMMA, precision)
-        if interval_due:
-            if k.gamma_mode == GAMMA_COUNT and S[s, VI_COUNT] >= 1.0:
-                S[s, GAMMA] = _q(S[s, EV_COUNT] * per_frame, Q_GAMMA, precision)  # events per frame since the last boundary
-            S[s, EV_COUNT] = 0.0
-            # Eq. (4): V_RI += β_vi ((P - P_prev) · T_frame / τ - V_RI); P_prev = P.
-            mx = _q((S[s, PX] - S[s, PPX]) * per_frame, Q_VI, precision)
-            my = _q((S[s, PY] - S[s, PPY]) * per_frame, Q_VI, precision)
-            n = S[s, VI_COUNT]  # full intervals measured before this one, plus one
-            if k.warm_start == 0.0 or n >= k.interval_warmup:
-                S[s, VIX] = _q(S[s, VIX] + k.beta_vel_int * (mx - S[s, VIX]), Q_VI, precision)
-                S[s, VIY] = _q(S[s, VIY] + k.beta_vel_int * (my - S[s, VIY]), Q_VI, precision)
-            elif n == 1.0:  # the first full interval: take it as it is
-                S[s, VIX], S[s, VIY] = mx, my
-            elif n >= 2.0:  # the running mean of the first measurements, until 1/n falls to β
-                S[s, VIX] = _q(S[s, VIX] + (mx - S[s, VIX]) / n, Q_VI, precision)
-                S[s, VIY] = _q(S[s, VIY] + (my - S[s, VIY]) / n, Q_VI, precision)
-            # (VI_COUNT 0: the cluster was born inside this interval; its displacement is partial.)
-            S[s, VI_COUNT] = min(n + 1.0, max(k.interval_warmup, 2.0))
-            S[s, PPX], S[s, PPY] = S[s, PX], S[s, PY]
-        if _exiting(S, s, k):
-            S[s, VALID] = 0.0
-            G[EXITED] += 1
-            continue
-        # The noise decision weighs evidence: the uncorrected V is small until many events agree.
-        moving_mcm = math.hypot(S[s, VMX], S[s, VMY]) >= v_min
-        vmx, vmy = _mcm_velocity(S, s, k)
-        moving_int = math.hypot(S[s, VIX], S[s, VIY]) >= v_min
-        reported = S[s, ACT] >= k.a_valid and (moving_mcm or moving_int)
-        if reported and k.noise_gate > 0.0:
-            # Beyond the paper: the background's events spread over the sensor would give the
-            # box A_bg·(box area / sensor area); an object's cluster holds noise_gate times more.
-            box = (2.0 * math.floor(S[s, RX]) + 1.0) * (2.0 * math.floor(S[s, RY]) + 1.0)  # its pixels
-            reported = S[s, ACT] * k.width * k.height >= k.noise_gate * G[BG_ACT] * box
-        if S[s, ACT] >= k.a_valid and not reported:
-            G[NOISE] += 1
-        S[s, REPORTED] = 1.0 if reported else 0.0
-        if not reported:
-            continue
-        row = out[n_out]
-        row[0], row[1], row[2], row[3] = t, G[STEP], s, S[s, ID]
-        row[4], row[5], row[6], row[7], row[8] = S[s, PX], S[s, PY], S[s, RX], S[s, RY], S[s, ACT]
-        row[9], row[10], row[11], row[12] = vmx, vmy, S[s, VIX], S[s, VIY]
-        cls = -1
-        row[13], row[14], row[15] = 0.0, 0.0, 0.0  # no colour without TFS data
-        if k.has_colour != 0.0:
-            # Eq. (11): C_obj = (C - BG) / p + BG, clamped to the byte range.
-            row[13] = min(max((S[s, CY] - G[BG_Y]) / k.p_correction + G[BG_Y], 0.0), 255.0)
-            row[14] = min(max((S[s, CCB] - G[BG_CB]) / k.p_correction + G[BG_CB], 0.0), 255.0)
-            row[15] = min(max((S[s, CCR] - G[BG_CR]) / k.p_correction + G[BG_CR], 0.0), 255.0)
-            best = 0
-            for j in range(H.shape[1]):
-                if not background_mask[j] and H[s, j] > best:
-                    best, cls = H[s, j], j
-        row[16] = cls
-        flags = 0
-        if S[s, EVER_REPORTED] == 0.0:
-            flags |= FLAG_NEW
-        if _near_border(S[s, PX], S[s, PY], k):
-            flags |= FLAG_BORDER
-        if moving_mcm:
-            flags |= FLAG_MOVING_MCM
-        if moving_int:
-            flags |= FLAG_MOVING_INT
-        row[17] = flags
-        S[s, EVER_REPORTED] = 1.0
-        n_out += 1
-    G[STEP] += 1
-    G[T_FILTER] = t
+        act, bg_act = S[s, ACT], G[BG_ACT]
+    else:  # A = Ã·2^-((t - t_ref)/T_half), the background's likewise
+        act = _q(S[s, ACT] * G[SWEEP_DECAY], Q_ACT, precision)
+        bg_act = _q(G[BG_ACT] * G[SWEEP_DECAY], Q_ACT, precision)
+    if act < k.a_min:
+        S[s, VALID] = 0.0
+        _cancel(line, s)
+        G[EXPIRED] += 1
+        return
+    if k.merge != 0.0:  # absorb every later slot that is the same object, lowest first
+        j = s + 1
+        while j < S.shape[0]:
+            if S[j, VALID] != 0.0 and _mergeable(S, s, j, k):
+                _merge(S, H, G, s, j, k, precision)
+                _cancel(line, j)
+                if k.activity_reference == 0.0 or k.sweep_slots_per_event == 0.0:
+                    act = S[s, ACT]
+                else:
+                    act = _q(S[s, ACT] * G[SWEEP_DECAY], Q_ACT, precision)
+                j = s  # the merged box may now reach a slot passed over
+            j += 1
+    if k.gamma_mode != GAMMA_COUNT or S[s, VI_COUNT] == 0.0:
+        S[s, GAMMA] = _q(_gamma(act, k), Q_GAMMA, precision)
+    if interval_due:
+        if k.gamma_mode == GAMMA_COUNT and S[s, VI_COUNT] >= 1.0:
+            S[s, GAMMA] = _q(S[s, EV_COUNT] * per_frame, Q_GAMMA, precision)  # events per frame since the last boundary
+        S[s, EV_COUNT] = 0.0
+        # Eq. (4): V_RI += β_vi ((P - P_prev) · T_frame / τ - V_RI); P_prev = P.
+        mx = _q((S[s, PX] - S[s, PPX]) * per_frame, Q_VI, precision)
+        my = _q((S[s, PY] - S[s, PPY]) * per_frame, Q_VI, precision)
+        n = S[s, VI_COUNT]  # full intervals measured before this one, plus one
+        if k.warm_start == 0.0 or n >= k.interval_warmup:
+            S[s, VIX] = _q(S[s, VIX] + k.beta_vel_int * (mx - S[s, VIX]), Q_VI, precision)
+            S[s, VIY] = _q(S[s, VIY] + k.beta_vel_int * (my - S[s, VIY]), Q_VI, precision)
+        elif n == 1.0:  # the first full interval: take it as it is
+            S[s, VIX], S[s, VIY] = mx, my
+        elif n >= 2.0:  # the running mean of the first measurements, until 1/n falls to β
+            S[s, VIX] = _q(S[s, VIX] + (mx - S[s, VIX]) / n, Q_VI, precision)
+            S[s, VIY] = _q(S[s, VIY] + (my - S[s, VIY]) / n, Q_VI, precision)
+        # (VI_COUNT 0: the cluster was born inside this interval; its displacement is partial.)
+        S[s, VI_COUNT] = min(n + 1.0, max(k.interval_warmup, 2.0))
+        S[s, PPX], S[s, PPY] = S[s, PX], S[s, PY]
+    if _exiting(S, s, k):
+        S[s, VALID] = 0.0
+        _cancel(line, s)
+        G[EXITED] += 1
+        return
+    # The noise decision weighs evidence: the uncorrected V is small until many events agree.
+    moving_mcm = math.hypot(S[s, VMX], S[s, VMY]) >= v_min
+    vmx, vmy = _mcm_velocity(S, s, k)
+    moving_int = math.hypot(S[s, VIX], S[s, VIY]) >= v_min
+    reported = act >= k.a_valid and (moving_mcm or moving_int)
+    if reported and k.noise_gate > 0.0:
+        # Beyond the paper: the background's events spread over the sensor would give the
+        # box A_bg·(box area / sensor area); an object's cluster holds noise_gate times more.
+        box = (2.0 * math.floor(S[s, RX]) + 1.0) * (2.0 * math.floor(S[s, RY]) + 1.0)  # its pixels
+        reported = act * k.width * k.height >= k.noise_gate * bg_act * box
+    if act >= k.a_valid and not reported:
+        G[NOISE] += 1
+    S[s, REPORTED] = 1.0 if reported else 0.0
+    if not reported:
+        return
+    row = held[int(G[SWEEP_RECORDS])]
+    row[0], row[1], row[2], row[3] = t, G[STEP], s, S[s, ID]
+    row[4], row[5], row[6], row[7], row[8] = S[s, PX], S[s, PY], S[s, RX], S[s, RY], act
+    row[9], row[10], row[11], row[12] = vmx, vmy, S[s, VIX], S[s, VIY]
+    cls = -1
+    row[13], row[14], row[15] = 0.0, 0.0, 0.0  # no colour without TFS data
+    if k.has_colour != 0.0:
+        # Eq. (11): C_obj = (C - BG) / p + BG, clamped to the byte range.
+        row[13] = min(max((S[s, CY] - G[BG_Y]) / k.p_correction + G[BG_Y], 0.0), 255.0)
+        row[14] = min(max((S[s, CCB] - G[BG_CB]) / k.p_correction + G[BG_CB], 0.0), 255.0)
+        row[15] = min(max((S[s, CCR] - G[BG_CR]) / k.p_correction + G[BG_CR], 0.0), 255.0)
+        best = 0
+        for j in range(H.shape[1]):
+            if not background_mask[j] and H[s, j] > best:
+                best, cls = H[s, j], j
+    row[16] = cls
+    flags = 0
+    if S[s, EVER_REPORTED] == 0.0:
+        flags |= FLAG_NEW
+    if _near_border(S[s, PX], S[s, PY], k):
+        flags |= FLAG_BORDER
+    if moving_mcm:
+        flags |= FLAG_MOVING_MCM
+    if moving_int:
+        flags |= FLAG_MOVING_INT
+    row[17] = flags
+    S[s, EVER_REPORTED] = 1.0
+    G[SWEEP_RECORDS] += 1
+
+
+@njit(cache=True, nogil=True)
+def _sweep(S, H, G, slots, k, palette, background_mask, line, held, out, n_out, steps, first_step, precision):
+    """The open step's next `slots` slots, in slot order; when the last is swept the step closes:
+    its records go to `out` and its time to `steps`. Returns the records in `out`."""
+    n = S.shape[0]
+    while G[SWEEP_LEFT] > 0 and slots > 0:
+        _sweep_slot(S, H, G, int(n - G[SWEEP_LEFT]), k, palette, background_mask, line, held, precision)
+        G[SWEEP_LEFT] -= 1
+        slots -= 1
+        if G[SWEEP_LEFT] == 0:  # the step closes
+            for r in range(int(G[SWEEP_RECORDS])):
+                out[n_out] = held[r]
+                n_out += 1
+            steps[int(G[STEP] - first_step)] = G[SWEEP_T]
+            G[STEP] += 1
     return n_out
 
 
@@ -482,19 +530,25 @@ def _supported(support, cx, cy, t, window):
 
 
 @njit(cache=True, nogil=True)
-def run_events(S, H, G, k, palette, background_mask, support, line, t_us, xs, ys, lums, cbs, crs, out, steps, precision=None):
+def run_events(S, H, G, k, palette, background_mask, support, line, held, t_us, xs, ys, lums, cbs, crs, out, steps, precision=None):
     """Feed events through the table; write track records into `out`; return how many. Each
-    filter step's time goes into `steps`, in order (the object layer's clock; G[STEP] counts
-    them). With a `precision` table (PRECISION_SIGNALS x 4) each quantisation point rounds to
+    filter step's time goes into `steps` as it closes, in order (the object layer's clock; G[STEP]
+    counts them). With a `precision` table (PRECISION_SIGNALS x 4) each quantisation point rounds to
     its format. `support` is the creation-support map (layout.support_shape), each cell the time
     of its latest event (-inf: none). `line` is the update delay line (D + 1 rows of
     layout.PENDING_COLUMNS): event n reads the table with the updates of events up to n - D - 1
-    committed (creations at once), and every filter step first commits all."""
+    committed (creations at once). `held` (N x RECORD_COLUMNS) holds the open step's records
+    until it closes. With sweep_slots_per_event = 0 every filter step first commits all and
+    sweeps every slot before the next event; with R >= 1 the sweep runs beside the events, R
+    slots before each event, each after that event's turn to commit; a step (or a move of the
+    reference) that comes while a sweep is still open first finishes it at once (G[SWEEP_FORCED])."""
     bits = int(k.support_cell_bits)
     delay = line.shape[0] - 1
     n_out = 0
     first_step = G[STEP]
     every = int(k.filter_every)
+    beside = int(k.sweep_slots_per_event)
+    n = S.shape[0]
     for i in range(t_us.size):
         t = float(t_us[i])
         x, y = float(xs[i]), float(ys[i])
@@ -506,12 +560,17 @@ def run_events(S, H, G, k, palette, background_mask, support, line, t_us, xs, ys
                 G[BG_T] = t
         if k.activity_reference != 0.0 and t - G[BG_T] > k.reference_halvings * k.t_half_us:
             # Ã would outgrow its headroom: commit what is in flight and move the reference to t.
+            if G[SWEEP_LEFT] > 0:
+                G[SWEEP_FORCED] += 1
+                n_out = _sweep(S, H, G, n, k, palette, background_mask, line, held, out, n_out, steps, first_step, precision)
             _drain(S, H, G, line, k, precision)
             _move_reference(S, G, t, k, precision)
         G[EVENTS] += 1
         row = line[int(G[EVENTS]) % (delay + 1)]  # it holds event n - D - 1: its turn to commit
         if delay > 0:
             _commit(S, H, G, row, k, precision)
+        if G[SWEEP_LEFT] > 0:  # the open step's sweep, beside the events
+            n_out = _sweep(S, H, G, beside, k, palette, background_mask, line, held, out, n_out, steps, first_step, precision)
         s = _seek(S, x, y, k)
         updated_reported = False
         cx, cy = (int(xs[i]) >> bits) + 1, (int(ys[i]) >> bits) + 1
@@ -547,7 +606,12 @@ def run_events(S, H, G, k, palette, background_mask, support, line, t_us, xs, ys
         G[SINCE_FILTER] += 1
         if G[SINCE_FILTER] >= every:
             G[SINCE_FILTER] = 0
-            steps[int(G[STEP] - first_step)] = t
-            _drain(S, H, G, line, k, precision)
-            n_out = _filter_step(S, H, G, t, k, palette, background_mask, out, n_out, precision)
+            if G[SWEEP_LEFT] > 0:  # the last step's sweep is not done: it finishes first
+                G[SWEEP_FORCED] += 1
+                n_out = _sweep(S, H, G, n, k, palette, background_mask, line, held, out, n_out, steps, first_step, precision)
+            if beside == 0:
+                _drain(S, H, G, line, k, precision)
+            _step_open(S, G, t, k, precision)
+            if beside == 0:
+                n_out = _sweep(S, H, G, n, k, palette, background_mask, line, held, out, n_out, steps, first_step, precision)
     return n_out

@@ -64,6 +64,13 @@ class ClustererParams(BaseModel):
     # in its recurrence. The step decays every slot by the same 2^-((t - t_ref)/T_half). False: the
     # paper's decay-then-add at every event.
     activity_reference: bool = False
+    # Beyond the paper: the filter step's sweep beside the events (docs/DESIGN.md, "The sweep
+    # beside the events"). 0: the step is one sweep of every slot between two events, with
+    # everything in flight committed first (the paper's; a core stalls the stream for it). R >= 1:
+    # the sweep runs on while events flow, R slots before each event after the step's; each event
+    # and each swept slot see the table as it then is. With activity_reference the reference then
+    # moves only when Ã runs out of headroom, and the step scales the activity by its decay.
+    sweep_slots_per_event: Annotated[int, Field(ge=0, le=1024)] = 0
     # The defaults hold across the generalization suite: they were tuned on its tuning split
     # (evclust tune --suite tuning, docs/TUNING.md), never on its test split.
     seek_margin: NonNegative = 2.7  # S, px: a cluster catches events within its box grown by S (+ seek_scale·max R)

@@ -36,18 +36,20 @@ class FloatClusterer:
         self.globals[[BG_Y, BG_CB, BG_CR]] = bg
         self.support = np.full(support_shape(width, height, params.support_cell_bits), -np.inf)
         self.delay_line = np.zeros((params.update_delay + 1, len(PENDING_COLUMNS)))  # the events in flight
+        self.held = np.zeros((params.n_clusters, RECORD_COLUMNS))  # the open filter step's records
         self.steps = np.zeros(0)  # the times of the filter steps the last feed completed
 
     def feed(self, events: np.ndarray) -> np.ndarray:
         """Process events; return the (n, RECORD_COLUMNS) float64 records of the filter steps they
         completed (their times, records or not, in `self.steps`)."""
         every = self.params.filter_every
-        out = np.empty(((events.size // every + 1) * self.params.n_clusters, RECORD_COLUMNS))
-        steps = np.empty(events.size // every + 1)
+        # (+ 2: a step opened in the last feed may close in this one)
+        out = np.empty(((events.size // every + 2) * self.params.n_clusters, RECORD_COLUMNS))
+        steps = np.empty(events.size // every + 2)
         first = self.globals[STEP]
         n = float_model.run_events(
             self.slots, self.hist, self.globals, self.k, self.palette, self.background_mask, self.support, self.delay_line,
-            *loop_columns(events), out, steps, self.precision,
+            self.held, *loop_columns(events), out, steps, self.precision,
         )  # fmt: skip
         self.steps = steps[: int(self.globals[STEP] - first)]
         return out[:n]

@@ -32,6 +32,8 @@ FIELDS = (
     "mcm_correct", "vote_contrast", "mixing", "merge", "create_support", "support_cell_bits", "interval_warmup",
     # The activity against a reference time: the switch, Ã's halvings of headroom and its raw top.
     "activity_reference", "reference_halvings", "activity_reference_max",
+    # The filter step's sweep beside the events: slots swept before each event (0: all at once).
+    "sweep_slots_per_event",
 )  # fmt: skip
 DTYPE = np.dtype([(name, np.int64) for name in FIELDS])
 
@@ -91,5 +93,6 @@ def constant_vector(table, params, has_colour: bool) -> np.record:
         "activity_reference": params.activity_reference,
         "reference_halvings": REFERENCE_HALVINGS,
         "activity_reference_max": ((f["activity"].raw_max + 1) << REFERENCE_HALVINGS) - 1,
+        "sweep_slots_per_event": params.sweep_slots_per_event,
     }
     return named_record(DTYPE, values)

@@ -15,8 +15,8 @@ from evclust.clusterer.layout import (
     MERGED, UNSUPPORTED,
     DECAY_RESIDUAL, EXITED, EXPIRED, GLOBAL_COLUMNS, T_FIRST, FLAG_BORDER, FLAG_MOVING_INT, FLAG_MOVING_MCM, FLAG_NEW, GAMMA, ID, MCM_NORM,
     NEXT_ID, NOISE, PD_BG, PD_BG_CB, PD_BG_CR, PD_BG_Y, PD_CCB, PD_CCR, PD_CLASS, PD_CY, PD_LIVE, PD_NORM, PD_PX, PD_PY, PD_RX,
-    PD_RY, PD_SLOT, PD_T, PD_VMX, PD_VMY, PD_VOTE, PPX, PPY, PX, PY, REPORTED, RX, RY, SINCE_FILTER, STEP, T_FILTER,
-    T_LAST, VALID, VI_COUNT, VIX, VIY, VMX, VMY,
+    PD_RY, PD_SLOT, PD_T, PD_VMX, PD_VMY, PD_VOTE, PPX, PPY, PX, PY, REPORTED, RX, RY, SINCE_FILTER, STEP, SWEEP_BOUNDARIES,
+    SWEEP_DECAY, SWEEP_FORCED, SWEEP_LEFT, SWEEP_RECORDS, SWEEP_T, T_FILTER, T_LAST, VALID, VI_COUNT, VIX, VIY, VMX, VMY,
 )  # fmt: skip
 from evclust.fixed.arith import FLOOR, NEAREST, alpha_increment_nb, alpha_step_nb, decay_apply_nb, decay_nb, decay_steps_nb
 from evclust.fixed.formats import DECAY_FRAC_BITS, DECAY_TABLE_BITS
@@ -78,6 +78,13 @@ def _align(raw, from_frac, to_frac):
     if to_frac >= from_frac:
         return raw << (to_frac - from_frac)
     return raw >> (from_frac - to_frac)
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _later(a, b):
+    """a is later than b on the wrapping 32-bit clock (within half its period)."""
+    d = (a - b) & TIME_MASK
+    return d != 0 and d < (np.int64(1) << 31)
 
 
 @njit(cache=True, nogil=True)
@@ -309,7 +316,8 @@ def _commit(S, H, G, row, k, table, log, ranges):
             S[s, ACT] = _store(S[s, ACT] + _weight(G, t, k, table), 0, k.activity_reference_max, S_ACT, log, ranges)
             S[s, T_LAST] = t
         else:  # decayed from the slot's own time, plus one
-            _decay_slot(S, s, t, k, table)
+            if not _later(S[s, T_LAST], t):  # (a sweep beside the events may have set a later time: no decay back)
+                _decay_slot(S, s, t, k, table)
             S[s, ACT] = _store(S[s, ACT] + (np.int64(1) << k.activity_frac), 0, k.activity_max, S_ACT, log, ranges)
         S[s, RX] = _seen(min(max(S[s, RX] + row[PD_RX], k.r_min), k.r_max), S_HALF, ranges)
         S[s, RY] = _seen(min(max(S[s, RY] + row[PD_RY], k.r_min), k.r_max), S_HALF, ranges)
@@ -466,123 +474,175 @@ def _box_pixels(S, s, k):
 
 
 @njit(cache=True, nogil=True)
-def _filter_step(S, H, G, t, k, table, gains, palette, inv_ww, background_mask, out, n_out, log, ranges):
+def _step_open(S, G, t_whole, k, table, log, ranges):
+    """A filter step at the event time t_whole (the datapath's clock is its low 32 bits): its τ
+    boundaries and the activities' time; the sweep of its slots is to come (_sweep_slot)."""
+    t = t_whole & TIME_MASK
     # τ boundaries since the last step, from a phase counter (no division of the wrapping time).
     phase = G[TAU_PHASE] + ((t - G[T_FILTER]) & TIME_MASK)
     boundaries = phase // k.tau_us
     G[TAU_PHASE] = phase - boundaries * k.tau_us
-    per_frame = k.frame_per_tau // max(boundaries, 1)  # T_frame/(n·τ), Q?.F_fpt
-    fp, fv, fw, fi, fc = k.centre_frac, k.v_mcm_frac, k.mcm_norm_frac, k.v_int_frac, k.colour_frac
+    G[SWEEP_BOUNDARIES] = boundaries
+    G[SWEEP_T] = t_whole
+    G[T_FILTER] = t
+    G[SWEEP_DECAY] = 0
     if k.activity_reference != 0:
-        _move_reference(S, G, t, k, table, log, ranges)  # every activity decayed to t at once
+        if k.sweep_slots_per_event == 0:
+            _move_reference(S, G, t, k, table, log, ranges)  # every activity decayed to t at once
+        else:  # the reference stays: the step's decay steps from it, its residual included, for the sweep to apply
+            G[SWEEP_DECAY], _ = decay_steps_nb((t - G[BG_T]) & TIME_MASK, G[BG_RESIDUAL], k.inv_t_half, k.inv_t_half_frac,
+                                               DECAY_TABLE_BITS)  # fmt: skip
     else:
         _decay_background(G, t, k, table)
+    G[SWEEP_LEFT] = S.shape[0]
+    G[SWEEP_RECORDS] = 0
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _step_activity(a, G, k, table, log, ranges):
+    """The activity the sweep decides on: as stored, or beside the events against a reference
+    time Ã decayed by the step's steps (a product, not stored), saturated as a move would."""
+    if k.activity_reference == 0 or k.sweep_slots_per_event == 0:
+        return a
+    return _store(decay_apply_nb(a, G[SWEEP_DECAY], table, DECAY_TABLE_BITS, DECAY_FRAC_BITS, FLOOR), 0, k.activity_max, S_ACT, log, ranges)
+
+
+@njit(cache=True, nogil=True)
+def _sweep_slot(S, H, G, s, k, table, gains, background_mask, line, held, log, ranges):
+    """The open step on slot s (the float model's _sweep_slot), its record into `held`. A slot
+    the sweep frees voids the updates still in flight for it."""
+    if S[s, VALID] == 0:
+        return
+    t = G[SWEEP_T] & TIME_MASK
+    boundaries = G[SWEEP_BOUNDARIES]
+    per_frame = k.frame_per_tau // max(boundaries, 1)  # T_frame/(n·τ), Q?.F_fpt
+    fp, fv, fw, fi, fc = k.centre_frac, k.v_mcm_frac, k.mcm_norm_frac, k.v_int_frac, k.colour_frac
     sensor = k.width * k.height
-    for s in range(S.shape[0]):
-        if S[s, VALID] == 0:
-            continue
-        if k.activity_reference != 0:
-            S[s, T_LAST] = t
-        else:
-            _decay_slot(S, s, t, k, table)
-        if S[s, ACT] < k.a_min:
+    if k.activity_reference != 0:
+        S[s, T_LAST] = t
+    elif k.sweep_slots_per_event == 0 or not _later(S[s, T_LAST], t):  # (beside the events: no older than t)
+        _decay_slot(S, s, t, k, table)
+    act = _step_activity(S[s, ACT], G, k, table, log, ranges)
+    if act < k.a_min:
+        S[s, VALID] = 0
+        _cancel(line, s)
+        G[EXPIRED] += 1
+        return
+    if k.merge != 0:  # absorb every later slot that is the same object, lowest first
+        j = s + 1
+        while j < S.shape[0]:
+            if S[j, VALID] != 0 and _mergeable(S, s, j, k):
+                _merge(S, H, G, s, j, k, log, ranges)
+                _cancel(line, j)
+                act = _step_activity(S[s, ACT], G, k, table, log, ranges)
+                j = s
+            j += 1
+    if k.gamma_mode != 2 or S[s, VI_COUNT] == 0:
+        S[s, GAMMA] = _store(_gamma_from_activity(act, k), 0, k.gamma_max, S_GAMMA, log, ranges)
+    if boundaries > 0:
+        if k.gamma_mode == 2 and S[s, VI_COUNT] >= 1:
+            g = (S[s, EV_COUNT] * per_frame) >> (k.frame_per_tau_frac - k.gamma_frac)
+            S[s, GAMMA] = _store(g, 0, k.gamma_max, S_GAMMA, log, ranges)
+        S[s, EV_COUNT] = 0
+        mx = _store(
+            _align((S[s, PX] - S[s, PPX]) * per_frame, fp + k.frame_per_tau_frac, fi), k.v_int_min, k.v_int_max, S_VI, log, ranges
+        )
+        my = _store(
+            _align((S[s, PY] - S[s, PPY]) * per_frame, fp + k.frame_per_tau_frac, fi), k.v_int_min, k.v_int_max, S_VI, log, ranges
+        )
+        n = S[s, VI_COUNT]
+        if k.warm_start == 0 or n >= k.interval_warmup:
+            S[s, VIX] = alpha_step_nb(S[s, VIX], mx, k.beta_vel_int, k.beta_vel_int_frac, 0, FLOOR)
+            S[s, VIY] = alpha_step_nb(S[s, VIY], my, k.beta_vel_int, k.beta_vel_int_frac, 0, FLOOR)
+        elif n == 1:
+            S[s, VIX], S[s, VIY] = mx, my
+        elif n >= 2:  # the warm-up's running mean: gain 1/n from the table
+            S[s, VIX] = alpha_step_nb(S[s, VIX], mx, gains[n], k.beta_vel_int_frac, 0, FLOOR)
+            S[s, VIY] = alpha_step_nb(S[s, VIY], my, gains[n], k.beta_vel_int_frac, 0, FLOOR)
+        S[s, VI_COUNT] = min(n + 1, max(k.interval_warmup, 2))
+        S[s, PPX], S[s, PPY] = S[s, PX], S[s, PY]
+    # The reported MCM velocity: V / w, the sweep's one division.
+    vmx, vmy = S[s, VMX], S[s, VMY]
+    w_cut = S[s, MCM_NORM] >> (fw - k.mcm_weight_frac)  # w in mcm_weight's format: V·2^F fits an int64
+    if k.mcm_correct != 0 and w_cut > 0:
+        # Saturated: early on (w small) V/w can leave V's format, which the record must hold.
+        vmx = _store((S[s, VMX] << k.mcm_weight_frac) // w_cut, k.v_mcm_min, k.v_mcm_max, S_VM, log, ranges)
+        vmy = _store((S[s, VMY] << k.mcm_weight_frac) // w_cut, k.v_mcm_min, k.v_mcm_max, S_VM, log, ranges)
+    # Exit prediction on the squared speed (no square root).
+    # No saturation: each component is clamped below 2^V_FULL_BITS, so the sum fits speed_sq.
+    speed_sq = _seen(_speed_sq(vmx, vmy, fv, k), S_SPEED, ranges)
+    left, right, top, bottom = _near(S[s, PX], S[s, PY], k)
+    if speed_sq >= k.v_exit_sq and speed_sq > 0:
+        limit = (speed_sq * k.cos_sq_exit) >> k.cos_sq_exit_frac
+        if (left and vmx < 0 and _speed_sq(vmx, 0, fv, k) >= limit) or (right and vmx > 0 and _speed_sq(vmx, 0, fv, k) >= limit) \
+                or (top and vmy < 0 and _speed_sq(0, vmy, fv, k) >= limit) or (bottom and vmy > 0 and _speed_sq(0, vmy, fv, k) >= limit):  # fmt: skip
             S[s, VALID] = 0
-            G[EXPIRED] += 1
-            continue
-        if k.merge != 0:  # absorb every later slot that is the same object, lowest first
-            j = s + 1
-            while j < S.shape[0]:
-                if S[j, VALID] != 0 and _mergeable(S, s, j, k):
-                    _merge(S, H, G, s, j, k, log, ranges)
-                    j = s
-                j += 1
-        if k.gamma_mode != 2 or S[s, VI_COUNT] == 0:
-            S[s, GAMMA] = _store(_gamma_from_activity(S[s, ACT], k), 0, k.gamma_max, S_GAMMA, log, ranges)
-        if boundaries > 0:
-            if k.gamma_mode == 2 and S[s, VI_COUNT] >= 1:
-                g = (S[s, EV_COUNT] * per_frame) >> (k.frame_per_tau_frac - k.gamma_frac)
-                S[s, GAMMA] = _store(g, 0, k.gamma_max, S_GAMMA, log, ranges)
-            S[s, EV_COUNT] = 0
-            mx = _store(
-                _align((S[s, PX] - S[s, PPX]) * per_frame, fp + k.frame_per_tau_frac, fi), k.v_int_min, k.v_int_max, S_VI, log, ranges
-            )
-            my = _store(
-                _align((S[s, PY] - S[s, PPY]) * per_frame, fp + k.frame_per_tau_frac, fi), k.v_int_min, k.v_int_max, S_VI, log, ranges
-            )
-            n = S[s, VI_COUNT]
-            if k.warm_start == 0 or n >= k.interval_warmup:
-                S[s, VIX] = alpha_step_nb(S[s, VIX], mx, k.beta_vel_int, k.beta_vel_int_frac, 0, FLOOR)
-                S[s, VIY] = alpha_step_nb(S[s, VIY], my, k.beta_vel_int, k.beta_vel_int_frac, 0, FLOOR)
-            elif n == 1:
-                S[s, VIX], S[s, VIY] = mx, my
-            elif n >= 2:  # the warm-up's running mean: gain 1/n from the table
-                S[s, VIX] = alpha_step_nb(S[s, VIX], mx, gains[n], k.beta_vel_int_frac, 0, FLOOR)
-                S[s, VIY] = alpha_step_nb(S[s, VIY], my, gains[n], k.beta_vel_int_frac, 0, FLOOR)
-            S[s, VI_COUNT] = min(n + 1, max(k.interval_warmup, 2))
-            S[s, PPX], S[s, PPY] = S[s, PX], S[s, PY]
-        # The reported MCM velocity: V / w, the sweep's one division.
-        vmx, vmy = S[s, VMX], S[s, VMY]
-        w_cut = S[s, MCM_NORM] >> (fw - k.mcm_weight_frac)  # w in mcm_weight's format: V·2^F fits an int64
-        if k.mcm_correct != 0 and w_cut > 0:
-            # Saturated: early on (w small) V/w can leave V's format, which the record must hold.
-            vmx = _store((S[s, VMX] << k.mcm_weight_frac) // w_cut, k.v_mcm_min, k.v_mcm_max, S_VM, log, ranges)
-            vmy = _store((S[s, VMY] << k.mcm_weight_frac) // w_cut, k.v_mcm_min, k.v_mcm_max, S_VM, log, ranges)
-        # Exit prediction on the squared speed (no square root).
-        # No saturation: each component is clamped below 2^V_FULL_BITS, so the sum fits speed_sq.
-        speed_sq = _seen(_speed_sq(vmx, vmy, fv, k), S_SPEED, ranges)
-        left, right, top, bottom = _near(S[s, PX], S[s, PY], k)
-        if speed_sq >= k.v_exit_sq and speed_sq > 0:
-            limit = (speed_sq * k.cos_sq_exit) >> k.cos_sq_exit_frac
-            if (left and vmx < 0 and _speed_sq(vmx, 0, fv, k) >= limit) or (right and vmx > 0 and _speed_sq(vmx, 0, fv, k) >= limit) \
-                    or (top and vmy < 0 and _speed_sq(0, vmy, fv, k) >= limit) or (bottom and vmy > 0 and _speed_sq(0, vmy, fv, k) >= limit):  # fmt: skip
-                S[s, VALID] = 0
-                G[EXITED] += 1
-                continue
-        moving_mcm = _speed_sq(S[s, VMX], S[s, VMY], fv, k) >= k.v_min_sq
-        moving_int = _speed_sq(S[s, VIX], S[s, VIY], fi, k) >= k.v_min_sq
-        reported = S[s, ACT] >= k.a_valid and (moving_mcm or moving_int)
-        if reported and k.noise_gate != 0:  # A·W·H >= γ_n·A_bg·box, γ_n in Q.4
-            reported = (S[s, ACT] * sensor) << k.noise_gate_frac >= k.noise_gate * G[BG_ACT] * _box_pixels(S, s, k)
-        if S[s, ACT] >= k.a_valid and not reported:
-            G[NOISE] += 1
-        S[s, REPORTED] = 1 if reported else 0
-        if not reported:
-            continue
-        row = out[n_out]
-        row[0], row[1], row[2], row[3] = t, G[STEP], s, S[s, ID]
-        row[4], row[5] = S[s, PX] / 2.0**fp, S[s, PY] / 2.0**fp
-        row[6], row[7] = S[s, RX] / 2.0**k.half_size_frac, S[s, RY] / 2.0**k.half_size_frac
-        row[8] = S[s, ACT] / 2.0**k.activity_frac
-        row[9], row[10] = vmx / 2.0**fv, vmy / 2.0**fv
-        row[11], row[12] = S[s, VIX] / 2.0**fi, S[s, VIY] / 2.0**fi
-        cls = -1
-        row[13], row[14], row[15] = 0.0, 0.0, 0.0
-        if k.has_colour != 0:
-            # Eq. (11): C_obj = BG + (C - BG)·(1/p), clamped to the byte range.
-            row[13] = _corrected(S[s, CY], G[BG_Y], k) / 2.0**fc
-            row[14] = _corrected(S[s, CCB], G[BG_CB], k) / 2.0**fc
-            row[15] = _corrected(S[s, CCR], G[BG_CR], k) / 2.0**fc
-            best = 0
-            for j in range(H.shape[1]):
-                if not background_mask[j] and H[s, j] > best:
-                    best, cls = H[s, j], j
-        row[16] = cls
-        flags = 0
-        if S[s, EVER_REPORTED] == 0:
-            flags |= FLAG_NEW
-        if left or right or top or bottom:
-            flags |= FLAG_BORDER
-        if moving_mcm:
-            flags |= FLAG_MOVING_MCM
-        if moving_int:
-            flags |= FLAG_MOVING_INT
-        row[17] = flags
-        S[s, EVER_REPORTED] = 1
-        n_out += 1
-    if k.mixing != 0 and k.background_fixed == 0:
-        refresh_mixing(G, palette, inv_ww, k)
-    G[STEP] += 1
-    G[T_FILTER] = t
+            _cancel(line, s)
+            G[EXITED] += 1
+            return
+    moving_mcm = _speed_sq(S[s, VMX], S[s, VMY], fv, k) >= k.v_min_sq
+    moving_int = _speed_sq(S[s, VIX], S[s, VIY], fi, k) >= k.v_min_sq
+    reported = act >= k.a_valid and (moving_mcm or moving_int)
+    if reported and k.noise_gate != 0:  # A·W·H >= γ_n·A_bg·box, γ_n in Q.4
+        # (against a reference time Ã and the background's Ã have one reference: beside the
+        # events the step's decay cancels, so they compare as stored)
+        gate = S[s, ACT] if k.activity_reference != 0 else act
+        reported = (gate * sensor) << k.noise_gate_frac >= k.noise_gate * G[BG_ACT] * _box_pixels(S, s, k)
+    if act >= k.a_valid and not reported:
+        G[NOISE] += 1
+    S[s, REPORTED] = 1 if reported else 0
+    if not reported:
+        return
+    row = held[G[SWEEP_RECORDS]]
+    row[0], row[1], row[2], row[3] = G[SWEEP_T], G[STEP], s, S[s, ID]  # a record keeps the event's whole time
+    row[4], row[5] = S[s, PX] / 2.0**fp, S[s, PY] / 2.0**fp
+    row[6], row[7] = S[s, RX] / 2.0**k.half_size_frac, S[s, RY] / 2.0**k.half_size_frac
+    row[8] = act / 2.0**k.activity_frac
+    row[9], row[10] = vmx / 2.0**fv, vmy / 2.0**fv
+    row[11], row[12] = S[s, VIX] / 2.0**fi, S[s, VIY] / 2.0**fi
+    cls = -1
+    row[13], row[14], row[15] = 0.0, 0.0, 0.0
+    if k.has_colour != 0:
+        # Eq. (11): C_obj = BG + (C - BG)·(1/p), clamped to the byte range.
+        row[13] = _corrected(S[s, CY], G[BG_Y], k) / 2.0**fc
+        row[14] = _corrected(S[s, CCB], G[BG_CB], k) / 2.0**fc
+        row[15] = _corrected(S[s, CCR], G[BG_CR], k) / 2.0**fc
+        best = 0
+        for j in range(H.shape[1]):
+            if not background_mask[j] and H[s, j] > best:
+                best, cls = H[s, j], j
+    row[16] = cls
+    flags = 0
+    if S[s, EVER_REPORTED] == 0:
+        flags |= FLAG_NEW
+    if left or right or top or bottom:
+        flags |= FLAG_BORDER
+    if moving_mcm:
+        flags |= FLAG_MOVING_MCM
+    if moving_int:
+        flags |= FLAG_MOVING_INT
+    row[17] = flags
+    S[s, EVER_REPORTED] = 1
+    G[SWEEP_RECORDS] += 1
+
+
+@njit(cache=True, nogil=True)
+def _sweep(S, H, G, slots, k, table, gains, palette, inv_ww, background_mask, line, held, out, n_out, steps, first_step, log, ranges):
+    """The open step's next `slots` slots, in slot order; when the last is swept the step closes:
+    the mixing rule follows the background, the records go to `out` and the time to `steps`."""
+    n = S.shape[0]
+    while G[SWEEP_LEFT] > 0 and slots > 0:
+        _sweep_slot(S, H, G, n - G[SWEEP_LEFT], k, table, gains, background_mask, line, held, log, ranges)
+        G[SWEEP_LEFT] -= 1
+        slots -= 1
+        if G[SWEEP_LEFT] == 0:  # the step closes
+            if k.mixing != 0 and k.background_fixed == 0:
+                refresh_mixing(G, palette, inv_ww, k)
+            for r in range(G[SWEEP_RECORDS]):
+                out[n_out] = held[r]
+                n_out += 1
+            steps[G[STEP] - first_step] = G[SWEEP_T]
+            G[STEP] += 1
     return n_out
 
 
@@ -604,19 +664,22 @@ def _supported(support, seen, cx, cy, t, window):
 
 
 @njit(cache=True, nogil=True)
-def run_events(S, H, G, k, table, gains, palette, inv_ww, background_mask, support, seen, line, t_us, xs, ys, lums, cbs, crs, out, steps,
-               log, ranges, trace):  # fmt: skip
+def run_events(S, H, G, k, table, gains, palette, inv_ww, background_mask, support, seen, line, held, t_us, xs, ys, lums, cbs, crs, out,
+               steps, log, ranges, trace):  # fmt: skip
     """Feed events; write records into `out` and each filter step's time (the 32-bit
     datapath's clock wraps, the step keeps the whole event time) into `steps`; with a `trace`
     (int64, one per event; None or empty for none), write each event's action << 16 | slot there;
     `ranges` as `_store` takes it. `support` holds each map cell's latest event time (32-bit),
     `seen` whether it has one; `line` is the update delay line
-    (D + 1 rows of layout.PENDING_COLUMNS), as in the float model."""
+    (D + 1 rows of layout.PENDING_COLUMNS), `held` the open step's records, and the sweep beside
+    the events (sweep_slots_per_event) runs as in the float model."""
     n_out = 0
     delay = line.shape[0] - 1
     first_step = G[STEP]
     fb = k.background_frac
     bits = k.support_cell_bits
+    beside = k.sweep_slots_per_event
+    n = S.shape[0]
     for i in range(t_us.size):
         t = np.int64(t_us[i]) & TIME_MASK  # the 32-bit timestamp counter
         ex, ey = np.int64(xs[i]), np.int64(ys[i])
@@ -629,12 +692,19 @@ def run_events(S, H, G, k, table, gains, palette, inv_ww, background_mask, suppo
                 G[BG_T], G[BG_RESIDUAL] = t, 0
         if k.activity_reference != 0 and _reference_passed(G, t, k):
             # Ã would outgrow its headroom: commit what is in flight and move the reference to t.
+            if G[SWEEP_LEFT] > 0:  # an open sweep finishes first
+                G[SWEEP_FORCED] += 1
+                n_out = _sweep(S, H, G, n, k, table, gains, palette, inv_ww, background_mask, line, held, out, n_out, steps, first_step,
+                               log, ranges)  # fmt: skip
             _drain(S, H, G, line, k, table, log, ranges)
             _move_reference(S, G, t, k, table, log, ranges)
         G[EVENTS] += 1
         row = line[G[EVENTS] % (delay + 1)]  # it holds event n - D - 1: its turn to commit
         if delay > 0:
             _commit(S, H, G, row, k, table, log, ranges)
+        if G[SWEEP_LEFT] > 0:  # the open step's sweep, beside the events
+            n_out = _sweep(S, H, G, beside, k, table, gains, palette, inv_ww, background_mask, line, held, out, n_out, steps, first_step,
+                           log, ranges)  # fmt: skip
         s = _seek(S, ex << k.centre_frac, ey << k.centre_frac, k)
         updated_reported = False
         action = TRACE_UPDATE
@@ -676,10 +746,14 @@ def run_events(S, H, G, k, table, gains, palette, inv_ww, background_mask, suppo
         G[SINCE_FILTER] += 1
         if G[SINCE_FILTER] >= k.filter_every:
             G[SINCE_FILTER] = 0
-            steps[G[STEP] - first_step] = t_us[i]
-            first = n_out
-            _drain(S, H, G, line, k, table, log, ranges)
-            n_out = _filter_step(S, H, G, t, k, table, gains, palette, inv_ww, background_mask, out, n_out, log, ranges)
-            for r in range(first, n_out):  # the datapath counts 32 bits; a record keeps the event's whole time
-                out[r, 0] = t_us[i]
+            if G[SWEEP_LEFT] > 0:  # the last step's sweep is not done: it finishes first
+                G[SWEEP_FORCED] += 1
+                n_out = _sweep(S, H, G, n, k, table, gains, palette, inv_ww, background_mask, line, held, out, n_out, steps, first_step,
+                               log, ranges)  # fmt: skip
+            if beside == 0:
+                _drain(S, H, G, line, k, table, log, ranges)
+            _step_open(S, G, np.int64(t_us[i]), k, table, log, ranges)
+            if beside == 0:
+                n_out = _sweep(S, H, G, n, k, table, gains, palette, inv_ww, background_mask, line, held, out, n_out, steps, first_step,
+                               log, ranges)  # fmt: skip
     return n_out

@@ -67,6 +67,7 @@ class FixedClusterer:
         self.support = np.zeros(support_shape(width, height, params.support_cell_bits), dtype=np.int64)
         self.seen = np.zeros(self.support.shape, dtype=np.bool_)
         self.delay_line = np.zeros((params.update_delay + 1, len(PENDING_COLUMNS)), dtype=np.int64)  # the events in flight
+        self.held = np.zeros((params.n_clusters, RECORD_COLUMNS))  # the open filter step's records
         self.inv_ww = np.zeros(len(params.palette), dtype=np.int64)
         fixed_model.refresh_mixing(self.globals, self.palette, self.inv_ww, self.k)
         self.overflow = np.zeros(len(fixed_model.SIGNALS), dtype=np.int64)
@@ -81,12 +82,13 @@ class FixedClusterer:
         """Records of the filter steps these events complete; with `trace` (int64, one per event),
         each event's action << 16 | slot (fixed_model.TRACE_*)."""
         every = self.params.filter_every
-        out = np.empty(((events.size // every + 1) * self.params.n_clusters, RECORD_COLUMNS))
-        steps = np.empty(events.size // every + 1, dtype=np.int64)
+        # (+ 2: a step opened in the last feed may close in this one)
+        out = np.empty(((events.size // every + 2) * self.params.n_clusters, RECORD_COLUMNS))
+        steps = np.empty(events.size // every + 2, dtype=np.int64)
         first = self.globals[STEP]
         n = fixed_model.run_events(
             self.slots, self.hist, self.globals, self.k, self.decay, self.gains, self.palette, self.inv_ww, self.background_mask,
-            self.support, self.seen, self.delay_line, *loop_columns(events), out, steps,
+            self.support, self.seen, self.delay_line, self.held, *loop_columns(events), out, steps,
             self.overflow, *_instrumentation(self.ranges, trace),
         )  # fmt: skip
         self.steps = steps[: int(self.globals[STEP] - first)]

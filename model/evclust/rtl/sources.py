@@ -65,6 +65,9 @@ RTL_UPDATE_DELAYS = (0, 1, 2)  # the pipeline semantics evclust_core implements 
 
 def require_rtl_semantics(params) -> None:
     """Refuse a parameter set whose pipeline semantics the RTL does not implement."""
+    if params.sweep_slots_per_event != 0:
+        raise EvclustError(f"clusterer: sweep_slots_per_event = {params.sweep_slots_per_event}, but the RTL sweeps a filter step "
+                           f"between two events (0); the float and fixed models run the sweep beside the events")  # fmt: skip
     if params.update_delay not in RTL_UPDATE_DELAYS:
         raise EvclustError(f"clusterer: update_delay = {params.update_delay}, but the RTL implements update_delay "
                            f"{' or '.join(map(str, RTL_UPDATE_DELAYS))}; the float and fixed models run any delay")  # fmt: skip

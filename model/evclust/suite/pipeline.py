@@ -42,23 +42,44 @@ REFERENCE_VARIANTS = {
     "float, D = 2": ("float", "2", "reference~2"),
     "fixed": ("fixed", "0~fixed", "reference~fixed"),
 }
-REFERENCE_RUNS = {"reference": ("float", 0), "reference~2": ("float", 2), "0~fixed": ("fixed", 0), "reference~fixed": ("fixed", 0)}
+# The filter step's sweep beside the events at one slot an event (the slowest sweep, the RTL's
+# cheapest: one swept slot a cycle), against the sweep between two events, each at the same D
+# and activity: the paper's update, and the pipelined core's (D = 2, the activity against a
+# reference time), in both models.
+SWEEP_SLOTS = 1
+SWEEP_VARIANTS = {
+    "float, D = 0": ("float", "0", "beside"),
+    "float, D = 2, referenced": ("float", "reference~2", "beside~reference~2"),
+    "fixed, D = 2, referenced": ("fixed", "reference~2~fixed", "beside~reference~2~fixed"),
+}
+# The runs beyond the delays: {variant: (model, update_delay, activity_reference, sweep_slots_per_event)}.
+# (The float paper runs at D = 0 and 2 are the delays' own.)
+RUNS = {
+    "reference": ("float", 0, True, 0),
+    "reference~2": ("float", 2, True, 0),
+    "0~fixed": ("fixed", 0, False, 0),
+    "reference~fixed": ("fixed", 0, True, 0),
+    "beside": ("float", 0, False, SWEEP_SLOTS),
+    "beside~reference~2": ("float", 2, True, SWEEP_SLOTS),
+    "reference~2~fixed": ("fixed", 2, True, 0),
+    "beside~reference~2~fixed": ("fixed", 2, True, SWEEP_SLOTS),
+}
 
 
 def configurations(delays=DELAYS) -> list[Configuration]:
     base = ClustererParams()
     delayed = [Configuration(f"{name}|{d}", base.model_copy(update={**update, "update_delay": d}), "float")
                for name, update in PERTURBATIONS.items() for d in (0, *delays)]  # fmt: skip
-    referenced = [
+    others = [
         Configuration(
             f"{name}|{variant}",
-            base.model_copy(update={**update, "activity_reference": variant.startswith("reference"), "update_delay": delay}),
+            base.model_copy(update={**update, "update_delay": delay, "activity_reference": reference, "sweep_slots_per_event": sweep}),
             model,
         )
         for name, update in PERTURBATIONS.items()
-        for variant, (model, delay) in REFERENCE_RUNS.items()
-    ]  # (the float paper runs at D = 0 and 2 are the delays' own)
-    return delayed + referenced
+        for variant, (model, delay, reference, sweep) in RUNS.items()
+    ]
+    return delayed + others
 
 
 def _pooled(runs: list[SuiteRun]) -> dict:
@@ -87,6 +108,12 @@ def reference_changes(runs: list[SuiteRun]) -> dict:
     return {
         (row, level): _pairs(pooled, before, after, level) for row, (_, before, after) in REFERENCE_VARIANTS.items() for level, _ in LEVELS
     }
+
+
+def sweep_changes(runs: list[SuiteRun]) -> dict:
+    """{(row, level): the same, the sweep beside the events against the sweep between two events}."""
+    pooled = _pooled(runs)
+    return {(row, level): _pairs(pooled, before, after, level) for row, (_, before, after) in SWEEP_VARIANTS.items() for level, _ in LEVELS}
 
 
 def _mean_se(values: np.ndarray) -> str:
@@ -121,9 +148,15 @@ def reference_section(changes: dict, held_out: bool) -> list[str]:
     return _paired_table(changes, "model", "model", "paper's activity → referenced", target if held_out else None)
 
 
-def write_page(by_split: dict, out: Path, command: str, machine: str, scenes: dict, reference_by_split: dict) -> str:
+def sweep_section(changes: dict, held_out: bool) -> list[str]:
+    target = f"Target: at most {TARGET_POINTS:g} HOTA points of what the defaults report on this split."
+    return _paired_table(changes, "model, update", "model, update", "sweep between events → beside them", target if held_out else None)
+
+
+def write_page(by_split: dict, out: Path, command: str, machine: str, scenes: dict, reference_by_split: dict,
+               sweep_by_split: dict) -> str:  # fmt: skip
     """`by_split`: {split: paired_changes(...)}, the test split first; `reference_by_split`:
-    {split: reference_changes(...)}."""
+    {split: reference_changes(...)}; `sweep_by_split`: {split: sweep_changes(...)}."""
     lines = [
         "# Pipeline semantics: what the delayed update costs",
         "",
@@ -165,6 +198,24 @@ def write_page(by_split: dict, out: Path, command: str, machine: str, scenes: di
         held_out = split == "test"
         lines += [f"### {split} split{' (held out)' if held_out else ' (the defaults were tuned on it: not a held-out measure)'}", "",
                   *reference_section(changes, held_out), ""]  # fmt: skip
+    lines += [
+        "## The filter step's sweep beside the events",
+        "",
+        f"With `sweep_slots_per_event = {SWEEP_SLOTS}` a filter step does not stop the events: its sweep runs on beside "
+        "them, one slot before each event after the step's, and each event and each swept slot see the table as it then "
+        "is (nothing in flight is committed first; a slot the sweep frees voids its updates in flight; a slot's time "
+        "never moves back). With the activity against a reference time the reference then stays at the steps, and the "
+        "sweep reads each activity as Ã times the step's one decay 2^−((t − t_ref)/T_half), so the step writes no "
+        'activity (docs/DESIGN.md, "The sweep beside the events"). A step that comes while a sweep is still open first '
+        "finishes it (at N = 16 and a step every 64 events, never). Each row compares it with the sweep between two "
+        "events at the same D and activity, paired over the same parameter sets: the paper's update in the float model, "
+        "and the pipelined core's (D = 2, referenced) in both models.",
+        "",
+    ]
+    for split, changes in sweep_by_split.items():
+        held_out = split == "test"
+        lines += [f"### {split} split{' (held out)' if held_out else ' (the defaults were tuned on it: not a held-out measure)'}", "",
+                  *sweep_section(changes, held_out), ""]  # fmt: skip
     lines += commands_section(("make generalize          # this page, with docs/GENERALIZATION.md",
                                "evclust generalize --pipeline -o docs/PIPELINE.md"))  # fmt: skip
     return save_page(out, lines, "PIPELINE")
