@@ -5,7 +5,10 @@ from __future__ import annotations
 import numpy as np
 
 from evclust.cli import main
-from evclust.suite.pipeline import PERTURBATIONS, REFERENCE_VARIANTS, TARGET_POINTS, configurations, reference_section, section
+from evclust.suite.pipeline import (
+    PERTURBATIONS, REFERENCE_VARIANTS, SWEEP_SLOTS, SWEEP_VARIANTS, TARGET_POINTS, configurations, reference_section, section,
+    sweep_section,
+)  # fmt: skip
 
 
 def test_every_delay_is_paired_with_the_sequential_update_on_every_perturbation():
@@ -30,6 +33,25 @@ def test_the_activity_reference_is_paired_with_the_papers_activity_in_each_model
             for key, value in update.items():
                 assert getattr(b.params, key) == value
     assert {by_name[f"defaults|{after}"].params.update_delay for _, _, after in REFERENCE_VARIANTS.values()} == {0, 2}
+
+
+def test_the_sweep_beside_the_events_is_paired_with_the_sweep_between_them_one_switch_apart():
+    by_name = {c.name: c for c in configurations(delays=(2,))}
+    for perturbation in PERTURBATIONS:
+        for model, before, after in SWEEP_VARIANTS.values():
+            a, b = by_name[f"{perturbation}|{before}"], by_name[f"{perturbation}|{after}"]
+            assert (a.model, b.model) == (model, model)
+            assert a.params.sweep_slots_per_event == 0 and b.params.sweep_slots_per_event == SWEEP_SLOTS
+            assert a.params.model_copy(update={"sweep_slots_per_event": SWEEP_SLOTS}) == b.params
+    # the paper's update, and the pipelined core's (D = 2 against a reference time) in both models
+    rows = {(by_name[f"defaults|{after}"].model, by_name[f"defaults|{after}"].params.update_delay,
+             by_name[f"defaults|{after}"].params.activity_reference) for _, _, after in SWEEP_VARIANTS.values()}  # fmt: skip
+    assert rows == {("float", 0, False), ("float", 2, True), ("fixed", 2, True)}
+    base = ({"HOTA": 0.5}, {"HOTA": 0.5})
+    zeros = np.zeros(2)
+    changes = {("float, D = 0", "objects"): {"HOTA": np.array([-0.4, -0.8]), "recall": zeros, "precision": zeros, "base": base}}
+    text = "\n".join(sweep_section(changes, held_out=True))
+    assert "| float, D = 0 | objects | 50.0 → 50.0 % | -0.60 ± 0.20 |" in text and "| float, D = 0 | -0.60 points | no |" in text
 
 
 def test_the_reference_section_gives_each_rows_mean_change_and_judges_it_on_the_held_out_split():
