@@ -544,12 +544,8 @@ def _sweep_slot(S, H, G, s, k, table, gains, background_mask, line, held, log, r
             g = (S[s, EV_COUNT] * per_frame) >> (k.frame_per_tau_frac - k.gamma_frac)
             S[s, GAMMA] = _store(g, 0, k.gamma_max, S_GAMMA, log, ranges)
         S[s, EV_COUNT] = 0
-        mx = _store(
-            _align((S[s, PX] - S[s, PPX]) * per_frame, fp + k.frame_per_tau_frac, fi), k.v_int_min, k.v_int_max, S_VI, log, ranges
-        )
-        my = _store(
-            _align((S[s, PY] - S[s, PPY]) * per_frame, fp + k.frame_per_tau_frac, fi), k.v_int_min, k.v_int_max, S_VI, log, ranges
-        )
+        mx = _store(_align((S[s, PX] - S[s, PPX]) * per_frame, fp + k.frame_per_tau_frac, fi), k.v_int_min, k.v_int_max, S_VI, log, ranges)
+        my = _store(_align((S[s, PY] - S[s, PPY]) * per_frame, fp + k.frame_per_tau_frac, fi), k.v_int_min, k.v_int_max, S_VI, log, ranges)
         n = S[s, VI_COUNT]
         if k.warm_start == 0 or n >= k.interval_warmup:
             S[s, VIX] = alpha_step_nb(S[s, VIX], mx, k.beta_vel_int, k.beta_vel_int_frac, 0, FLOOR)

@@ -153,6 +153,16 @@ def sweep_section(changes: dict, held_out: bool) -> list[str]:
     return _paired_table(changes, "model, update", "model, update", "sweep between events → beside them", target if held_out else None)
 
 
+def _by_split(by_split: dict, section_of) -> list[str]:
+    """A subsection a split, each the split's table by `section_of` (judged on the held-out split only)."""
+    lines = []
+    for split, changes in by_split.items():
+        held_out = split == "test"
+        lines += [f"### {split} split{' (held out)' if held_out else ' (the defaults were tuned on it: not a held-out measure)'}", "",
+                  *section_of(changes, held_out), ""]  # fmt: skip
+    return lines
+
+
 def write_page(by_split: dict, out: Path, command: str, machine: str, scenes: dict, reference_by_split: dict,
                sweep_by_split: dict) -> str:  # fmt: skip
     """`by_split`: {split: paired_changes(...)}, the test split first; `reference_by_split`:
@@ -194,10 +204,7 @@ def write_page(by_split: dict, out: Path, command: str, machine: str, scenes: di
         "per event).",
         "",
     ]
-    for split, changes in reference_by_split.items():
-        held_out = split == "test"
-        lines += [f"### {split} split{' (held out)' if held_out else ' (the defaults were tuned on it: not a held-out measure)'}", "",
-                  *reference_section(changes, held_out), ""]  # fmt: skip
+    lines += _by_split(reference_by_split, reference_section)
     lines += [
         "## The filter step's sweep beside the events",
         "",
@@ -212,10 +219,7 @@ def write_page(by_split: dict, out: Path, command: str, machine: str, scenes: di
         "and the pipelined core's (D = 2, referenced) in both models.",
         "",
     ]
-    for split, changes in sweep_by_split.items():
-        held_out = split == "test"
-        lines += [f"### {split} split{' (held out)' if held_out else ' (the defaults were tuned on it: not a held-out measure)'}", "",
-                  *sweep_section(changes, held_out), ""]  # fmt: skip
+    lines += _by_split(sweep_by_split, sweep_section)
     lines += commands_section(("make generalize          # this page, with docs/GENERALIZATION.md",
                                "evclust generalize --pipeline -o docs/PIPELINE.md"))  # fmt: skip
     return save_page(out, lines, "PIPELINE")
