@@ -238,8 +238,11 @@ def _commit(S, H, G, row, k, precision):
         s, t = int(row[PD_SLOT]), row[PD_T]
         if k.activity_reference != 0.0:  # an addition: the event's weight
             S[s, ACT] = _q_referenced(S[s, ACT] + _weight(G, t, k), precision, k)
-        else:  # decayed from the slot's own time, plus one (a sweep beside the events may have set a later time: no decay back)
-            a = _q(_decayed(S[s, ACT], max(t - S[s, T_LAST], 0.0), k.t_half_us, precision), Q_ACT, precision) + 1.0
+        else:  # decayed from the slot's own time, plus one
+            dt = t - S[s, T_LAST]
+            if k.sweep_slots_per_event != 0.0:  # a sweep beside the events may have set a later time: no decay back
+                dt = max(dt, 0.0)
+            a = _q(_decayed(S[s, ACT], dt, k.t_half_us, precision), Q_ACT, precision) + 1.0
             S[s, ACT] = _q(a, Q_ACT, precision)
         S[s, RX] = min(max(_q(S[s, RX] + row[PD_RX], Q_HALF, precision), k.r_min), k.r_max)
         S[s, RY] = min(max(_q(S[s, RY] + row[PD_RY], Q_HALF, precision), k.r_min), k.r_max)
@@ -259,7 +262,7 @@ def _commit(S, H, G, row, k, precision):
                 for j in range(H.shape[1]):
                     H[s, j] >>= 1
         S[s, EV_COUNT] += 1.0
-        S[s, T_LAST] = max(S[s, T_LAST], t)
+        S[s, T_LAST] = max(S[s, T_LAST], t) if k.sweep_slots_per_event != 0.0 else t
         row[PD_LIVE] = 0.0
     if row[PD_BG] != 0.0:
         G[BG_Y] = _q(G[BG_Y] + row[PD_BG_Y], Q_BG, precision)

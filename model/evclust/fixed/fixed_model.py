@@ -82,7 +82,8 @@ def _align(raw, from_frac, to_frac):
 
 @njit(cache=True, nogil=True, inline="always")
 def _later(a, b):
-    """a is later than b on the wrapping 32-bit clock (within half its period)."""
+    """a is later than b on the wrapping 32-bit clock (within half its period: beside the events,
+    with the paper's activity, a slot's events more than 2^31 µs apart are taken out of order)."""
     d = (a - b) & TIME_MASK
     return d != 0 and d < (np.int64(1) << 31)
 
@@ -316,7 +317,8 @@ def _commit(S, H, G, row, k, table, log, ranges):
             S[s, ACT] = _store(S[s, ACT] + _weight(G, t, k, table), 0, k.activity_reference_max, S_ACT, log, ranges)
             S[s, T_LAST] = t
         else:  # decayed from the slot's own time, plus one
-            if not _later(S[s, T_LAST], t):  # (a sweep beside the events may have set a later time: no decay back)
+            # (a sweep beside the events may have set a later time: no decay back)
+            if k.sweep_slots_per_event == 0 or not _later(S[s, T_LAST], t):
                 _decay_slot(S, s, t, k, table)
             S[s, ACT] = _store(S[s, ACT] + (np.int64(1) << k.activity_frac), 0, k.activity_max, S_ACT, log, ranges)
         S[s, RX] = _seen(min(max(S[s, RX] + row[PD_RX], k.r_min), k.r_max), S_HALF, ranges)
