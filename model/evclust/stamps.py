@@ -292,12 +292,12 @@ def _hash(parts) -> str:
     return _sha(part for label, data in parts for part in (label, data))
 
 
-def probe_reference_records() -> list[tuple[str, bytes]]:
-    """The activity against a reference time (ClustererParams.activity_reference), which no other
-    probe runs: the float and fixed models' records on the probe's events, at D = 0 and 2."""
+def _both_models_on_probe(configs) -> list[tuple[str, bytes]]:
+    """The float and fixed models' records on the probe's events, each labelled "<scene> <tag>
+    <model>", for `configs`: (tag, ClustererParams) pairs (float records as float32)."""
     import numpy as np
 
-    from evclust.clusterer import ClustererParams, FloatClusterer
+    from evclust.clusterer import FloatClusterer
     from evclust.events import EVENT_DTYPE
     from evclust.fixed.model import FixedClusterer
 
@@ -305,34 +305,31 @@ def probe_reference_records() -> list[tuple[str, bytes]]:
     out = []
     for label, scene in _probe_scenes():
         src = scene.source
-        for delay in (0, 2):
-            params = ClustererParams(activity_reference=True, update_delay=delay, objects=False)
+        for tag, params in configs:
             for name, model in (("float", FloatClusterer), ("fixed", FixedClusterer)):
                 rows = model(params, src.width, src.height, src.t_frame_us).feed(np.frombuffer(events[label], dtype=EVENT_DTYPE))
-                out.append((f"{label} D={delay} {name}", _rounded(rows) if name == "float" else np.ascontiguousarray(rows).tobytes()))
+                out.append((f"{label} {tag} {name}", _rounded(rows) if name == "float" else np.ascontiguousarray(rows).tobytes()))
     return out
+
+
+def probe_reference_records() -> list[tuple[str, bytes]]:
+    """The activity against a reference time (ClustererParams.activity_reference), which no other
+    probe runs: the float and fixed models' records on the probe's events, at D = 0 and 2."""
+    from evclust.clusterer import ClustererParams
+
+    return _both_models_on_probe([(f"D={d}", ClustererParams(activity_reference=True, update_delay=d, objects=False)) for d in (0, 2)])
 
 
 def probe_sweep_records() -> list[tuple[str, bytes]]:
     """The sweep beside the events (ClustererParams.sweep_slots_per_event), which no other probe
     runs: the float and fixed models' records on the probe's events at one slot an event, with the
     paper's update (D = 0) and the pipelined core's (D = 2, the activity against a reference time)."""
-    import numpy as np
+    from evclust.clusterer import ClustererParams
 
-    from evclust.clusterer import ClustererParams, FloatClusterer
-    from evclust.events import EVENT_DTYPE
-    from evclust.fixed.model import FixedClusterer
-
-    events = {label.split(" ", 1)[1]: data for label, data in probe_events() if label.startswith("events ")}
-    out = []
-    for label, scene in _probe_scenes():
-        src = scene.source
-        for delay, reference in ((0, False), (2, True)):
-            params = ClustererParams(sweep_slots_per_event=1, update_delay=delay, activity_reference=reference, objects=False)
-            for name, model in (("float", FloatClusterer), ("fixed", FixedClusterer)):
-                rows = model(params, src.width, src.height, src.t_frame_us).feed(np.frombuffer(events[label], dtype=EVENT_DTYPE))
-                out.append((f"{label} D={delay} {name}", _rounded(rows) if name == "float" else np.ascontiguousarray(rows).tobytes()))
-    return out
+    return _both_models_on_probe([
+        (f"D={d}", ClustererParams(sweep_slots_per_event=1, update_delay=d, activity_reference=reference, objects=False))
+        for d, reference in ((0, False), (2, True))
+    ])  # fmt: skip
 
 
 def sweep_fingerprint(files: Files | None = None) -> str:
