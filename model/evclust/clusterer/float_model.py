@@ -15,7 +15,7 @@ from evclust.clusterer.layout import (
     ACT, BG_ACT, BG_CB, BG_CR, BG_T, BG_Y, CCB, CCR, MERGED, UNSUPPORTED, CREATED, CY, DROPPED, EV_COUNT, EVENTS, EVER_REPORTED, EVICTED, EXITED,
     EXPIRED, T_FIRST, FLAG_BORDER, FLAG_MOVING_INT, FLAG_MOVING_MCM, FLAG_NEW, GAMMA, ID, MCM_NORM, NEXT_ID, NOISE, PPX, PPY, PX,
     PD_BG, PD_BG_CB, PD_BG_CR, PD_BG_Y, PD_CCB, PD_CCR, PD_CLASS, PD_CY, PD_LIVE, PD_NORM, PD_PX, PD_PY, PD_RX, PD_RY, PD_SLOT,
-    PD_T, PD_VMX, PD_VMY, PD_VOTE, PY, REPORTED, RX, RY, SINCE_FILTER, STEP, SWEEP_BOUNDARIES, SWEEP_DECAY, SWEEP_FORCED, SWEEP_LEFT,
+    PD_T, PD_VMX, PD_VMY, PD_VOTE, PY, REPORTED, RX, RY, SINCE_FILTER, STEP, SWEEP_DECAY, SWEEP_FORCED, SWEEP_LEFT, SWEEP_PER_FRAME,
     SWEEP_RECORDS, SWEEP_T, T_FILTER, T_LAST, VALID, VI_COUNT, VIX, VIY, VMX, VMY,
 )  # fmt: skip
 from evclust.jit import njit
@@ -375,7 +375,8 @@ def _step_open(S, G, t, k, precision):
     """A filter step every N_f events, at t: its τ boundaries and the activities' time; the sweep
     of its slots is then to come (all at once, or beside the events: _sweep_slot)."""
     # τ boundaries crossed since the last step: usually 0 or 1, more when events are sparse.
-    G[SWEEP_BOUNDARIES] = math.floor((t - G[T_FIRST]) / k.tau_us) - math.floor((G[T_FILTER] - G[T_FIRST]) / k.tau_us)
+    boundaries = math.floor((t - G[T_FIRST]) / k.tau_us) - math.floor((G[T_FILTER] - G[T_FIRST]) / k.tau_us)
+    G[SWEEP_PER_FRAME] = k.t_frame_us / (boundaries * k.tau_us) if boundaries > 0 else -1.0  # T_frame over the time measured
     G[SWEEP_T] = t
     G[T_FILTER] = t
     G[SWEEP_DECAY] = 1.0
@@ -391,30 +392,31 @@ def _step_open(S, G, t, k, precision):
     G[SWEEP_RECORDS] = 0
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _step_activity(a, G, k, precision):
+    """The activity the sweep decides on: as stored, or beside the events against a reference
+    time A = Ã·2^-((t - t_ref)/T_half), the step's one decay (not stored)."""
+    if k.activity_reference == 0.0 or k.sweep_slots_per_event == 0.0:
+        return a
+    return _q(a * G[SWEEP_DECAY], Q_ACT, precision)
+
+
 @njit(cache=True, nogil=True)
 def _sweep_slot(S, H, G, s, k, palette, background_mask, line, held, precision):
     """The open step on slot s: decay, free, merge, interval velocity, noise and exit decisions,
     and its record into `held` (the step's records until it closes). A slot the sweep frees
     voids the updates still in flight for it."""
-    t = G[SWEEP_T]
-    boundaries = G[SWEEP_BOUNDARIES]
-    interval_due = boundaries > 0
-    per_frame = k.t_frame_us / (max(boundaries, 1) * k.tau_us)  # T_frame over the time measured
-    v_min = k.v_min
     if S[s, VALID] == 0.0:
         return
-    if k.activity_reference == 0.0:
-        # (beside the events a slot may have taken events since the step: it is no older than t)
-        if S[s, T_LAST] < t or k.sweep_slots_per_event == 0.0:
-            S[s, ACT] = _q(_decayed(S[s, ACT], t - S[s, T_LAST], k.t_half_us, precision), Q_ACT, precision)
-            S[s, T_LAST] = t
-        act, bg_act = S[s, ACT], G[BG_ACT]
-    elif k.sweep_slots_per_event == 0.0:
+    t = G[SWEEP_T]
+    per_frame = G[SWEEP_PER_FRAME]
+    v_min = k.v_min
+    if k.activity_reference != 0.0:
         S[s, T_LAST] = t
-        act, bg_act = S[s, ACT], G[BG_ACT]
-    else:  # A = Ã·2^-((t - t_ref)/T_half), the background's likewise
-        act = _q(S[s, ACT] * G[SWEEP_DECAY], Q_ACT, precision)
-        bg_act = _q(G[BG_ACT] * G[SWEEP_DECAY], Q_ACT, precision)
+    elif S[s, T_LAST] < t or k.sweep_slots_per_event == 0.0:  # (beside the events: no older than t)
+        S[s, ACT] = _q(_decayed(S[s, ACT], t - S[s, T_LAST], k.t_half_us, precision), Q_ACT, precision)
+        S[s, T_LAST] = t
+    act = _step_activity(S[s, ACT], G, k, precision)
     if act < k.a_min:
         S[s, VALID] = 0.0
         _cancel(line, s)
@@ -426,15 +428,12 @@ def _sweep_slot(S, H, G, s, k, palette, background_mask, line, held, precision):
             if S[j, VALID] != 0.0 and _mergeable(S, s, j, k):
                 _merge(S, H, G, s, j, k, precision)
                 _cancel(line, j)
-                if k.activity_reference == 0.0 or k.sweep_slots_per_event == 0.0:
-                    act = S[s, ACT]
-                else:
-                    act = _q(S[s, ACT] * G[SWEEP_DECAY], Q_ACT, precision)
+                act = _step_activity(S[s, ACT], G, k, precision)
                 j = s  # the merged box may now reach a slot passed over
             j += 1
     if k.gamma_mode != GAMMA_COUNT or S[s, VI_COUNT] == 0.0:
         S[s, GAMMA] = _q(_gamma(act, k), Q_GAMMA, precision)
-    if interval_due:
+    if per_frame >= 0.0:  # a τ boundary since the last step: an interval is due
         if k.gamma_mode == GAMMA_COUNT and S[s, VI_COUNT] >= 1.0:
             S[s, GAMMA] = _q(S[s, EV_COUNT] * per_frame, Q_GAMMA, precision)  # events per frame since the last boundary
         S[s, EV_COUNT] = 0.0
@@ -467,7 +466,7 @@ def _sweep_slot(S, H, G, s, k, palette, background_mask, line, held, precision):
         # Beyond the paper: the background's events spread over the sensor would give the
         # box A_bg·(box area / sensor area); an object's cluster holds noise_gate times more.
         box = (2.0 * math.floor(S[s, RX]) + 1.0) * (2.0 * math.floor(S[s, RY]) + 1.0)  # its pixels
-        reported = act * k.width * k.height >= k.noise_gate * bg_act * box
+        reported = act * k.width * k.height >= k.noise_gate * _step_activity(G[BG_ACT], G, k, precision) * box
     if act >= k.a_valid and not reported:
         G[NOISE] += 1
     S[s, REPORTED] = 1.0 if reported else 0.0

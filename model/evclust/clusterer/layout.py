@@ -25,17 +25,18 @@ SLOT_COLUMNS = (
 (
     NEXT_ID, BG_Y, BG_CB, BG_CR, SINCE_FILTER, STEP, T_FILTER, EVENTS, CREATED, EVICTED, DROPPED, EXPIRED,
     EXITED, NOISE, T_FIRST, BG_ACT, BG_T, BG_RESIDUAL, MERGED, UNSUPPORTED,
-    SWEEP_LEFT, SWEEP_T, SWEEP_BOUNDARIES, SWEEP_DECAY, SWEEP_RECORDS, SWEEP_FORCED,
+    SWEEP_LEFT, SWEEP_T, SWEEP_PER_FRAME, SWEEP_DECAY, SWEEP_RECORDS, SWEEP_FORCED,
 ) = range(26)  # fmt: skip
 GLOBAL_COLUMNS = (
     "next_id", "bg_Y", "bg_Cb", "bg_Cr", "since_filter", "step", "t_filter", "events",
     "created", "evicted", "dropped", "expired", "exited", "noise", "t_first",  # τ boundaries count from t_first
     "bg_activity", "bg_t_last", "bg_decay_residual",  # the activity of the events no reported cluster takes
     "merged", "unsupported",  # clusters merged into another; events that found no cluster and no support
-    # The filter step's sweep beside the events (ClustererParams.sweep_slots_per_event): slots
-    # left to sweep, the step's time, its τ boundaries, its decay of Ã (activity_reference), the
-    # records it holds so far, and the events at which a sweep had to finish at once.
-    "sweep_left", "sweep_t", "sweep_boundaries", "sweep_decay", "sweep_records", "sweep_forced",
+    # The filter step's sweep (beside the events: ClustererParams.sweep_slots_per_event): slots
+    # left to sweep, the step's time, T_frame over the τ boundaries' time (-1: no boundary since
+    # the last step), its decay of Ã (activity_reference), the records it holds so far, and the
+    # events at which a sweep had to finish at once.
+    "sweep_left", "sweep_t", "sweep_per_frame", "sweep_decay", "sweep_records", "sweep_forced",
 )  # fmt: skip
 
 # The update delay line (beyond the paper; ClustererParams.update_delay = D): a pipelined core

@@ -15,8 +15,8 @@ from evclust.clusterer.layout import (
     MERGED, UNSUPPORTED,
     DECAY_RESIDUAL, EXITED, EXPIRED, GLOBAL_COLUMNS, T_FIRST, FLAG_BORDER, FLAG_MOVING_INT, FLAG_MOVING_MCM, FLAG_NEW, GAMMA, ID, MCM_NORM,
     NEXT_ID, NOISE, PD_BG, PD_BG_CB, PD_BG_CR, PD_BG_Y, PD_CCB, PD_CCR, PD_CLASS, PD_CY, PD_LIVE, PD_NORM, PD_PX, PD_PY, PD_RX,
-    PD_RY, PD_SLOT, PD_T, PD_VMX, PD_VMY, PD_VOTE, PPX, PPY, PX, PY, REPORTED, RX, RY, SINCE_FILTER, STEP, SWEEP_BOUNDARIES,
-    SWEEP_DECAY, SWEEP_FORCED, SWEEP_LEFT, SWEEP_RECORDS, SWEEP_T, T_FILTER, T_LAST, VALID, VI_COUNT, VIX, VIY, VMX, VMY,
+    PD_RY, PD_SLOT, PD_T, PD_VMX, PD_VMY, PD_VOTE, PPX, PPY, PX, PY, REPORTED, RX, RY, SINCE_FILTER, STEP, SWEEP_DECAY,
+    SWEEP_FORCED, SWEEP_LEFT, SWEEP_PER_FRAME, SWEEP_RECORDS, SWEEP_T, T_FILTER, T_LAST, VALID, VI_COUNT, VIX, VIY, VMX, VMY,
 )  # fmt: skip
 from evclust.fixed.arith import FLOOR, NEAREST, alpha_increment_nb, alpha_step_nb, decay_apply_nb, decay_nb, decay_steps_nb
 from evclust.fixed.formats import DECAY_FRAC_BITS, DECAY_TABLE_BITS
@@ -484,7 +484,9 @@ def _step_open(S, G, t_whole, k, table, log, ranges):
     phase = G[TAU_PHASE] + ((t - G[T_FILTER]) & TIME_MASK)
     boundaries = phase // k.tau_us
     G[TAU_PHASE] = phase - boundaries * k.tau_us
-    G[SWEEP_BOUNDARIES] = boundaries
+    G[SWEEP_PER_FRAME] = (
+        k.frame_per_tau // boundaries if boundaries > 0 else -1
+    )  # T_frame/(n·τ), Q?.F_fpt (it floors to 0 after a long gap); -1: no interval due
     G[SWEEP_T] = t_whole
     G[T_FILTER] = t
     G[SWEEP_DECAY] = 0
@@ -516,8 +518,7 @@ def _sweep_slot(S, H, G, s, k, table, gains, background_mask, line, held, log, r
     if S[s, VALID] == 0:
         return
     t = G[SWEEP_T] & TIME_MASK
-    boundaries = G[SWEEP_BOUNDARIES]
-    per_frame = k.frame_per_tau // max(boundaries, 1)  # T_frame/(n·τ), Q?.F_fpt
+    per_frame = G[SWEEP_PER_FRAME]
     fp, fv, fw, fi, fc = k.centre_frac, k.v_mcm_frac, k.mcm_norm_frac, k.v_int_frac, k.colour_frac
     sensor = k.width * k.height
     if k.activity_reference != 0:
@@ -541,7 +542,7 @@ def _sweep_slot(S, H, G, s, k, table, gains, background_mask, line, held, log, r
             j += 1
     if k.gamma_mode != 2 or S[s, VI_COUNT] == 0:
         S[s, GAMMA] = _store(_gamma_from_activity(act, k), 0, k.gamma_max, S_GAMMA, log, ranges)
-    if boundaries > 0:
+    if per_frame >= 0:  # a τ boundary since the last step: an interval is due
         if k.gamma_mode == 2 and S[s, VI_COUNT] >= 1:
             g = (S[s, EV_COUNT] * per_frame) >> (k.frame_per_tau_frac - k.gamma_frac)
             S[s, GAMMA] = _store(g, 0, k.gamma_max, S_GAMMA, log, ranges)
