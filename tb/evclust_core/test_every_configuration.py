@@ -91,8 +91,17 @@ def test_the_share_is_a_stable_subset_drawn_apart_per_simulator_and_everything_u
     assert len(set(share)) == 4 and set(share) <= set(items)
     assert share == [item for item in items if item in share]  # in the list's order
     assert cosim_share(items, 4, "vectors", "icarus") == share  # every xdist worker draws the same
-    # The simulators draw apart: the chance that two 4-of-20 draws coincide is 1 in 4845.
-    assert cosim_share(items, 4, "vectors", "verilator") != share
+    # The simulators draw apart: two 4-of-20 draws coincide once in 4845 commits, so over fixed
+    # commits, not this checkout's (whose draws may be that one, as at c86330e).
+    import cosim
+
+    coincide = 0
+    for commit in range(40):
+        monkeypatch.setattr(cosim, "rotation_key", lambda commit=commit: f"{commit:040x}")
+        coincide += cosim_share(items, 4, "vectors", "verilator") == cosim_share(items, 4, "vectors", "icarus")
+    assert coincide <= 1
+    monkeypatch.undo()
+    monkeypatch.delenv("EVCLUST_COVER", raising=False)
     assert cosim_share(items, 50, "vectors", "icarus") == items  # more than there are: all
     monkeypatch.setenv("EVCLUST_COVER", "all")
     assert cosim_share(items, 4, "vectors", "icarus") == items
