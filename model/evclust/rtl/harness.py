@@ -181,8 +181,13 @@ async def _coverage(dut, counters: dict, records: list[dict]) -> dict:
 
     fsm = {
         name: read(handle)
-        for name, handle in (("state", dut.cov_state), ("arc", dut.cov_arc), ("phase", dut.cov_phase), ("stream", dut.cov_stream),
-                             ("lookahead", dut.cov_lookahead))
+        for name, handle in (
+            ("state", dut.cov_state),
+            ("arc", dut.cov_arc),
+            ("phase", dut.cov_phase),
+            ("stream", dut.cov_stream),
+            ("lookahead", dut.cov_lookahead),
+        )
     }
     return run_bins(fsm, counters, records)
 
