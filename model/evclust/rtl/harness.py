@@ -102,6 +102,11 @@ class Harness:
             await RisingEdge(dut.clk)
             if int(dut.overflow.value):
                 raise AssertionError("the harness's record memory overflowed: a smaller batch is needed")
+            if int(dut.lookahead_stale.value):
+                raise AssertionError(
+                    f"the sweep's look-ahead register held a row other than its slot's on {int(dut.lookahead_stale.value)} "
+                    f"cycles (by batch {lo // self.batch})"
+                )
             traced, captured = int(dut.traced.value), int(dut.captured.value)
             trace += [int(dut.trace_mem[i].value) for i in range(traced)]
             records += [int(dut.rec_mem[i].value) for i in range(captured)]
