@@ -279,10 +279,9 @@ module evclust_core #(
     reg [VREL_W-1:0]               vrel          [0:N-1];
 
     // The rest of a slot, one row per slot in RAM (evclust_slot_ram), fields at ROW_*: one write
-    // port (an update, a creation, a merge or the sweep's stage 0, each in its own state) and
-    // three read ports: A at the event's slot (EXEC), the scanned slot or, a cycle ahead, the
-    // swept one (k_row below); B at the sweep tail's slot t or the slot a merge absorbs; E at a
-    // delayed update's slot. Only the searches need every slot at once.
+    // port (an update, a creation, a merge or the sweep's stage 0, each in its own state) and two
+    // read ports, A at the event's slot (EXEC) or the swept, scanned or merging slot k, B at the
+    // sweep tail's slot t or the slot a merge absorbs. Only the searches need every slot at once.
     localparam integer ROW_ID = 0;
     localparam integer ROW_PPX = ROW_ID + ID_W;
     localparam integer ROW_PPY = ROW_PPX + CENTRE_W;
@@ -300,14 +299,13 @@ module evclust_core #(
     localparam integer ROW_HIST = ROW_COL_CR + COLOUR_W;  // entry c at ROW_HIST + c * HIST_W
     localparam integer ROW_W = ROW_HIST + P * HIST_W;
     wire [SLOT_W-1:0] row_a_slot, row_b_slot;
-    wire [ROW_W-1:0]  row_a_ram, row_b, row_e;
-    wire [ROW_W-1:0]  row_a;  // port A's row as the states read it: the RAM's, or k_row in SWEEP and MERGE
+    wire [ROW_W-1:0]  row_a, row_b, row_e;
     reg               row_we;
     reg  [SLOT_W-1:0] row_w_slot;
     reg  [ROW_W-1:0]  row_w;
     evclust_slot_ram #(.DEPTH(N), .WIDTH(ROW_W), .ADDR_W(SLOT_W)) slot_rows (
         .clk(clk), .we(row_we), .waddr(row_w_slot), .wdata(row_w),
-        .raddr_a(row_a_slot), .rdata_a(row_a_ram), .raddr_b(row_b_slot), .rdata_b(row_b), .raddr_e(e_slot), .rdata_e(row_e)
+        .raddr_a(row_a_slot), .rdata_a(row_a), .raddr_b(row_b_slot), .rdata_b(row_b), .raddr_e(e_slot), .rdata_e(row_e)
     );
     wire [ID_W-1:0]                 id_b = row_b[ROW_ID +: ID_W];  // (port A's id: a merge copies the whole row)
     wire [CENTRE_W-1:0]             ppx_a = row_a[ROW_PPX +: CENTRE_W], ppx_b = row_b[ROW_PPX +: CENTRE_W];
@@ -363,14 +361,6 @@ module evclust_core #(
     reg [FRAME_PER_TAU_W-1:0] per_frame; // T_frame / (boundaries * tau)
 
     assign filter_active = state == ST_PHASE || state == ST_SWEEP || state == ST_MERGE;
-
-    // The sweep's look-ahead: the swept (or merging) slot k's row, read from port A the cycle
-    // before, so that stage 0's decay, expiry and write-back start from a register rather than
-    // behind the RAM's read multiplexer. PHASE loads slot 0; each cycle the sweep leaves k it
-    // loads k + 1; a merge's write loads what it writes to k (forwarded, so no bubble).
-    reg  [ROW_W-1:0]  k_row;
-    wire              sweeping = state == ST_SWEEP || state == ST_MERGE;
-    assign row_a = sweeping ? k_row : row_a_ram;
     // The datapath restarts on a reset or a clear; the configuration lives outside (evclust_regs).
     wire dp_rst = rst || clear;
 
@@ -575,7 +565,7 @@ module evclust_core #(
     // each alpha filter's new value and its increment from the slot read at port A. With
     // UPDATE_DELAY = 2 its second half runs a stage later (stage H, below), from a register
     // loaded as the event finishes (h_load).
-    wire [ROW_W-1:0] row_u = UPDATE_DELAY == 0 ? row_a_ram : row_e;  // the event's slot's row (port E when delayed)
+    wire [ROW_W-1:0] row_u = UPDATE_DELAY == 0 ? row_a : row_e;  // the event's slot's row (port E when delayed)
     wire [CENTRE_W-1:0]       up_px, up_py;
     wire [HALF_SIZE_W-1:0]    up_rx, up_ry;
     wire [V_MCM_W-1:0]        up_vmx, up_vmy;
@@ -637,7 +627,7 @@ module evclust_core #(
     // before's at port B (the decay unit reads the same port).
     localparam DELAYED = UPDATE_DELAY != 0;
     wire [SLOT_W-1:0] sw_slot = DELAYED ? c_slot : e_slot;
-    wire [ROW_W-1:0]  sw_row = DELAYED ? row_b : row_a_ram;
+    wire [ROW_W-1:0]  sw_row = DELAYED ? row_b : row_a;
     wire [ACTIVITY_W-1:0] cm_act;
     wire [CENTRE_W-1:0]   cm_px, cm_py;
     wire [HALF_SIZE_W-1:0] cm_rx, cm_ry;
@@ -1269,9 +1259,7 @@ module evclust_core #(
     wire [DECAY_RESIDUAL_W-1:0] row_residual = REFERENCED ? {DECAY_RESIDUAL_W{1'b0}} : dec_residual;
     // A delayed update reads its slot at port E, so port A's address (the scan, the sweep, a
     // merge) does not hang on the event's search; without delay EXEC decays at port A.
-    // In SWEEP port A reads the next slot (the look-ahead), k itself being in k_row.
-    wire [SLOT_W-1:0] k_next = index < LAST_SLOT ? k + 1'b1 : k;
-    assign row_a_slot = state == ST_EXEC && UPDATE_DELAY == 0 ? e_slot : (state == ST_SWEEP ? k_next : k);
+    assign row_a_slot = state == ST_EXEC && UPDATE_DELAY == 0 ? e_slot : k;
     assign row_b_slot = state == ST_MERGE ? m_j : (commit_reads ? c_slot : t);
     always @* begin
         row_we = 1'b0;
@@ -1342,17 +1330,6 @@ module evclust_core #(
         if (dp_rst)
             row_we = 1'b0;
     end
-
-    // The look-ahead's register (above): in PHASE slot 0's row as it is now, a write to it this
-    // cycle included; as the sweep leaves k, port A's slot k + 1 (nothing writes it this cycle);
-    // as a merge writes k, the row written.
-    always @(posedge clk)
-        if (state == ST_PHASE)
-            k_row <= row_we && row_w_slot == k ? row_w : row_a_ram;
-        else if (m_write)
-            k_row <= row_w;
-        else if (sweep_advance && !sweep_merge)
-            k_row <= row_a_ram;
 
     integer i;
     always @(posedge clk) begin

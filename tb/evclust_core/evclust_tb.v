@@ -161,11 +161,7 @@ module evclust_tb #(
     reg [31:0] cov_state [0:7];   // cycles in state s (ST_INIT .. ST_PHASE)
     reg [31:0] cov_arc   [0:63];  // changes from state a to state b, at a * 8 + b
     reg [31:0] cov_phase [0:3];   // cycles in ST_PHASE per phase_step (decide, divide by τ, divide the frame)
-    reg [31:0] cov_lookahead [0:1];  // the sweep's look-ahead forwards a write: slot 0's as PHASE ends; a merge's
     reg [31:0] cov_stream [0:3];  // record held (valid, not ready); input gap (ready, not valid); both; event and record in one cycle
-    // A check, not a bin: cycles in which the sweep's look-ahead register does not hold the RAM's
-    // row of the live slot k that SWEEP or MERGE reads through it (the harness fails a run on any).
-    reg [31:0] lookahead_stale;
     reg [2:0]  cov_prev;
     reg        cov_armed;  // from the first reset on: the core's state before it is not the design's
     integer    cov_i;
@@ -176,8 +172,6 @@ module evclust_tb #(
             cov_phase[cov_i] = 32'd0;
             cov_stream[cov_i] = 32'd0;
         end
-        for (cov_i = 0; cov_i < 2; cov_i = cov_i + 1) cov_lookahead[cov_i] = 32'd0;
-        lookahead_stale = 32'd0;
         cov_prev = 3'd0;
         cov_armed = 1'b0;
     end
@@ -190,12 +184,6 @@ module evclust_tb #(
                 cov_arc[{cov_prev, core.state}] <= cov_arc[{cov_prev, core.state}] + 32'd1;
             if (core.state == core.ST_PHASE)
                 cov_phase[core.phase_step] <= cov_phase[core.phase_step] + 32'd1;
-            if (core.state == core.ST_PHASE && core.state_next == core.ST_SWEEP && core.row_we && core.row_w_slot == core.k)
-                cov_lookahead[0] <= cov_lookahead[0] + 32'd1;
-            if (core.m_write)
-                cov_lookahead[1] <= cov_lookahead[1] + 32'd1;
-            if (core.sweeping && core.index < core.N_SLOTS && core.valid[core.k] && core.k_row != core.slot_rows.rows[core.k])
-                lookahead_stale <= lookahead_stale + 32'd1;
             if (rec_valid && !rec_ready)
                 cov_stream[0] <= cov_stream[0] + 32'd1;
             if (running && ev_ready && !ev_valid)

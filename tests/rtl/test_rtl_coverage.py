@@ -18,7 +18,7 @@ def _fsm(**arcs):
     for name, count in arcs.items():
         a, b = name.split("_to_")
         arc[coverage.STATES.index(a) * 8 + coverage.STATES.index(b)] = count
-    return {"state": [1] * 8, "arc": arc, "phase": [2, 0, 1, 0], "stream": [3, 0, 0, 4], "lookahead": [0, 5]}
+    return {"state": [1] * 8, "arc": arc, "phase": [2, 0, 1, 0], "stream": [3, 0, 0, 4]}
 
 
 def test_each_source_fills_its_bins():
@@ -34,7 +34,6 @@ def test_each_source_fills_its_bins():
     assert bins["arc: SWEEP -> EXEC"] == 2 and coverage.unexpected(bins) == ["arc: SWEEP -> EXEC"]
     assert bins["filter step: decide"] == 2 and bins["filter step: divide the frame period"] == 1
     assert bins["stream: an event in and a record out in one cycle"] == 4
-    assert bins["look-ahead: a merge's write"] == 5 and "look-ahead: a write to slot 0 as PHASE ends" in coverage.holes(bins)
 
 
 def test_runs_merge_by_sum_and_holes_are_the_empty_bins(tmp_path):

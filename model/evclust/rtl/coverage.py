@@ -36,14 +36,11 @@ ARCS = (
     ("PHASE", "SWEEP"), ("SWEEP", "MERGE"), ("MERGE", "SWEEP"), ("SWEEP", "IDLE"),
 )  # fmt: skip
 PHASE_STEPS = ("decide", "divide the phase by τ", "divide the frame period")
-# The sweep's look-ahead register (rtl/evclust_core.v, k_row) takes a row being written instead
-# of the RAM's: slot 0's, written as PHASE ends (an update committed then), and a merge's.
-LOOKAHEAD = ("a write to slot 0 as PHASE ends", "a merge's write")
 STREAM = ("a record held by back-pressure", "an input gap while the core is ready",
           "a record held while an event waits", "an event in and a record out in one cycle")  # fmt: skip
 ACTIONS = ("updates", "creates", "evictions", "drops", "unsupported", "expiries", "exits", "merges", "records")
 FLAGS = {"new": FLAG_NEW, "border": FLAG_BORDER, "moving (MCM)": FLAG_MOVING_MCM, "moving (interval)": FLAG_MOVING_INT}
-GROUPS = ("action", "saturation", "flag", "class", "state", "arc", "filter step", "look-ahead", "stream")
+GROUPS = ("action", "saturation", "flag", "class", "state", "arc", "filter step", "stream")
 
 
 def empty() -> dict[str, int]:
@@ -55,7 +52,6 @@ def empty() -> dict[str, int]:
     bins |= {f"state: {s}": 0 for s in STATES}
     bins |= {f"arc: {a} -> {b}": 0 for a, b in ARCS}
     bins |= {f"filter step: {p}": 0 for p in PHASE_STEPS}
-    bins |= {f"look-ahead: {c}": 0 for c in LOOKAHEAD}
     bins |= {f"stream: {c}": 0 for c in STREAM}
     return bins
 
@@ -80,8 +76,6 @@ def run_bins(fsm: dict, counters: dict, records: list[dict]) -> dict[str, int]:
             bins[f"arc: {a} -> {b}"] = bins.get(f"arc: {a} -> {b}", 0) + count
     for code, name in enumerate(PHASE_STEPS):
         bins[f"filter step: {name}"] = fsm["phase"][code]
-    for code, name in enumerate(LOOKAHEAD):
-        bins[f"look-ahead: {name}"] = fsm["lookahead"][code]
     for code, name in enumerate(STREAM):
         bins[f"stream: {name}"] = fsm["stream"][code]
     return bins

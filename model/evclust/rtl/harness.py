@@ -102,11 +102,6 @@ class Harness:
             await RisingEdge(dut.clk)
             if int(dut.overflow.value):
                 raise AssertionError("the harness's record memory overflowed: a smaller batch is needed")
-            if int(dut.lookahead_stale.value):
-                raise AssertionError(
-                    f"the sweep's look-ahead register held a row other than its slot's on {int(dut.lookahead_stale.value)} "
-                    f"cycles (by batch {lo // self.batch})"
-                )
             traced, captured = int(dut.traced.value), int(dut.captured.value)
             trace += [int(dut.trace_mem[i].value) for i in range(traced)]
             records += [int(dut.rec_mem[i].value) for i in range(captured)]
@@ -186,13 +181,7 @@ async def _coverage(dut, counters: dict, records: list[dict]) -> dict:
 
     fsm = {
         name: read(handle)
-        for name, handle in (
-            ("state", dut.cov_state),
-            ("arc", dut.cov_arc),
-            ("phase", dut.cov_phase),
-            ("stream", dut.cov_stream),
-            ("lookahead", dut.cov_lookahead),
-        )
+        for name, handle in (("state", dut.cov_state), ("arc", dut.cov_arc), ("phase", dut.cov_phase), ("stream", dut.cov_stream))
     }
     return run_bins(fsm, counters, records)
 
