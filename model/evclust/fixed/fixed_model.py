@@ -484,9 +484,8 @@ def _step_open(S, G, t_whole, k, table, log, ranges):
     phase = G[TAU_PHASE] + ((t - G[T_FILTER]) & TIME_MASK)
     boundaries = phase // k.tau_us
     G[TAU_PHASE] = phase - boundaries * k.tau_us
-    G[SWEEP_PER_FRAME] = (
-        k.frame_per_tau // boundaries if boundaries > 0 else -1
-    )  # T_frame/(n·τ), Q?.F_fpt (it floors to 0 after a long gap); -1: no interval due
+    # T_frame/(n·τ), Q?.F_fpt (it floors to 0 after a long gap); -1: no interval due
+    G[SWEEP_PER_FRAME] = k.frame_per_tau // boundaries if boundaries > 0 else -1
     G[SWEEP_T] = t_whole
     G[T_FILTER] = t
     G[SWEEP_DECAY] = 0
