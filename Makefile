@@ -6,7 +6,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 BUILD  := build
 
-.PHONY: formal setup warm recordings demo-real demo demo-video results-video bench-peers test test-full cosim cosim-full coverage lint synth timing ablation bench results report params registers-html vectors generalize clean
+.PHONY: formal setup warm recordings demo-real demo demo-video results-video bench-peers test test-full cosim cosim-full coverage lint synth timing area ablation bench results report params registers-html vectors generalize clean
 
 setup: $(STAMP)
 
@@ -134,6 +134,13 @@ synth: $(SYNTH_STAMP)
 timing: $(SYNTH_STAMP)
 	$(PY) synth/timing.py --write docs/BENCHMARKS.md --datasheet docs/RTL.md
 	$(PY) synth/activity_reference.py --write docs/BENCHMARKS.md
+
+# Where the logic cells go: the defaults synthesised for the ECP5 with the hierarchy kept, each
+# unit's cells at N = 16 and 64 and what each costs per slot (BENCHMARKS.md's section and
+# docs/img/area_units.png). A few minutes, cached by content in build/area/: run it when rtl/
+# changes, and before placing a change, to price it.
+area: $(SYNTH_STAMP)
+	$(PY) synth/area.py --write docs/BENCHMARKS.md
 
 # What each event-rate addition costs in hardware beside what it buys: the tuning split with each
 # addition switched (docs/ABLATION.md, and its figures for the next step), then Yosys on every

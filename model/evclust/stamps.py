@@ -102,6 +102,7 @@ DOCUMENTS = (
     _bench("synth", ("formats", "rtl"), "make synth"),
     _bench("synth-defaults", ("formats", "rtl"), f"{PY} synth/synth.py --defaults --n 16 --write docs/BENCHMARKS.md"),
     _bench("timing", ("formats", "rtl"), "make timing"),
+    _bench("area", ("formats", "rtl"), "make area"),
     _bench("activity-reference", ("formats", "rtl", "reference"), f"{PY} synth/activity_reference.py --write docs/BENCHMARKS.md"),
     _bench("peers", ("simulator",), "make bench-peers"),
     _bench("recordings", ("float",), f"make recordings && {PY} bench/recordings.py --write docs/BENCHMARKS.md"),
@@ -479,7 +480,7 @@ README_TABLES = f"{PY} -m evclust.readme --write README.md"  # the README's tabl
 AFTER = {f"{PY} bench/rtl.py --write docs/BENCHMARKS.md": ("make timing",)}
 # Each command's wall time on this machine (2 cores, from the documents' own recorded runs), in
 # minutes: only to start the longest first when commands run at once.
-MINUTES = {"make timing": 100, "make ablation": 30, "make report": 20, "make coverage": 20, "make generalize": 25, "make synth": 8,
+MINUTES = {"make timing": 100, "make area": 4, "make ablation": 30, "make report": 20, "make coverage": 20, "make generalize": 25, "make synth": 8,
            f"{PY} synth/synth.py --defaults --n 16 --write docs/BENCHMARKS.md": 6}  # fmt: skip
 
 

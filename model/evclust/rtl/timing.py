@@ -29,7 +29,8 @@ from evclust.rtl.sources import RTL_SOURCES, require_repository
 from evclust.rtl.synth import ABC9_KNOBS, last_step, rtl_snapshot, run_tool, stage_sources, yowasp_command
 
 TOP = "evclust_core"
-PART = {"device": "LFE5U-85F", "nextpnr": ["--85k", "--package", "CABGA381", "--speed", "8"]}
+# The part, and its logic cells (TRELLIS_COMB) and multipliers as nextpnr reports them.
+PART = {"device": "LFE5U-85F", "nextpnr": ["--85k", "--package", "CABGA381", "--speed", "8"], "logic_cells": 83_640, "mult18": 156}
 TARGET_MHZ = 100
 # Part of the cache key with the scripts: bump it when `_figures` reads the results differently.
 FLOW_VERSION = 1
