@@ -65,6 +65,9 @@ module evclust_core #(
     localparam integer P = PALETTE_SIZE;
     localparam integer SLOT_W = N > 1 ? $clog2(N) : 1;
     localparam integer CLASS_W = P > 1 ? $clog2(P) : 1;
+    // The palette's mixing products in multiplier blocks, three an entry, for as many entries as
+    // the LFE5U-85F's 156 leave beside the rest of the core (137 in the defaults' build): six.
+    localparam integer MIXING_DSP_ENTRIES = P < 6 ? P : 6;
     localparam integer SWEEP_LEN = N > P ? N : P;
     // The sweep tail: the operand register, the divider's stages (SWEEP_DIV_STEP bits each) and
     // stage T1's register (the squares and the record, so T2's exit and report start from registers).
@@ -190,17 +193,34 @@ module evclust_core #(
 
     // |V|^2 (model: _speed_sq) from squares taken once per component: each component is
     // clamped to full scale, so its magnitude fits SQ_MAG_W bits and its square a small multiplier.
+    // The product is sized to the clamp, which synthesis cannot see: a magnitude of up to 18 bits
+    // squares in one 18x18 multiplier; a wider one as lo^2 + 2 hi lo 2^18 + hi^2 2^36, three
+    // multipliers where the plain product takes four (the cross term once, doubled by a shift).
     localparam integer SQ_MAG_W = V_FULL_BITS + (FV > FI ? FV : FI);
+    localparam integer SQ_TILE = 18;  // a MULT18X18D operand
+    localparam integer SQ_HI_W = SQ_MAG_W > SQ_TILE ? SQ_MAG_W - SQ_TILE : 1;
     function automatic [2*SQ_MAG_W-1:0] square;
         input signed [63:0] v;
         input integer frac;
         reg signed [63:0] full, c;
         reg [SQ_MAG_W-1:0] m;
+        /* verilator lint_off UNUSEDSIGNAL */  // the bits above lo and hi are zero
+        reg [63:0] wide;
+        /* verilator lint_on UNUSEDSIGNAL */
+        reg [SQ_TILE-1:0] lo;
+        reg [SQ_HI_W-1:0] hi;
+        reg [2*SQ_MAG_W-1:0] lo_lo, hi_lo, hi_hi;  // each product at the square's width
         begin
             full = (64'sd1 <<< (V_FULL_BITS + frac)) - 1;
             c = abs64(saturate(v, -full, full));
             m = c[SQ_MAG_W-1:0];
-            square = m * m;
+            wide = {{(64 - SQ_MAG_W){1'b0}}, m};
+            lo = wide[SQ_TILE-1:0];
+            hi = wide[SQ_TILE +: SQ_HI_W];
+            lo_lo = lo * lo;
+            hi_lo = hi * lo;
+            hi_hi = hi * hi;
+            square = V_FULL_BITS + frac <= SQ_TILE ? lo_lo : lo_lo + (hi_lo << (SQ_TILE + 1)) + (hi_hi << (2 * SQ_TILE));
         end
     endfunction
 
@@ -548,7 +568,7 @@ module evclust_core #(
     wire [VOTE_W-1:0]  vote;
     evclust_palette #(
         .P(P), .CLASS_W(CLASS_W), .BG_BITS(BACKGROUND_W), .INV_BITS(INV_WW_W), .VOTE_BITS(VOTE_W),
-        .LUMA_BITS(LUMA_WEIGHT_W), .TOL_BITS(MIXING_TOLERANCE_W), .STAGES(UPDATE_STAGES)
+        .LUMA_BITS(LUMA_WEIGHT_W), .TOL_BITS(MIXING_TOLERANCE_W), .STAGES(UPDATE_STAGES), .DSP_ENTRIES(MIXING_DSP_ENTRIES)
     ) palette (
         .clk(clk), .rst(dp_rst), .advance(h_load),  // with stage H, its second half is H's
         .lum(e_lum), .cb(e_cb), .cr(e_cr),

@@ -25,7 +25,10 @@ module evclust_palette #(
     parameter integer VOTE_BITS = 10,   // VOTE_W
     parameter integer LUMA_BITS = 8,    // LUMA_WEIGHT_W
     parameter integer TOL_BITS = 11,    // MIXING_TOLERANCE_W
-    parameter integer STAGES = 1        // 1: combinational; 2: one pipeline register
+    parameter integer STAGES = 1,       // 1: combinational; 2: one pipeline register
+    // Entries 0 .. DSP_ENTRIES - 1 take their mixing products q.w in multiplier blocks, the rest
+    // as shifted additions: as shifted additions a product costs some 600 logic cells.
+    parameter integer DSP_ENTRIES = 0
 ) (
     input  wire                  clk,      // STAGES = 2 only
     input  wire                  rst,      // STAGES = 2: clears the register (synchronous)
@@ -202,9 +205,15 @@ module evclust_palette #(
             v_cb = $signed({2'b00, palette_cb[j*8 +: 8]}) - $signed(s2_bi_cb);
             v_cr = $signed({2'b00, palette_cr[j*8 +: 8]}) - $signed(s2_bi_cr);
             q = s2_q[j*MIXING_Q_W +: MIXING_Q_W];
-            qw_y = mul_by_addition($signed({{(64 - MIXING_Q_W){1'b0}}, q}), {{54{v_y[9]}}, v_y}, 10);
-            qw_cb = mul_by_addition($signed({{(64 - MIXING_Q_W){1'b0}}, q}), {{54{v_cb[9]}}, v_cb}, 10);
-            qw_cr = mul_by_addition($signed({{(64 - MIXING_Q_W){1'b0}}, q}), {{54{v_cr[9]}}, v_cr}, 10);
+            if (j < DSP_ENTRIES) begin  // a multiplier block each (one 18x18 holds q by w's 10 bits)
+                qw_y = $signed({{(64 - MIXING_Q_W){1'b0}}, q}) * $signed({{54{v_y[9]}}, v_y});
+                qw_cb = $signed({{(64 - MIXING_Q_W){1'b0}}, q}) * $signed({{54{v_cb[9]}}, v_cb});
+                qw_cr = $signed({{(64 - MIXING_Q_W){1'b0}}, q}) * $signed({{54{v_cr[9]}}, v_cr});
+            end else begin
+                qw_y = mul_by_addition($signed({{(64 - MIXING_Q_W){1'b0}}, q}), {{54{v_y[9]}}, v_y}, 10);
+                qw_cb = mul_by_addition($signed({{(64 - MIXING_Q_W){1'b0}}, q}), {{54{v_cb[9]}}, v_cb}, 10);
+                qw_cr = mul_by_addition($signed({{(64 - MIXING_Q_W){1'b0}}, q}), {{54{v_cr[9]}}, v_cr}, 10);
+            end
             r_y = ($signed({{(RES_W - 10){s2_u_y[9]}}, s2_u_y}) <<< QF) - qw_y[RES_W-1:0];
             r_cb = ($signed({{(RES_W - 10){s2_u_cb[9]}}, s2_u_cb}) <<< QF) - qw_cb[RES_W-1:0];
             r_cr = ($signed({{(RES_W - 10){s2_u_cr[9]}}, s2_u_cr}) <<< QF) - qw_cr[RES_W-1:0];

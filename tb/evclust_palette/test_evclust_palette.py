@@ -198,21 +198,23 @@ def palette_build(name: str) -> tuple[str, dict, dict]:
     return verilog_header(table), widths, {"widths": widths, "k": {name: int(model.k[name]) for name in DTYPE.names}}
 
 
-# One build a simulator in `make test`, drawn from the commit hash for each (all three under both
-# in `make test-full`).
-LEAF_CASES = [("traffic", 1), ("defaults", 1), ("defaults", 2)]
+# (build, STAGES, DSP_ENTRIES): the mixing products as shifted additions (0), in multiplier
+# blocks for every entry (traffic: 8 of 8), and split (defaults: 3 of 7 in blocks, the rest
+# added; the core takes 6 of 7). One case a simulator in `make test`, drawn from the commit hash
+# for each (all of them under both in `make test-full`).
+LEAF_CASES = [("traffic", 1, 0), ("defaults", 1, 0), ("defaults", 2, 0), ("traffic", 2, 8), ("defaults", 1, 3)]
 
 
 @pytest.mark.rotating
 @pytest.mark.parametrize(
-    "sim, build, stages",
+    "sim, build, stages, dsp_entries",
     [(sim, *case) for sim in selected_simulators(PALETTE_SIMULATORS) for case in cosim_share(LEAF_CASES, 1, "palette", sim)],
 )
-def test_the_palette_class_and_vote_match_the_models_functions(sim, build, stages):
+def test_the_palette_class_and_vote_match_the_models_functions(sim, build, stages, dsp_entries):
     header, parameters, config = palette_build(build)
     settings = SETTINGS_ON[sim]
     result = run(sim, header, "palette_vectors", config | {"seed": 11, "stages": stages, "settings": settings},
-                 toplevel="evclust_palette", parameters=parameters | {"STAGES": stages})  # fmt: skip
+                 toplevel="evclust_palette", parameters=parameters | {"STAGES": stages, "DSP_ENTRIES": dsp_entries})  # fmt: skip
     assert result["checked"] == settings * (3 * 256 + 2 * RANDOM_EVENTS) * len(SWITCHES)
     size = parameters["P"]
     # Both rules chose every entry somewhere, so no class index went untested.
