@@ -17,7 +17,6 @@ call with the same header, sources and Yosys build reuses.
 
 from __future__ import annotations
 
-import hashlib
 import json
 import re
 from collections import Counter
@@ -26,7 +25,7 @@ from pathlib import Path
 from evclust.errors import EvclustError
 from evclust.paths import BUILD, REPO
 from evclust.rtl.sources import RTL_SOURCES, require_repository
-from evclust.rtl.synth import ABC9_KNOBS, last_step, rtl_snapshot, run_tool, stage_sources, yosys_command
+from evclust.rtl.synth import ABC9_KNOBS, _first_error, content_key, last_step, rtl_snapshot, run_tool, stage_sources, yosys_command
 
 TOP = "evclust_core"
 # Part of the cache key with the script: bump it when `unit_cells` reads the results differently.
@@ -96,10 +95,7 @@ def module_name(kind: str) -> str:
 
 
 def cache_key(header: str, sources: dict[str, str], identity: str) -> str:
-    digest = hashlib.sha256(f"{FLOW_VERSION}\n{identity}\n{yosys_script(Path('SRC'), Path('OUT'))}\n{header}".encode())
-    for name in sorted(sources):
-        digest.update(f"\n{name}\n{sources[name]}".encode())
-    return digest.hexdigest()[:12]
+    return content_key(f"{FLOW_VERSION}\n{identity}\n{yosys_script(Path('SRC'), Path('OUT'))}\n{header}", sources)
 
 
 def area(header: str, label: str, heartbeat=None, snapshot=None) -> dict:
@@ -120,7 +116,8 @@ def area(header: str, label: str, heartbeat=None, snapshot=None) -> dict:
     beat = (lambda seconds: heartbeat(seconds, last_step(log))) if heartbeat else None
     status, wall = run_tool(yosys + ["-q", "-l", "yosys.log", "synth.ys"], out, out / "yosys.stderr", beat)
     if status != 0 or not (out / "instances.il").exists():
-        raise EvclustError(f"Yosys failed for {label} (exit status {status}; log: {log.relative_to(REPO)})")
+        why = _first_error(log) or _first_error(out / "yosys.stderr") or f"exit status {status}"
+        raise EvclustError(f"Yosys failed for {label}: {why} (log: {log.relative_to(REPO)})")
     units = unit_cells(json.loads((out / "stat.json").read_text()), instances((out / "instances.il").read_text()))
     figures = {"label": label, "rtl": rtl, "yosys": identity, "wall_s": round(wall, 1), "units": units}
     done.write_text(json.dumps(figures, indent=1) + "\n")

@@ -206,13 +206,19 @@ def _figures(out: Path, wall: float, hier: bool, top: str = TOP) -> dict:
     }
 
 
-def cache_key(header: str, sources: dict[str, str], hier: bool, identity: str, top: str = TOP, static: bool = False) -> str:
-    """Everything that decides the figures: the header, the named sources, the script, the
-    figures' reading (FLOW_VERSION) and the Yosys build."""
-    digest = hashlib.sha256(f"{FLOW_VERSION}\n{identity}\n{script(Path('SRC'), Path('OUT'), hier, top, static)}\n{header}".encode())
+def content_key(flow: str, sources: dict[str, str]) -> str:
+    """A run folder's key: the flow's text (its version, tools, scripts and header) and the named
+    sources, so that a run is reused exactly when nothing that decides its figures changed."""
+    digest = hashlib.sha256(flow.encode())
     for name in sorted(sources):
         digest.update(f"\n{name}\n{sources[name]}".encode())
     return digest.hexdigest()[:12]
+
+
+def cache_key(header: str, sources: dict[str, str], hier: bool, identity: str, top: str = TOP, static: bool = False) -> str:
+    """Everything that decides the figures: the header, the named sources, the script, the
+    figures' reading (FLOW_VERSION) and the Yosys build."""
+    return content_key(f"{FLOW_VERSION}\n{identity}\n{script(Path('SRC'), Path('OUT'), hier, top, static)}\n{header}", sources)
 
 
 def rtl_snapshot() -> tuple[dict[str, str], str | None]:

@@ -16,7 +16,6 @@ builds reuses.
 
 from __future__ import annotations
 
-import hashlib
 import json
 import re
 from importlib.metadata import PackageNotFoundError, version
@@ -26,7 +25,7 @@ from evclust.errors import EvclustError
 from evclust.paths import BUILD, REPO
 from evclust.rtl.census import Census, endpoint_census
 from evclust.rtl.sources import RTL_SOURCES, require_repository
-from evclust.rtl.synth import ABC9_KNOBS, last_step, rtl_snapshot, run_tool, stage_sources, yowasp_command
+from evclust.rtl.synth import ABC9_KNOBS, content_key, last_step, rtl_snapshot, run_tool, stage_sources, yowasp_command
 
 TOP = "evclust_core"
 # The part, and its logic cells (TRELLIS_COMB) and multipliers as nextpnr reports them.
@@ -81,11 +80,8 @@ def nextpnr_args(out: Path, route: bool) -> list[str]:
 
 def cache_key(header: str, sources: dict[str, str], route: bool, identity: str, static: bool = False, top: str = TOP,
               extra: tuple[str, ...] = ()) -> str:  # fmt: skip
-    key = f"{FLOW_VERSION}\n{identity}\n{yosys_script(Path('SRC'), Path('OUT'), static, top, extra)}\n{nextpnr_args(Path('OUT'), route)}\n{header}"
-    digest = hashlib.sha256(key.encode())
-    for name in sorted(sources):
-        digest.update(f"\n{name}\n{sources[name]}".encode())
-    return digest.hexdigest()[:12]
+    return content_key(f"{FLOW_VERSION}\n{identity}\n{yosys_script(Path('SRC'), Path('OUT'), static, top, extra)}\n{nextpnr_args(Path('OUT'), route)}\n{header}",
+                       sources)  # fmt: skip
 
 
 def _critical_path(report: dict) -> dict:
