@@ -29,7 +29,12 @@ module evclust_core #(
 ,
     // 1: the constants come from `cfg` (the register file); 0: from the header (CFG_RESET),
     // `cfg` unread, so synthesis folds them into the datapath: the smaller core, one parameter set.
-    parameter integer RUNTIME_CONFIG = 1
+    parameter integer RUNTIME_CONFIG = 1,
+    // The palette entries whose mixing products take multiplier blocks, three an entry (the rest
+    // are shifted additions, some 600 logic cells a product; the results are the same): six
+    // for the LFE5U-85F, whose 156 leave that many beside the rest of the core (137 in the
+    // defaults' build); a part with fewer blocks than logic to spare sets fewer.
+    parameter integer MIXING_DSP = 6
 ) (
     input  wire               clk,
     input  wire               rst,
@@ -65,9 +70,7 @@ module evclust_core #(
     localparam integer P = PALETTE_SIZE;
     localparam integer SLOT_W = N > 1 ? $clog2(N) : 1;
     localparam integer CLASS_W = P > 1 ? $clog2(P) : 1;
-    // The palette's mixing products in multiplier blocks, three an entry, for as many entries as
-    // the LFE5U-85F's 156 leave beside the rest of the core (137 in the defaults' build): six.
-    localparam integer MIXING_DSP_ENTRIES = P < 6 ? P : 6;
+    localparam integer MIXING_DSP_ENTRIES = P < MIXING_DSP ? P : MIXING_DSP;  // MIXING_DSP says why
     localparam integer SWEEP_LEN = N > P ? N : P;
     // The sweep tail: the operand register, the divider's stages (SWEEP_DIV_STEP bits each) and
     // stage T1's register (the squares and the record, so T2's exit and report start from registers).
