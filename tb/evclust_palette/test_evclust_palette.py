@@ -252,7 +252,9 @@ if cocotb is not None:
                 want = pal.expect_at(lum, cb, cr, tolerance, vote_contrast)
                 searched = int(pal.classes(np.array([[lum, cb, cr]], np.int64), [tolerance])[0][0])
                 if searched != want[0]:
-                    error = f"{_describe(pal, lum, cb, cr, 1, vote_contrast, tolerance)}: the search's class {searched}, the model's {want[0]}"
+                    error = (
+                        f"{_describe(pal, lum, cb, cr, 1, vote_contrast, tolerance)}: the search's class {searched}, the model's {want[0]}"
+                    )
                     break
                 dut.mixing_tolerance.value = tolerance
                 got = await _palette_case(dut, rng, pal, lum, cb, cr, 1, vote_contrast, pipelined, bg_max)
