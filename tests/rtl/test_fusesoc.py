@@ -19,9 +19,15 @@ def fileset(name: str, text: str | None = None) -> list[str]:
     return [re.match(r"      - ([^:\s]+)", line).group(1) for line in body.group(1).splitlines()]
 
 
+def unlisted(listed: list[str]) -> tuple[set[str], set[str]]:
+    """(what the tools read but the core file leaves out, what it lists that they do not read)."""
+    read = {f"rtl/{name}" for name in (*RTL_SOURCES, *RTL_INCLUDES, HEADER)}
+    return read - set(listed), set(listed) - read
+
+
 def test_the_core_file_lists_every_source_and_include_the_tools_read():
     listed = fileset("rtl")
-    assert sorted(listed) == sorted(f"rtl/{name}" for name in (*RTL_SOURCES, *RTL_INCLUDES, HEADER))
+    assert unlisted(listed) == (set(), set())
     assert len(listed) == len(set(listed))
 
 
@@ -31,8 +37,7 @@ def test_each_listed_file_exists_and_the_waivers_are_listed():
     assert fileset("lint_waivers") == ["rtl/evclust_lint.vlt"]
 
 
-def test_a_source_left_out_of_the_core_file_shows():
-    """The comparison above fails on a core file without one of the sources (the seek key)."""
+def test_a_source_left_out_of_the_core_file_is_named():
+    """The check names a source a core file leaves out (here the seek key)."""
     text = (REPO / "evclust.core").read_text().replace("      - rtl/evclust_seek_key.v\n", "")
-    listed = fileset("rtl", text)
-    assert "rtl/evclust_seek_key.v" not in listed and len(listed) == len(fileset("rtl")) - 1
+    assert unlisted(fileset("rtl", text)) == ({"rtl/evclust_seek_key.v"}, set())
