@@ -17,7 +17,8 @@ module evclust_axis #(
     parameter integer EV_BYTES = (EV_W + 7) / 8,
     parameter integer REC_BYTES = (REC_W + 7) / 8,
     parameter integer OBJ_BYTES = (OBJ_W + 7) / 8,
-    parameter integer RUNTIME_CONFIG = 1  // 0: the build's parameter set only, in the smaller core
+    parameter integer RUNTIME_CONFIG = 1,  // 0: the build's parameter set only, in the smaller core
+    parameter integer MIXING_DSP = 6       // the palette's multiplier blocks (evclust_core)
 ) (
     input  wire                   clk,
     input  wire                   rst,
@@ -87,7 +88,7 @@ module evclust_axis #(
         .cfg(cfg), .clear(clear), .idle(idle), .count_inc(count_inc), .irq(irq)
     );
 
-    evclust_core #(.N(N), .EV_W(EV_W), .REC_W(REC_W), .TRACE_W(TRACE_W), .OBJ_W(OBJ_W), .CFG_W(CFG_W), .COUNT_W(COUNT_W), .RUNTIME_CONFIG(RUNTIME_CONFIG)) core (
+    evclust_core #(.N(N), .EV_W(EV_W), .REC_W(REC_W), .TRACE_W(TRACE_W), .OBJ_W(OBJ_W), .CFG_W(CFG_W), .COUNT_W(COUNT_W), .RUNTIME_CONFIG(RUNTIME_CONFIG), .MIXING_DSP(MIXING_DSP)) core (
         .clk(clk), .rst(rst), .clear(clear), .cfg(cfg),
         .ev_valid(s_axis_event_tvalid), .ev_ready(s_axis_event_tready), .ev_data(s_axis_event_tdata[EV_W-1:0]),
         .rec_valid(core_rec_valid), .rec_ready(core_rec_ready), .rec_data(core_record),

@@ -29,7 +29,12 @@ module evclust_core #(
 ,
     // 1: the constants come from `cfg` (the register file); 0: from the header (CFG_RESET),
     // `cfg` unread, so synthesis folds them into the datapath: the smaller core, one parameter set.
-    parameter integer RUNTIME_CONFIG = 1
+    parameter integer RUNTIME_CONFIG = 1,
+    // The palette entries whose mixing products take multiplier blocks, three an entry (the rest
+    // are shifted additions, some 600 logic cells a product; the results are the same): six
+    // for the LFE5U-85F, whose 156 leave that many beside the rest of the core (137 in the
+    // defaults' build); a part with fewer blocks than logic to spare sets fewer.
+    parameter integer MIXING_DSP = 6
 ) (
     input  wire               clk,
     input  wire               rst,
@@ -65,9 +70,7 @@ module evclust_core #(
     localparam integer P = PALETTE_SIZE;
     localparam integer SLOT_W = N > 1 ? $clog2(N) : 1;
     localparam integer CLASS_W = P > 1 ? $clog2(P) : 1;
-    // The palette's mixing products in multiplier blocks, three an entry, for as many entries as
-    // the LFE5U-85F's 156 leave beside the rest of the core (137 in the defaults' build): six.
-    localparam integer MIXING_DSP_ENTRIES = P < 6 ? P : 6;
+    localparam integer MIXING_DSP_ENTRIES = P < MIXING_DSP ? P : MIXING_DSP;  // MIXING_DSP says why
     localparam integer SWEEP_LEN = N > P ? N : P;
     // The sweep tail: the operand register, the divider's stages (SWEEP_DIV_STEP bits each) and
     // stage T1's register (the squares and the record, so T2's exit and report start from registers).
@@ -286,15 +289,17 @@ module evclust_core #(
     reg                            reported      [0:N-1];
     reg                            ever_reported [0:N-1];
     // Derived once as the slot is written, for the searches that compare every slot at once
-    // (no multiply per slot): the seek window's reach per axis in P's format, and for merging
-    // merge_scale * max(Rx, Ry) and merge_v_rel * (|Vx| + |Vy|), both unaligned.
+    // (no multiply per slot): the seek window per axis (evclust_seek_window, out of the reach in
+    // P's format), and for merging merge_scale * max(Rx, Ry) and merge_v_rel * (|Vx| + |Vy|),
+    // both unaligned.
     localparam integer SCALED_SEEK_W = SEEK_SCALE_W + HALF_SIZE_W + (FP > SEEK_SCALE_FRAC + FR ? FP - SEEK_SCALE_FRAC - FR : 0);
     localparam integer REACH_BASE_W = HALF_SIZE_W + FP - FR > SEEK_MARGIN_W ? HALF_SIZE_W + FP - FR : SEEK_MARGIN_W;
     localparam integer REACH_W = (REACH_BASE_W > SCALED_SEEK_W ? REACH_BASE_W : SCALED_SEEK_W) + 2;
     localparam integer GROW_W = MERGE_SCALE_W + HALF_SIZE_W;
     localparam integer VREL_W = MERGE_V_REL_W + V_INT_W + 1;
-    reg [REACH_W-1:0]              reach_x       [0:N-1];
-    reg [REACH_W-1:0]              reach_y       [0:N-1];
+    localparam integer WINDOW_W = 2 * (CENTRE_W - FP + 1) + EV_XY_W + FP;
+    reg [WINDOW_W-1:0]             window_x      [0:N-1];
+    reg [WINDOW_W-1:0]             window_y      [0:N-1];
     reg [GROW_W-1:0]               grow          [0:N-1];
     reg [VREL_W-1:0]               vrel          [0:N-1];
 
@@ -413,23 +418,23 @@ module evclust_core #(
     // Every slot's key, and the two smallest of the seek and free-slot keys (evclust_seek).
     reg  [N-1:0]            valid_bits;
     reg  [N*CENTRE_W-1:0]   px_bits, py_bits;
-    reg  [N*REACH_W-1:0]    reach_x_bits, reach_y_bits;
+    reg  [N*WINDOW_W-1:0]   window_x_bits, window_y_bits;
     integer s;
     always @* begin
         for (s = 0; s < N; s = s + 1) begin
             valid_bits[s] = valid[s];
             px_bits[s*CENTRE_W +: CENTRE_W] = px[s];
             py_bits[s*CENTRE_W +: CENTRE_W] = py[s];
-            reach_x_bits[s*REACH_W +: REACH_W] = reach_x[s];
-            reach_y_bits[s*REACH_W +: REACH_W] = reach_y[s];
+            window_x_bits[s*WINDOW_W +: WINDOW_W] = window_x[s];
+            window_y_bits[s*WINDOW_W +: WINDOW_W] = window_y[s];
         end
     end
     wire [SEEK_KEY_W-1:0] seek_first, seek_second;
     wire [FREE_KEY_W-1:0] free_first, free_second;
     evclust_seek #(
-        .N(N), .XY_BITS(EV_XY_W), .CENTRE_BITS(CENTRE_W), .REACH_BITS(REACH_W), .SLOT_BITS(SLOT_W), .KEY_BITS(SEEK_KEY_W)
+        .N(N), .XY_BITS(EV_XY_W), .CENTRE_BITS(CENTRE_W), .WINDOW_BITS(WINDOW_W), .SLOT_BITS(SLOT_W), .KEY_BITS(SEEK_KEY_W)
     ) seek (
-        .x(a_x), .y(a_y), .valid(valid_bits), .centre_x(px_bits), .centre_y(py_bits), .reach_x(reach_x_bits), .reach_y(reach_y_bits),
+        .x(a_x), .y(a_y), .valid(valid_bits), .centre_x(px_bits), .centre_y(py_bits), .window_x(window_x_bits), .window_y(window_y_bits),
         .seek_first(seek_first), .seek_second(seek_second), .free_first(free_first), .free_second(free_second)
     );
 
@@ -440,10 +445,10 @@ module evclust_core #(
     reg [SLOT_W-1:0]     seek_w;
     wire [SEEK_KEY_W-1:0] w_key;
     evclust_seek_key #(
-        .XY_BITS(EV_XY_W), .CENTRE_BITS(CENTRE_W), .REACH_BITS(REACH_W), .SLOT_BITS(SLOT_W), .KEY_BITS(SEEK_KEY_W)
+        .XY_BITS(EV_XY_W), .CENTRE_BITS(CENTRE_W), .WINDOW_BITS(WINDOW_W), .SLOT_BITS(SLOT_W), .KEY_BITS(SEEK_KEY_W)
     ) seek_w_key (
         .x(e_x), .y(e_y), .live(valid[seek_w]), .centre_x(px[seek_w]), .centre_y(py[seek_w]),
-        .reach_x(reach_x[seek_w]), .reach_y(reach_y[seek_w]), .slot(seek_w), .key(w_key)
+        .window_x(window_x[seek_w]), .window_y(window_y[seek_w]), .slot(seek_w), .key(w_key)
     );
     wire [SEEK_KEY_W-1:0] other_key = e_seek_first[SLOT_W-1:0] == seek_w ? e_seek_second : e_seek_first;
     wire [SEEK_KEY_W-1:0] chosen_key = w_key < other_key ? w_key : other_key;
@@ -1182,6 +1187,16 @@ module evclust_core #(
     wire signed [63:0]     d_scaled_seek = r64(size_r) * K_SEEK_SCALE;
     wire signed [63:0]     d_reach_x = reach(size_rx, K_SEEK, d_scaled_seek);
     wire signed [63:0]     d_reach_y = reach(size_ry, K_SEEK, d_scaled_seek);
+    // the centre written with that size: the window moves with it
+    wire [CENTRE_W-1:0]    size_px = m_write ? m_px[CENTRE_W-1:0] : (slot_write ? sw_px : {{(CENTRE_W - EV_XY_W - FP){1'b0}}, e_x, {FP{1'b0}}});
+    wire [CENTRE_W-1:0]    size_py = m_write ? m_py[CENTRE_W-1:0] : (slot_write ? sw_py : {{(CENTRE_W - EV_XY_W - FP){1'b0}}, e_y, {FP{1'b0}}});
+    wire [WINDOW_W-1:0]    d_window_x, d_window_y;
+    evclust_seek_window #(.XY_BITS(EV_XY_W), .CENTRE_BITS(CENTRE_W), .REACH_BITS(REACH_W), .WINDOW_BITS(WINDOW_W)) window_x_unit (
+        .centre(size_px), .reach(d_reach_x[REACH_W-1:0]), .window(d_window_x)
+    );
+    evclust_seek_window #(.XY_BITS(EV_XY_W), .CENTRE_BITS(CENTRE_W), .REACH_BITS(REACH_W), .WINDOW_BITS(WINDOW_W)) window_y_unit (
+        .centre(size_py), .reach(d_reach_y[REACH_W-1:0]), .window(d_window_y)
+    );
     wire signed [63:0]     d_grow = r64(size_r) * K_MERGE_SCALE;
     wire signed [63:0]     d_speed = abs64(s64v(f_vix[V_INT_W-1:0])) + abs64(s64v(f_viy[V_INT_W-1:0]));  // of the words written: <= 2^V_INT_W
     wire signed [63:0]     d_vrel = K_MERGE_V_REL * u64({{(63 - V_INT_W - 1){1'b0}}, d_speed[V_INT_W:0]});
@@ -1673,8 +1688,8 @@ module evclust_core #(
             end
 
             if (size_write) begin
-                reach_x[size_slot] <= d_reach_x[REACH_W-1:0];
-                reach_y[size_slot] <= d_reach_y[REACH_W-1:0];
+                window_x[size_slot] <= d_window_x;
+                window_y[size_slot] <= d_window_y;
                 grow[size_slot] <= d_grow[GROW_W-1:0];
             end
             if (sweep_slot && !moving && !f_expire)

@@ -9,7 +9,7 @@ module evclust_seek #(
     parameter integer N = 16,
     parameter integer XY_BITS = 9,
     parameter integer CENTRE_BITS = 26,
-    parameter integer REACH_BITS = 26,
+    parameter integer WINDOW_BITS = 46,  // evclust_seek_window's
     parameter integer SLOT_BITS = 4,
     parameter integer KEY_BITS = 32
 ) (
@@ -18,8 +18,8 @@ module evclust_seek #(
     input  wire [N-1:0]             valid,     // slot i at bit i, and likewise below
     input  wire [N*CENTRE_BITS-1:0] centre_x,
     input  wire [N*CENTRE_BITS-1:0] centre_y,
-    input  wire [N*REACH_BITS-1:0]  reach_x,
-    input  wire [N*REACH_BITS-1:0]  reach_y,
+    input  wire [N*WINDOW_BITS-1:0] window_x,  // each slot's seek window (evclust_seek_window)
+    input  wire [N*WINDOW_BITS-1:0] window_y,
     output wire [KEY_BITS-1:0]      seek_first,
     output wire [KEY_BITS-1:0]      seek_second,
     output wire [SLOT_BITS:0]       free_first,   // {taken, slot}
@@ -32,11 +32,11 @@ module evclust_seek #(
         for (s = 0; s < N; s = s + 1) begin : slot
             localparam [SLOT_BITS-1:0] INDEX = s;
             evclust_seek_key #(
-                .XY_BITS(XY_BITS), .CENTRE_BITS(CENTRE_BITS), .REACH_BITS(REACH_BITS), .SLOT_BITS(SLOT_BITS), .KEY_BITS(KEY_BITS)
+                .XY_BITS(XY_BITS), .CENTRE_BITS(CENTRE_BITS), .WINDOW_BITS(WINDOW_BITS), .SLOT_BITS(SLOT_BITS), .KEY_BITS(KEY_BITS)
             ) slot_key (
                 .x(x), .y(y), .live(valid[s]),
                 .centre_x(centre_x[s*CENTRE_BITS +: CENTRE_BITS]), .centre_y(centre_y[s*CENTRE_BITS +: CENTRE_BITS]),
-                .reach_x(reach_x[s*REACH_BITS +: REACH_BITS]), .reach_y(reach_y[s*REACH_BITS +: REACH_BITS]),
+                .window_x(window_x[s*WINDOW_BITS +: WINDOW_BITS]), .window_y(window_y[s*WINDOW_BITS +: WINDOW_BITS]),
                 .slot(INDEX), .key(seek_keys[s*KEY_BITS +: KEY_BITS])
             );
             assign free_keys[s*(SLOT_BITS+1) +: SLOT_BITS+1] = {valid[s], INDEX};

@@ -1,7 +1,7 @@
 """The seek's two builds, shared by the seek's bench (tb/evclust_seek) and its per-slot key's
-(tb/evclust_seek_key): the defaults with a scaled seek (seek_scale > 0, so the reach grows with
+(tb/evclust_seek_key) and its per-axis window (tb/evclust_seek_window): the defaults with a scaled seek (seek_scale > 0, so the reach grows with
 max(Rx, Ry)) at N = 16, and the traffic preset (a fixed margin) at N = 4; the fixed model for
-each, and the module parameters evclust_core gives the seek for it."""
+each, the module parameters evclust_core gives the seek for it, and the seek window's definition."""
 
 from __future__ import annotations
 
@@ -42,4 +42,36 @@ def widths(name: str) -> dict:
     params, width, height, t_frame = build_params(name)
     return {"header": params_header(params, width, height, t_frame), "n": n, "xy_w": f["ev_xy"].word_bits,
             "centre_w": f["centre"].word_bits, "reach_w": max(base, scaled) + 2, "slot_w": slot_w,
+            "window_w": window_bits(f["ev_xy"].word_bits, f["centre"].word_bits, fp),
             "key_w": 1 + f["seek_distance"].word_bits + slot_w}  # fmt: skip
+
+
+def window_bits(xy_w: int, centre_w: int, fp: int) -> int:
+    """{lo, hi, up, nf}: lo and up take the centre's integer bits and one more, hi a pixel, nf P's fraction."""
+    return 2 * (centre_w - fp + 1) + xy_w + fp
+
+
+def window(centre: int, reach: int, xy_w: int, centre_w: int, fp: int) -> int:
+    """One axis of a slot's seek window by its definition (rtl/evclust_seek_window.v): the pixels
+    lo..hi within `reach` of the centre P (both in P's format), up = ceil(P / 2^fp) and
+    nf = -P mod 2^fp, packed {lo, hi, up, nf}. Python's >> floors, so -((-a) >> fp) is a ceiling."""
+    lo = max(0, -((reach - centre) >> fp))
+    hi = min((1 << xy_w) - 1, (centre + reach) >> fp)
+    up = -((-centre) >> fp)
+    nf = -centre % (1 << fp)
+    lo_w = centre_w - fp + 1
+    return (((((lo << xy_w) | hi) << lo_w) | up) << fp) | nf
+
+
+def slot_windows(model, S, s: int) -> tuple[int, int]:
+    """Slot s's seek window per axis as the core stores it when the slot is written: the reach,
+    (R << (F_P - F_R)) + the model's `_margin`, about the centre."""
+    from evclust.clusterer.layout import PX, PY, RX, RY
+    from evclust.fixed import fixed_model
+
+    f = model.table.formats
+    fp, xy_w, centre_w = f["centre"].frac_bits, f["ev_xy"].word_bits, f["centre"].word_bits
+    up = fp - f["half_size"].frac_bits
+    margin = int(fixed_model._margin(S, s, model.k))
+    return (window(int(S[s, PX]), (int(S[s, RX]) << up) + margin, xy_w, centre_w, fp),
+            window(int(S[s, PY]), (int(S[s, RY]) << up) + margin, xy_w, centre_w, fp))  # fmt: skip

@@ -3,8 +3,8 @@
 under Icarus and Verilator.
 
 Random tables around each event: live and free slots, centres near the event and far from it,
-half-sizes over their format, equal distances (ties). Each slot's reach comes from the model's
-`_margin`, as the core derives it when the slot is written. Two builds: the defaults with a
+half-sizes over their format, equal distances (ties). Each slot's window comes from the model's
+`_margin`, as the core derives it when the slot is written (tb/seek_builds.py). Two builds: the defaults with a
 scaled seek (seek_scale > 0, so the reach grows with max(Rx, Ry)) at N = 16, and the traffic
 preset (a fixed margin) at N = 4.
 """
@@ -25,7 +25,7 @@ try:
 except ImportError:  # collected by pytest without cocotb: the pytest half still reports why
     cocotb = None
 
-from seek_builds import BUILDS, build_params, model_for, widths  # noqa: F401  (tb/seek_builds.py)
+from seek_builds import BUILDS, build_params, model_for, slot_windows, widths  # noqa: F401  (tb/seek_builds.py)
 
 TABLES = 1500
 
@@ -69,16 +69,6 @@ def model_choice(model, x: int, y: int, S) -> tuple[int, int]:
     return int(fixed_model._seek(S, x << fp, y << fp, model.k)), (free[0] if free else -1)
 
 
-def reaches(model, S) -> list[tuple[int, int]]:
-    """Each slot's reach per axis in P's format, from the model's margin."""
-    from evclust.clusterer.layout import RX, RY
-    from evclust.fixed import fixed_model
-
-    up = model.table["centre"].frac_bits - model.table["half_size"].frac_bits
-    return [(int(S[s, RX] << up) + int(fixed_model._margin(S, s, model.k)), int(S[s, RY] << up) + int(fixed_model._margin(S, s, model.k)))
-            for s in range(S.shape[0])]  # fmt: skip
-
-
 if cocotb is not None:
 
     @cocotb.test()
@@ -89,17 +79,17 @@ if cocotb is not None:
         from evclust.clusterer.layout import PX, PY, VALID
 
         model, width, height = model_for(config["build"])
-        centre_w, reach_w, slot_w, key_w = config["centre_w"], config["reach_w"], config["slot_w"], config["key_w"]
+        centre_w, window_w, slot_w, key_w = config["centre_w"], config["window_w"], config["slot_w"], config["key_w"]
         checked = 0
         for x, y, S in tables(model, width, height, config["seed"]):
             n = S.shape[0]
-            reach = reaches(model, S)
+            windows = [slot_windows(model, S, s) for s in range(n)]
             dut.x.value, dut.y.value = x, y
             dut.valid.value = sum(int(S[s, VALID]) << s for s in range(n))
             dut.centre_x.value = sum(int(S[s, PX]) << (s * centre_w) for s in range(n))
             dut.centre_y.value = sum(int(S[s, PY]) << (s * centre_w) for s in range(n))
-            dut.reach_x.value = sum(r[0] << (s * reach_w) for s, r in enumerate(reach))
-            dut.reach_y.value = sum(r[1] << (s * reach_w) for s, r in enumerate(reach))
+            dut.window_x.value = sum(w[0] << (s * window_w) for s, w in enumerate(windows))
+            dut.window_y.value = sum(w[1] << (s * window_w) for s, w in enumerate(windows))
             await Timer(1, unit="ns")
             first, free = int(dut.seek_first.value), int(dut.free_first.value)
             got = (-1 if first >> (key_w - 1) else first & ((1 << slot_w) - 1), -1 if free >> slot_w else free & ((1 << slot_w) - 1))
@@ -120,7 +110,7 @@ from cosim import LEAF_SIMULATORS, run, selected_simulators  # noqa: E402
 @pytest.mark.parametrize("sim", selected_simulators(LEAF_SIMULATORS))
 def test_the_seek_chooses_the_models_slot_and_the_lowest_free_one(sim, build):
     w = widths(build)
-    parameters = {"N": w["n"], "XY_BITS": w["xy_w"], "CENTRE_BITS": w["centre_w"], "REACH_BITS": w["reach_w"], "SLOT_BITS": w["slot_w"],
+    parameters = {"N": w["n"], "XY_BITS": w["xy_w"], "CENTRE_BITS": w["centre_w"], "WINDOW_BITS": w["window_w"], "SLOT_BITS": w["slot_w"],
                   "KEY_BITS": w["key_w"]}  # fmt: skip
     header = w.pop("header")
     result = run(sim, header, "seek_vectors", {"build": build, "seed": 3} | w, toplevel="evclust_seek", parameters=parameters)

@@ -4,8 +4,8 @@ is {miss, L1 distance, slot} with the distance |x - Px| + |y - Py| in P's format
 
 Random slots around each event, and the edges the key's widths must hold: centres at 0 and at
 the sensor's last pixel, an event at a corner, each axis exactly at the reach and one LSB
-beyond it, half-sizes over their whole format (the reach as the core derives it from the
-model's `_margin` when the slot is written), dead slots. The seek's two builds (tb/seek_builds.py):
+beyond it, half-sizes over their whole format (the window as the core derives it from the
+model's `_margin` when the slot is written: tb/seek_builds.py), dead slots. The seek's two builds (tb/seek_builds.py):
 the scaled seek in `make test`, both in `make test-full`.
 """
 
@@ -24,7 +24,7 @@ try:
 except ImportError:  # collected by pytest without cocotb: the pytest half still reports why
     cocotb = None
 
-from seek_builds import BUILDS, model_for, widths
+from seek_builds import BUILDS, model_for, slot_windows, widths
 
 SLOTS = 3000
 
@@ -71,16 +71,6 @@ def model_key(model, x: int, y: int, S, slot: int, slot_w: int, distance_w: int)
     return (int(not hit) << (distance_w + slot_w)) | ((distance if hit else 0) << slot_w) | slot
 
 
-def reach(model, S) -> tuple[int, int]:
-    """The slot's reach per axis in P's format, as the core stores it when the slot is written."""
-    from evclust.clusterer.layout import RX, RY
-    from evclust.fixed import fixed_model
-
-    up = model.table["centre"].frac_bits - model.table["half_size"].frac_bits
-    margin = int(fixed_model._margin(S, 0, model.k))
-    return (int(S[0, RX]) << up) + margin, (int(S[0, RY]) << up) + margin
-
-
 if cocotb is not None:
 
     @cocotb.test()
@@ -97,10 +87,10 @@ if cocotb is not None:
         checked = 0
         for x, y, S in slots(model, width, height, config["seed"]):
             slot = rng.randrange(1 << slot_w)
-            rx, ry = reach(model, S)
+            wx, wy = slot_windows(model, S, 0)
             dut.x.value, dut.y.value, dut.live.value, dut.slot.value = x, y, int(S[0, VALID]), slot
             dut.centre_x.value, dut.centre_y.value = int(S[0, PX]), int(S[0, PY])
-            dut.reach_x.value, dut.reach_y.value = rx, ry
+            dut.window_x.value, dut.window_y.value = wx, wy
             await Timer(1, unit="ns")
             got, want = int(dut.key.value), model_key(model, x, y, S, slot, slot_w, distance_w)
             checked += 1
@@ -120,7 +110,7 @@ from cosim import LEAF_SIMULATORS, full, run, selected_simulators  # noqa: E402
 @pytest.mark.parametrize("sim", selected_simulators(LEAF_SIMULATORS))
 def test_each_slots_key_is_the_models_hit_and_distance(sim, build):
     w = widths(build)
-    parameters = {"XY_BITS": w["xy_w"], "CENTRE_BITS": w["centre_w"], "REACH_BITS": w["reach_w"], "SLOT_BITS": w["slot_w"],
+    parameters = {"XY_BITS": w["xy_w"], "CENTRE_BITS": w["centre_w"], "WINDOW_BITS": w["window_w"], "SLOT_BITS": w["slot_w"],
                   "KEY_BITS": w["key_w"]}  # fmt: skip
     header = w.pop("header")
     result = run(sim, header, "seek_key_vectors", {"build": build, "seed": 5} | w, toplevel="evclust_seek_key", parameters=parameters)

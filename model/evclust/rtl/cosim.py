@@ -37,6 +37,7 @@ BENCHES = {
     "evclust_merge_search": ((), TB_DIR.parent / "evclust_merge_search", "test_evclust_merge_search"),
     "evclust_seek": ((), TB_DIR.parent / "evclust_seek", "test_evclust_seek"),
     "evclust_seek_key": ((), TB_DIR.parent / "evclust_seek_key", "test_evclust_seek_key"),
+    "evclust_seek_window": ((), TB_DIR.parent / "evclust_seek_window", "test_evclust_seek_window"),
     "evclust_slot_ram": ((), TB_DIR.parent / "evclust_slot_ram", "test_evclust_slot_ram"),
     "evclust_top2": ((), TB_DIR.parent / "evclust_top2", "test_evclust_top2"),
     "evclust_update": ((), TB_DIR.parent / "evclust_update", "test_evclust_update"),

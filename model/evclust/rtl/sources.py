@@ -34,6 +34,7 @@ RTL_SOURCES = (
     "evclust_top2.v",
     "evclust_pipediv.v",
     "evclust_slot_ram.v",
+    "evclust_seek_window.v",
     "evclust_seek_key.v",
     "evclust_seek.v",
     "evclust_merge_search.v",
