@@ -63,7 +63,7 @@ def section(by_n: dict[int, dict[str, dict[str, int]]], rows: list[dict]) -> str
     shared = sum(s for _, s in line.values())
     part = PART["logic_cells"]
     at = {n: shared + per_slot * n for n in (64, 256)}
-    fit = (part - shared) / per_slot
+    fit = int((part - shared) // per_slot)  # the most slots whose line stays within the part
     seconds = ", ".join(f"N = {r['n']}: {r['wall_s'] / 60:.1f} min" for r in rows)
     return "\n".join([
         START,
@@ -82,7 +82,7 @@ def section(by_n: dict[int, dict[str, dict[str, int]]], rows: list[dict]) -> str
         "",
         f"`per slot` and `shared` are the straight line through N = {lo} and N = {hi}. On that line the defaults need "
         f"{at[64]:,.0f} logic cells at N = 64 ({100 * at[64] / part:.0f} % of the LFE5U-85F's {part:,}) and {at[256]:,.0f} "
-        f"at N = 256 ({100 * at[256] / part:.0f} %); with this design the part holds N ≤ {fit:.0f} on the line "
+        f"at N = 256 ({100 * at[256] / part:.0f} %); with this design the part holds N ≤ {fit} on the line "
         f"(in this count, before the flattened build's savings). The picture splits each unit at N = {hi} the same way.",
         "",
         f"![logic cells per unit at N = {hi}](img/{PLOT.name})",
