@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from evclust.errors import EvclustError
-from evclust.rtl.synth import cache_key, in_parallel, rtl_snapshot, script
+from evclust.rtl.synth import MIXING_DSP_TOPS, cache_key, in_parallel, rtl_snapshot, script
 
 
 def test_the_cache_key_changes_with_everything_that_decides_the_figures():
@@ -36,6 +36,16 @@ def test_the_script_reads_every_source_and_measures_the_path_without_registers()
             assert f"/src/{name}" in text
     assert "synth_xilinx -top evclust_core -family xc7 -noiopad -flatten" in text
     assert "ltp -noff * t:FD* %d t:RAM* %d t:SRL* %d @regdsp %d" in text
+
+
+def test_mixing_dsp_is_set_on_exactly_the_tops_that_declare_it():
+    """chparam stops Yosys on a top without the parameter (the object unit's build did)."""
+    sources, _ = rtl_snapshot()
+    declaring = {name[:-2] for name, text in sources.items() if name.endswith(".v") and "parameter integer MIXING_DSP" in text}
+    assert declaring == set(MIXING_DSP_TOPS)
+    for top in ("evclust_core", "evclust_axis", "evclust_objects"):
+        text = script(Path("/src"), Path("/out"), hier=False, top=top)
+        assert ("chparam -set MIXING_DSP" in text) == (top in declaring)
 
 
 def test_runs_in_parallel_overlap_and_come_back_in_the_jobs_order():

